@@ -1,0 +1,31 @@
+"""asp: assembly sequence planning as a robot-vs-human game.
+
+The game DAG (:mod:`asp.dag`), its file formats (:mod:`asp.io`), the synthetic generator
+(:mod:`asp.synth`), the exact solver (:mod:`asp.solve`) and the metrics (:mod:`asp.metrics`).
+This package never imports torch.
+"""
+
+from asp.dag import ANY, HUMAN, ROBOT, GameDAG, from_arrays, from_edges, from_networkx
+from asp.io import load_dag, save_dag
+from asp.metrics import PlanMetrics, plan_metrics
+from asp.solve import Solution, certified_worst_case, evaluate_policy, solve
+from asp.synth import synthetic_dag
+
+__all__ = [
+    "ANY",
+    "HUMAN",
+    "ROBOT",
+    "GameDAG",
+    "PlanMetrics",
+    "Solution",
+    "certified_worst_case",
+    "evaluate_policy",
+    "from_arrays",
+    "from_edges",
+    "from_networkx",
+    "load_dag",
+    "plan_metrics",
+    "save_dag",
+    "solve",
+    "synthetic_dag",
+]

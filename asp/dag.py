@@ -1,0 +1,435 @@
+"""The game DAG: an array-backed directed acyclic graph the robot and the human play on.
+
+Nodes are indexed ``0 .. n-1``; each keeps its original id (an int or a string) in
+``node_ids``. Out-edges are stored in CSR form: the edges leaving node ``v`` are
+``indptr[v]:indptr[v+1]``, with their heads in ``targets``, their costs in ``costs`` and the
+side that may take them in ``sides``.
+
+Turn model (``../shared/DESIGN.md``, "The game"): the robot moves first; on its turn a player
+takes one out-edge open to its side (``ROBOT``, ``HUMAN`` or ``ANY``); a player with none
+passes at zero cost; the turn then flips. A game state is ``(node, player on turn)``.
+On a synthetic DAG every edge is ``ANY``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass, field
+
+import networkx as nx
+import numpy as np
+
+ROBOT = 0
+HUMAN = 1
+ANY = 2
+SIDE_NAMES = ("robot", "human", "any")
+PLAYERS = (ROBOT, HUMAN)
+
+
+def side_from_name(name: str) -> int:
+    """Return the side code of ``"robot"``, ``"human"`` or ``"any"``."""
+    try:
+        return SIDE_NAMES.index(str(name).lower())
+    except ValueError:
+        raise ValueError(
+            f"unknown side {name!r}: expected one of {', '.join(SIDE_NAMES)}"
+        ) from None
+
+
+@dataclass(frozen=True, eq=False)
+class GameDAG:
+    """A validated game DAG.
+
+    Attributes
+    ----------
+    node_ids : tuple, length n
+        The original id of each node (int or str).
+    indptr : (n + 1,) int64
+        CSR row pointer: the out-edges of node ``v`` are ``indptr[v]:indptr[v + 1]``.
+    targets : (m,) int64
+        Head node index of each edge.
+    costs : (m,) float64
+        Cost of each edge (``>= 0``).
+    sides : (m,) int8
+        Who may take each edge: ``ROBOT``, ``HUMAN`` or ``ANY``.
+    start, end : int
+        Start and end node indices.
+    operations, agents : tuple of str or None, length m
+        Optional edge labels (operation id, agent name).
+    node_labels : tuple of str or None, length n
+        Optional human-readable node descriptions.
+    cost_model : str
+        ``"steps"`` or ``"time"``.
+    metadata : dict
+        Free-form provenance (generator parameters, source file, ...).
+    """
+
+    node_ids: tuple
+    indptr: np.ndarray
+    targets: np.ndarray
+    costs: np.ndarray
+    sides: np.ndarray
+    start: int
+    end: int
+    operations: tuple[str, ...] | None = None
+    agents: tuple[str, ...] | None = None
+    node_labels: tuple[str, ...] | None = None
+    cost_model: str = "steps"
+    turn_model: str = "alternate"
+    metadata: dict = field(default_factory=dict)
+
+    # ------------------------------------------------------------------ sizes
+    @property
+    def n_nodes(self) -> int:
+        return len(self.node_ids)
+
+    @property
+    def n_edges(self) -> int:
+        return int(self.targets.shape[0])
+
+    @property
+    def sources(self) -> np.ndarray:
+        """(m,) int64: tail node index of each edge."""
+        return np.repeat(np.arange(self.n_nodes, dtype=np.int64), np.diff(self.indptr))
+
+    def out_edges(self, v: int) -> range:
+        """Edge indices leaving node ``v``."""
+        return range(int(self.indptr[v]), int(self.indptr[v + 1]))
+
+    def moves(self, v: int, player: int) -> list[int]:
+        """Edge indices player ``player`` may take from node ``v`` (empty: it passes)."""
+        lo, hi = int(self.indptr[v]), int(self.indptr[v + 1])
+        return [e for e in range(lo, hi) if self.sides[e] == ANY or self.sides[e] == player]
+
+    def index_of(self, node_id) -> int:
+        """Index of the node whose original id is ``node_id`` (also accepts its str form)."""
+        lookup = self._lookup()
+        if node_id in lookup:
+            return lookup[node_id]
+        key = str(node_id)
+        if key in lookup:
+            return lookup[key]
+        raise ValueError(f"unknown node {node_id!r}")
+
+    def _lookup(self) -> dict:
+        cached = self.__dict__.get("_lookup_cache")
+        if cached is None:
+            cached = {}
+            for i, nid in enumerate(self.node_ids):
+                cached[nid] = i
+                cached.setdefault(str(nid), i)
+            object.__setattr__(self, "_lookup_cache", cached)
+        return cached
+
+    def edge_label(self, e: int) -> str:
+        """A short description of edge ``e``: operation and agent where known."""
+        parts = []
+        if self.operations is not None and self.operations[e]:
+            parts.append(self.operations[e])
+        if self.agents is not None and self.agents[e]:
+            parts.append(self.agents[e])
+        return " ".join(parts)
+
+    # ---------------------------------------------------------------- convert
+    def to_networkx(self) -> nx.DiGraph:
+        """A networkx DiGraph keyed by original node ids, edges carrying ``cost`` and labels."""
+        g = nx.DiGraph(start=self.node_ids[self.start], end=self.node_ids[self.end])
+        g.graph["cost_model"] = self.cost_model
+        for i, nid in enumerate(self.node_ids):
+            attrs = {"label": self.node_labels[i]} if self.node_labels is not None else {}
+            g.add_node(nid, **attrs)
+        src = self.sources
+        for e in range(self.n_edges):
+            attrs = {"cost": float(self.costs[e]), "side": SIDE_NAMES[int(self.sides[e])]}
+            if self.operations is not None:
+                attrs["operation"] = self.operations[e]
+            if self.agents is not None:
+                attrs["agent"] = self.agents[e]
+            g.add_edge(self.node_ids[src[e]], self.node_ids[int(self.targets[e])], **attrs)
+        return g
+
+
+def from_edges(
+    node_ids: Sequence,
+    edges: Iterable[tuple],
+    *,
+    start=None,
+    end=None,
+    costs: Sequence[float] | None = None,
+    sides: Sequence[int] | None = None,
+    operations: Sequence[str] | None = None,
+    agents: Sequence[str] | None = None,
+    node_labels: Sequence[str] | None = None,
+    cost_model: str = "steps",
+    metadata: dict | None = None,
+) -> GameDAG:
+    """Build and validate a :class:`GameDAG` from node ids and ``(u, v)`` edge pairs.
+
+    ``start`` / ``end`` default to the one node without in-edges / out-edges. Edge order is
+    kept within each node (it fixes move indices and so tie-breaks). Costs default to 1,
+    sides to ``ANY``.
+
+    Raises
+    ------
+    ValueError
+        Empty graph, duplicate node, unknown node in an edge, negative or non-finite cost,
+        a cycle (one is named), a node other than the end without out-edges, no path from
+        start to end, or ambiguous start/end.
+    """
+    node_ids = tuple(node_ids)
+    if not node_ids:
+        raise ValueError("empty graph: expected at least one node")
+    index: dict = {}
+    for i, nid in enumerate(node_ids):
+        if nid in index:
+            raise ValueError(f"duplicate node {nid!r}")
+        index[nid] = i
+    edge_list = list(edges)
+    m = len(edge_list)
+    src = np.empty(m, dtype=np.int64)
+    dst = np.empty(m, dtype=np.int64)
+    for k, (u, v) in enumerate(edge_list):
+        for x in (u, v):
+            if x not in index:
+                raise ValueError(f"edge ({u!r}, {v!r}) names unknown node {x!r}")
+        src[k], dst[k] = index[u], index[v]
+    cost_arr = np.ones(m) if costs is None else np.asarray(costs, dtype=np.float64)
+    side_arr = np.full(m, ANY, np.int8) if sides is None else np.asarray(sides, dtype=np.int8)
+    for name, arr in (("costs", cost_arr), ("sides", side_arr)):
+        if arr.shape != (m,):
+            raise ValueError(f"{name}: expected {m} values, got shape {arr.shape}")
+    for name, labels in (("operations", operations), ("agents", agents)):
+        if labels is not None and len(labels) != m:
+            raise ValueError(f"{name}: expected {m} labels, got {len(labels)}")
+    if node_labels is not None and len(node_labels) != len(node_ids):
+        raise ValueError(f"node_labels: expected {len(node_ids)} labels, got {len(node_labels)}")
+    return from_arrays(
+        node_ids,
+        src,
+        dst,
+        cost_arr,
+        side_arr,
+        start=None if start is None else _resolve(index, start, "start"),
+        end=None if end is None else _resolve(index, end, "end"),
+        operations=None if operations is None else tuple(str(x) for x in operations),
+        agents=None if agents is None else tuple(str(x) for x in agents),
+        node_labels=None if node_labels is None else tuple(str(x) for x in node_labels),
+        cost_model=cost_model,
+        metadata=metadata,
+    )
+
+
+def _resolve(index: dict, nid, what: str) -> int:
+    if nid in index:
+        return index[nid]
+    for key, i in index.items():
+        if str(key) == str(nid):
+            return i
+    raise ValueError(f"{what} node {nid!r} is not in the graph")
+
+
+def from_arrays(
+    node_ids: Sequence,
+    src: np.ndarray,
+    dst: np.ndarray,
+    costs: np.ndarray | None = None,
+    sides: np.ndarray | None = None,
+    *,
+    start: int | None = None,
+    end: int | None = None,
+    operations: tuple[str, ...] | None = None,
+    agents: tuple[str, ...] | None = None,
+    node_labels: tuple[str, ...] | None = None,
+    cost_model: str = "steps",
+    metadata: dict | None = None,
+    validate: bool = True,
+) -> GameDAG:
+    """Build a :class:`GameDAG` from edge arrays of node indices (the fast path).
+
+    Parameters
+    ----------
+    node_ids : sequence, length n
+    src, dst : (m,) int
+        Tail and head node index of each edge. Edges are stably sorted by tail.
+    costs : (m,) float, optional (default 1)
+    sides : (m,) int8, optional (default ``ANY``)
+    """
+    n = len(node_ids)
+    if n == 0:
+        raise ValueError("empty graph: expected at least one node")
+    src = np.asarray(src, dtype=np.int64)
+    dst = np.asarray(dst, dtype=np.int64)
+    m = src.shape[0]
+    if dst.shape != (m,):
+        raise ValueError(f"src and dst: expected equal lengths, got {m} and {dst.shape[0]}")
+    costs = np.ones(m) if costs is None else np.asarray(costs, dtype=np.float64)
+    sides = np.full(m, ANY, np.int8) if sides is None else np.asarray(sides, dtype=np.int8)
+    if m and (min(src.min(), dst.min()) < 0 or max(src.max(), dst.max()) >= n):
+        raise ValueError(f"edge endpoints: expected node indices in [0, {n}), got out of range")
+    order = np.argsort(src, kind="stable")
+    if m and np.any(order != np.arange(m)):
+        src, dst, costs, sides = src[order], dst[order], costs[order], sides[order]
+        operations = None if operations is None else tuple(operations[i] for i in order)
+        agents = None if agents is None else tuple(agents[i] for i in order)
+    indptr = np.zeros(n + 1, dtype=np.int64)
+    np.cumsum(np.bincount(src, minlength=n), out=indptr[1:])
+    if start is None:
+        start = _unique_node(
+            np.flatnonzero(np.bincount(dst, minlength=n) == 0), node_ids, "start", "in-edges"
+        )
+    if end is None:
+        end = _unique_node(np.flatnonzero(np.diff(indptr) == 0), node_ids, "end", "out-edges")
+    dag = GameDAG(
+        node_ids=tuple(node_ids),
+        indptr=indptr,
+        targets=dst,
+        costs=costs,
+        sides=sides,
+        start=int(start),
+        end=int(end),
+        operations=operations,
+        agents=agents,
+        node_labels=node_labels,
+        cost_model=cost_model,
+        metadata=dict(metadata or {}),
+    )
+    if validate:
+        validate_dag(dag)
+    return dag
+
+
+def _unique_node(candidates: np.ndarray, node_ids: Sequence, what: str, lacking: str) -> int:
+    if candidates.size != 1:
+        names = ", ".join(repr(node_ids[i]) for i in candidates[:5])
+        raise ValueError(
+            f"cannot infer the {what} node: expected exactly one node without {lacking}, "
+            f"found {candidates.size}" + (f" ({names})" if candidates.size else "")
+        )
+    return int(candidates[0])
+
+
+def topological_order(dag: GameDAG) -> np.ndarray:
+    """(n,) int64 node indices in topological order (Kahn's algorithm, vectorised by level).
+
+    Raises ``ValueError`` naming a node on a cycle if the graph is not acyclic.
+    """
+    n = dag.n_nodes
+    indeg = np.bincount(dag.targets, minlength=n).astype(np.int64)
+    src = dag.sources
+    frontier = np.flatnonzero(indeg == 0)
+    out = [frontier]
+    seen = frontier.size
+    while frontier.size:
+        # Edges leaving the frontier, then the heads whose last in-edge was just removed.
+        lo, hi = dag.indptr[frontier], dag.indptr[frontier + 1]
+        edge_idx = _ranges(lo, hi)
+        heads = dag.targets[edge_idx]
+        np.subtract.at(indeg, heads, 1)
+        frontier = np.unique(heads[indeg[heads] == 0])
+        seen += frontier.size
+        out.append(frontier)
+    if seen != n:
+        raise ValueError(f"graph has a cycle: {_cycle_text(dag, src)}")
+    return np.concatenate(out).astype(np.int64)
+
+
+def _ranges(lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """Concatenate ``arange(lo[i], hi[i])`` for all i, vectorised."""
+    lengths = hi - lo
+    total = int(lengths.sum())
+    if total == 0:
+        return np.empty(0, dtype=np.int64)
+    offsets = np.repeat(lo - np.cumsum(lengths) + lengths, lengths)
+    return offsets + np.arange(total, dtype=np.int64)
+
+
+def _cycle_text(dag: GameDAG, src: np.ndarray) -> str:
+    g = nx.DiGraph()
+    g.add_edges_from(zip(src.tolist(), dag.targets.tolist(), strict=True))
+    cycle = nx.find_cycle(g)
+    nodes = [dag.node_ids[u] for u, _ in cycle] + [dag.node_ids[cycle[0][0]]]
+    return " -> ".join(str(x) for x in nodes)
+
+
+def validate_dag(dag: GameDAG) -> None:
+    """Check the invariants the solvers rely on; raise ``ValueError`` naming the fault."""
+    if dag.n_nodes == 0:
+        raise ValueError("empty graph: expected at least one node")
+    if dag.cost_model not in ("steps", "time"):
+        raise ValueError(f"cost_model: expected 'steps' or 'time', got {dag.cost_model!r}")
+    if dag.turn_model != "alternate":
+        raise ValueError(f"turn_model: expected 'alternate', got {dag.turn_model!r}")
+    if dag.n_edges:
+        bad = np.flatnonzero(~np.isfinite(dag.costs) | (dag.costs < 0))
+        if bad.size:
+            e = int(bad[0])
+            u, v = dag.node_ids[int(dag.sources[e])], dag.node_ids[int(dag.targets[e])]
+            raise ValueError(f"edge ({u!r}, {v!r}) has negative or non-finite cost {dag.costs[e]}")
+        if np.any((dag.sides < 0) | (dag.sides > ANY)):
+            raise ValueError("sides: expected values 0 (robot), 1 (human) or 2 (any)")
+        loops = np.flatnonzero(dag.sources == dag.targets)
+        if loops.size:
+            nid = dag.node_ids[int(dag.targets[loops[0]])]
+            raise ValueError(f"graph has a cycle: self-loop at node {nid!r}")
+    if dag.indptr[dag.end + 1] != dag.indptr[dag.end]:
+        raise ValueError(f"end node {dag.node_ids[dag.end]!r} has out-edges")
+    order = topological_order(dag)
+    del order
+    dead = np.flatnonzero(np.diff(dag.indptr) == 0)
+    dead = dead[dead != dag.end]
+    if dead.size:
+        raise ValueError(
+            f"node {dag.node_ids[int(dead[0])]!r} has no out-edge but is not the end node "
+            f"{dag.node_ids[dag.end]!r}"
+        )
+    if not reachable(dag)[dag.end]:
+        raise ValueError(
+            f"no path from start {dag.node_ids[dag.start]!r} to end {dag.node_ids[dag.end]!r}"
+        )
+
+
+def reachable(dag: GameDAG, source: int | None = None) -> np.ndarray:
+    """(n,) bool: nodes reachable from ``source`` (default: the start), by frontier sweeps."""
+    seen = np.zeros(dag.n_nodes, dtype=bool)
+    frontier = np.array([dag.start if source is None else source], dtype=np.int64)
+    seen[frontier] = True
+    while frontier.size:
+        heads = dag.targets[_ranges(dag.indptr[frontier], dag.indptr[frontier + 1])]
+        heads = np.unique(heads[~seen[heads]])
+        seen[heads] = True
+        frontier = heads
+    return seen
+
+
+def from_networkx(g: nx.DiGraph, *, start=None, end=None, cost_model: str | None = None) -> GameDAG:
+    """Build a :class:`GameDAG` from a networkx DiGraph.
+
+    Start and end come from the arguments, else the graph attributes ``start`` / ``end``,
+    else the one node without in-edges / out-edges. Edge attributes used: ``cost``
+    (default 1), ``side`` (``robot``/``human``/``any``, default any), ``operation``, ``agent``.
+    """
+    if not isinstance(g, nx.DiGraph) or g.is_multigraph():
+        raise ValueError(f"expected a networkx DiGraph, got {type(g).__name__}")
+    nodes = list(g.nodes)
+    start = g.graph.get("start") if start is None else start
+    end = g.graph.get("end") if end is None else end
+    edges = list(g.edges(data=True))
+    has_ops = any("operation" in d for _, _, d in edges)
+    has_agents = any("agent" in d for _, _, d in edges)
+    labels = [g.nodes[v].get("label") for v in nodes]
+    try:
+        costs = [float(d.get("cost", 1.0)) for _, _, d in edges]
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"edge cost: expected a number ({exc})") from None
+    return from_edges(
+        nodes,
+        [(u, v) for u, v, _ in edges],
+        start=start,
+        end=end,
+        costs=costs,
+        sides=[side_from_name(d.get("side", "any")) for _, _, d in edges],
+        operations=[str(d.get("operation", "")) for _, _, d in edges] if has_ops else None,
+        agents=[str(d.get("agent", "")) for _, _, d in edges] if has_agents else None,
+        node_labels=[str(x) for x in labels] if all(x is not None for x in labels) else None,
+        cost_model=cost_model or g.graph.get("cost_model", "steps"),
+    )

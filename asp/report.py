@@ -1,0 +1,36 @@
+"""Plain-text renderings of results, for a person at a terminal."""
+
+from __future__ import annotations
+
+from asp.metrics import PlanMetrics
+
+
+def _num(x: float) -> str:
+    return str(int(x)) if float(x).is_integer() else f"{x:.3f}"
+
+
+def metrics_text(m: PlanMetrics, title: str = "") -> str:
+    """A two-column table of the metrics and the robust path."""
+    rows = [
+        ("nodes / edges", f"{m.nodes} / {m.edges}"),
+        ("TCT (cooperative minimum)", _num(m.tct)),
+        ("W* (minimax value)", _num(m.minimax)),
+        ("WCPL (reference)", _num(m.wcpl)),
+        ("certified WCPL", _num(m.certified_wcpl)),
+        ("robust-optimal", "yes" if m.robust_optimal else "no"),
+        ("avg random length (exact)", f"{m.avg_random:.3f}"),
+        ("min / max random length (exact)", f"{_num(m.min_random)} / {_num(m.max_random)}"),
+        ("RR vs reference WCPL (exact)", f"{100 * m.rr:.1f}%"),
+        ("RR vs certified WCPL", f"{100 * m.rr_certified:.1f}%"),
+        (
+            f"simulated ({m.games} games, seed {m.seed})",
+            f"avg {m.avg_random_sampled:.3f}, max {_num(m.max_random_sampled)}, "
+            f"RR {100 * m.rr_sampled:.1f}%",
+        ),
+        ("adversarial tax (W*/TCT)", f"{m.adversarial_tax:.2f}"),
+    ]
+    width = max(len(k) for k, _ in rows)
+    lines = [title] if title else []
+    lines += [f"{k.ljust(width)}  {v}" for k, v in rows]
+    lines.append("robust path (both play minimax): " + " -> ".join(str(x) for x in m.robust_path))
+    return "\n".join(lines)
