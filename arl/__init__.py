@@ -1,0 +1,1 @@
+"""arl: adversarial reinforcement learning of the robot policy on game DAGs."""
