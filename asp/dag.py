@@ -371,20 +371,19 @@ def validate_dag(dag: GameDAG) -> None:
         if loops.size:
             nid = dag.node_ids[int(dag.targets[loops[0]])]
             raise ValueError(f"graph has a cycle: self-loop at node {nid!r}")
+    topological_order(dag)  # raises on a cycle, naming one
     if dag.indptr[dag.end + 1] != dag.indptr[dag.end]:
         raise ValueError(f"end node {dag.node_ids[dag.end]!r} has out-edges")
-    order = topological_order(dag)
-    del order
+    if not reachable(dag)[dag.end]:
+        raise ValueError(
+            f"no path from start {dag.node_ids[dag.start]!r} to end {dag.node_ids[dag.end]!r}"
+        )
     dead = np.flatnonzero(np.diff(dag.indptr) == 0)
     dead = dead[dead != dag.end]
     if dead.size:
         raise ValueError(
             f"node {dag.node_ids[int(dead[0])]!r} has no out-edge but is not the end node "
             f"{dag.node_ids[dag.end]!r}"
-        )
-    if not reachable(dag)[dag.end]:
-        raise ValueError(
-            f"no path from start {dag.node_ids[dag.start]!r} to end {dag.node_ids[dag.end]!r}"
         )
 
 

@@ -69,9 +69,9 @@ def simulate_random_human(
         humans = active & (player == HUMAN)
         count = h_indptr[node[humans] + 1] - h_indptr[node[humans]]
         pick = np.floor(rng.random(humans.sum()) * np.maximum(count, 1)).astype(np.int64)
-        chosen = np.where(
-            count > 0, h_edges[np.minimum(h_indptr[node[humans]] + pick, len(h_edges) - 1)], -1
-        )
+        chosen = np.full(count.shape, -1, dtype=np.int64)
+        has = count > 0  # a human without a move passes
+        chosen[has] = h_edges[h_indptr[node[humans]][has] + pick[has]]
         edge[humans] = chosen
         moving = edge >= 0
         cost[moving] += dag.costs[edge[moving]]
@@ -93,7 +93,8 @@ def random_cost_distribution(dag: GameDAG, robot_policy: np.ndarray) -> dict[flo
     dist: dict[tuple[int, int], dict[float, float]] = {}
     for v in node_order(dag)[::-1]:
         v = int(v)
-        for p in (HUMAN, ROBOT):
+        passes = []
+        for p in (ROBOT, HUMAN):
             if not reach[v, p]:
                 continue
             if v == dag.end:
@@ -104,8 +105,8 @@ def random_cost_distribution(dag: GameDAG, robot_policy: np.ndarray) -> dict[flo
                 moves = [e] if e >= 0 else []
             else:
                 moves = h_edges[h_indptr[v] : h_indptr[v + 1]].tolist()
-            if not moves:  # pass
-                dist[v, p] = dist[v, 1 - p]
+            if not moves:
+                passes.append(p)
                 continue
             out: dict[float, float] = {}
             share = 1.0 / len(moves)
@@ -115,6 +116,8 @@ def random_cost_distribution(dag: GameDAG, robot_policy: np.ndarray) -> dict[flo
                     key = round(value + c, 9)
                     out[key] = out.get(key, 0.0) + prob * share
             dist[v, p] = out
+        for p in passes:  # a pass costs nothing: same distribution as the other side's turn
+            dist[v, p] = dist[v, 1 - p]
     return dict(sorted(dist[dag.start, ROBOT].items()))
 
 

@@ -325,9 +325,11 @@ def _first_invalid_state(indptr, targets, sides, policy, worst, start):  # pragm
     while top > 0:
         top -= 1
         v, p = stack_v[top], stack_p[top]
-        if np.isnan(worst[v, ROBOT]) and p == ROBOT:
-            return v
         lo, hi = indptr[v], indptr[v + 1]
+        if p == ROBOT and np.isnan(worst[v, ROBOT]):
+            e = policy[v]
+            if e < lo or e >= hi or not (sides[e] == ANY or sides[e] == ROBOT):
+                return v
         moved = False
         for e in range(lo, hi):
             s = sides[e]

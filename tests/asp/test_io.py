@@ -1,0 +1,92 @@
+"""Graph files: asmplan-dag/1 JSON and GraphML, with clear errors on bad files."""
+
+import json
+
+import networkx as nx
+import pytest
+
+from asp.dag import HUMAN, from_edges
+from asp.io import dag_to_dict, load_dag, save_dag
+from asp.synth import synthetic_dag
+
+
+def _same(a, b):
+    assert [str(x) for x in a.node_ids] == [str(x) for x in b.node_ids]
+    assert a.indptr.tolist() == b.indptr.tolist()
+    assert a.targets.tolist() == b.targets.tolist()
+    assert a.costs.tolist() == b.costs.tolist()
+    assert a.sides.tolist() == b.sides.tolist()
+    assert (a.start, a.end) == (b.start, b.end)
+
+
+@pytest.mark.parametrize("suffix", [".json", ".graphml"])
+def test_round_trip(tmp_path, suffix):
+    dag = from_edges(
+        ["s", "a", "t"],
+        [("s", "a"), ("a", "t"), ("s", "t")],
+        costs=[1.5, 2, 7],
+        sides=[0, HUMAN, 2],
+        operations=["1.1", "1.2", "2.1"],
+        agents=["R1", "H", "R2"],
+        cost_model="time",
+    )
+    path = save_dag(dag, tmp_path / f"g{suffix}")
+    back = load_dag(path)
+    _same(dag, back)
+    assert back.operations == dag.operations and back.agents == dag.agents
+    assert back.cost_model == "time"
+
+
+def test_synthetic_json_keeps_metadata(tmp_path):
+    dag = synthetic_dag(4, 10, 4, seed=1)
+    back = load_dag(save_dag(dag, tmp_path / "g.json"))
+    _same(dag, back)
+    assert back.metadata["seed"] == 1
+
+
+def test_plain_networkx_graphml(tmp_path):
+    g = nx.DiGraph()
+    g.add_edge(1, 2, cost=3)
+    g.add_edge(1, 3)
+    g.add_edge(2, 4)
+    g.add_edge(3, 4)
+    nx.write_graphml(g, tmp_path / "plain.graphml")
+    dag = load_dag(tmp_path / "plain.graphml")
+    assert dag.node_ids[dag.start] == "1" and dag.node_ids[dag.end] == "4"
+    assert sorted(dag.costs.tolist()) == [1, 1, 1, 3]
+
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        ("{not json", "malformed JSON"),
+        ('{"format": "other/1", "nodes": [], "edges": []}', "expected format"),
+        ('{"nodes": [1, 2], "edges": [[1, 2]]}', "malformed graph"),
+        ('{"nodes": [], "edges": []}', "empty graph"),
+        ('{"nodes": [1, 2], "edges": [{"source": 1, "target": 3}]}', "unknown node 3"),
+        ('{"nodes": [1, 2], "edges": [{"source": 1, "target": 2, "cost": -2}]}', "negative"),
+        ("[1, 2]", "expected a JSON object"),
+    ],
+)
+def test_bad_json_names_the_file(tmp_path, content, message):
+    path = tmp_path / "bad.json"
+    path.write_text(content)
+    with pytest.raises(ValueError, match=message) as info:
+        load_dag(path)
+    assert "bad.json" in str(info.value)
+
+
+def test_missing_file_and_unknown_suffix(tmp_path):
+    with pytest.raises(FileNotFoundError, match="nope.json"):
+        load_dag(tmp_path / "nope.json")
+    (tmp_path / "g.txt").write_text("x")
+    with pytest.raises(ValueError, match="unknown graph format"):
+        load_dag(tmp_path / "g.txt")
+
+
+def test_save_is_atomic_and_readable_json(tmp_path):
+    dag = synthetic_dag(3, 3, 2, seed=0)
+    path = save_dag(dag, tmp_path / "sub" / "g.json")
+    data = json.loads(path.read_text())
+    assert data == dag_to_dict(dag) | {"metadata": data["metadata"]}
+    assert [p.name for p in path.parent.iterdir()] == ["g.json"]
