@@ -12,3 +12,4 @@ from arl.cli.app import app, main
 from arl.cli import core as _core  # noqa: F401, E402  isort: skip
 
 __all__ = ["app", "main"]
+from arl.cli import cad as _cad  # noqa: F401, E402  isort: skip

@@ -1,0 +1,45 @@
+"""``asmplan relations``: contact and translational-freedom tables of an assembly."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from arl.cli.app import TableFormat, app
+
+
+@app.command("relations")
+def relations_command(
+    assembly: Path = typer.Argument(
+        ..., help="Folder of part meshes, multi-body scene (GLB/glTF/3MF/STEP) or assembly.yaml."
+    ),
+    fmt: TableFormat = typer.Option(TableFormat.text, "--format", help="Output format."),
+    contact_tol: float | None = typer.Option(
+        None, "--contact-tol", help="Contact tolerance in mm (default 0.01)."
+    ),
+    penetration_tol: float | None = typer.Option(
+        None,
+        "--penetration-tol",
+        help="Penetration tolerance in mm (default max(0.05, 0.001 x median part diagonal)).",
+    ),
+    units: str | None = typer.Option(
+        None, "--units", help="Unit of mesh files that declare none (default mm)."
+    ),
+    progress: bool = typer.Option(False, "--progress", help="Show progress on stderr."),
+) -> None:
+    """Compute TC (contact) and TT (translational freedom) for every pair of parts."""
+    from cad import compute_relations, load_assembly
+    from cad.report import relations_csv, relations_json, relations_markdown, relations_text
+
+    loaded = load_assembly(assembly, units=units)
+    relations = compute_relations(
+        loaded, contact_tol=contact_tol, penetration_tol=penetration_tol, progress=progress
+    )
+    render = {
+        TableFormat.text: relations_text,
+        TableFormat.json: relations_json,
+        TableFormat.csv: relations_csv,
+        TableFormat.markdown: relations_markdown,
+    }[fmt]
+    typer.echo(render(relations), nl=False)

@@ -1,0 +1,236 @@
+"""Translational freedom ``TT_d(i, j)``: can part i leave along d without penetrating j?
+
+Method (exact, no sampling of the motion)
+-----------------------------------------
+1. Tolerance by erosion. Every part is eroded by ``r = penetration_tol / 2``: each face
+   plane moves inwards by ``r`` (:mod:`cad.offset`). Two parts whose surfaces overlap by
+   at most ``penetration_tol`` are then disjoint, and a motion is *blocked* iff it drives
+   the eroded parts into each other. Sliding along a shared face (or one overlapping by a
+   few hundredths) therefore stays free, moving into it is blocked, and a slide that
+   drives deeper than the tolerance is blocked. The eroded parts must be disjoint in the
+   assembled pose; otherwise :func:`check_interpenetration` raises a ValueError naming the
+   pair and an estimate of the depth.
+2. Exact sweep test. Translating the eroded part i along ``d`` to infinity sweeps the
+   region ``i + {s d : s >= 0}``. Since i starts disjoint from j, the sweep meets j iff a
+   face of i that faces ``d`` (outward normal component along ``d`` > 0; only these
+   bound the swept region ahead of i) and a face of j that faces ``-d`` (only through
+   these can anything enter j moving along ``d``) have overlapping projections along ``d``
+   with the face of j ahead (``h_j >= h_i``) somewhere on the overlap. Faces parallel to
+   ``d`` bound no volume of the sweep and are skipped. The height difference is affine on
+   the convex overlap polygon, so its maximum sits at one of the polygon's corners, which
+   :func:`cad.projection.height_gap_range` enumerates exactly. The test needs no step
+   size and no sweep length: a plate of any thickness anywhere ahead is found (the path
+   goes beyond the assembly's bounding box, i.e. to infinity for this test).
+3. Broad phase: part bounding boxes, then overlapping 2-D triangle boxes
+   (:func:`cad.projection.box_pair_chunks`); each ordered pair stops at the first blocking
+   triangle pair.
+
+Relative motion makes the relation antisymmetric in direction: i moving along ``d``
+into j is j moving along ``-d`` into i, so ``TT_d(i, j) == TT_-d(j, i)`` for any shapes,
+and each pair is computed once per axis.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import trimesh
+
+from cad.assembly import Assembly
+from cad.faces import FaceSet, axis_face_sets, bounds_overlap, unit_normals
+from cad.offset import offset_vertices
+from cad.progress import progress_bar
+from cad.projection import box_pair_chunks, height_gap_range
+from cad.tolerances import resolve_tolerances
+
+_PARALLEL = 1e-9
+"""Faces whose normal component along the axis is below this are parallel to it."""
+_CHUNK = 4096
+
+
+def part_diagonals(assembly: Assembly) -> np.ndarray:
+    """Bounding-box diagonal of each part in mm, shape ``(n,)``."""
+    return np.array([np.linalg.norm(np.ptp(p.bounds, axis=0)) for p in assembly.parts])
+
+
+def eroded_meshes(assembly: Assembly, depth: float) -> list[trimesh.Trimesh]:
+    """Every part with its faces moved inwards by ``depth`` mm (same topology)."""
+    return [
+        trimesh.Trimesh(vertices=offset_vertices(p.mesh, -depth), faces=p.mesh.faces, process=False)
+        for p in assembly.parts
+    ]
+
+
+def translational_freedom(
+    assembly: Assembly,
+    *,
+    penetration_tol: float | None = None,
+    progress: bool = False,
+    check: bool = True,
+) -> np.ndarray:
+    """Translational freedom of every ordered pair of parts in every direction.
+
+    Parameters
+    ----------
+    assembly : Assembly
+        ``n`` parts in assembled pose (mm).
+    penetration_tol : float, optional
+        Overlap depth in mm that still counts as touching (default
+        :func:`cad.tolerances.default_penetration_tol`).
+    progress : bool
+        Show a progress bar over the pairs.
+    check : bool
+        First verify that no pair interpenetrates deeper than the tolerance.
+
+    Returns
+    -------
+    np.ndarray
+        Bool, shape ``(n, n, 6)``: ``tt[i, j, d]`` is true iff part i can move from its
+        pose along direction ``d`` (order ``+x,-x,+y,-y,+z,-z``) to beyond the assembly's
+        bounding box without penetrating part j. The diagonal is false.
+
+    Raises
+    ------
+    ValueError
+        Two parts interpenetrate deeper than the tolerance (when ``check``).
+    """
+    _, ptol = resolve_tolerances(part_diagonals(assembly), None, penetration_tol)
+    eroded = eroded_meshes(assembly, ptol / 2.0)
+    if check:
+        check_interpenetration(assembly, penetration_tol=ptol, eroded=eroded)
+    n = len(assembly)
+    blocked = np.zeros((n, n, 6), dtype=bool)
+    triangles = [np.asarray(m.triangles, dtype=float) for m in eroded]
+    normals = [unit_normals(t) for t in triangles]
+    bounds = [np.asarray(m.bounds, dtype=float) for m in eroded]
+    pairs = [(a, b) for a in range(n) for b in range(n) if a != b]
+    bar = progress_bar(progress, 3 * len(pairs), "freedom")
+    for axis in range(3):
+        sets = [
+            axis_face_sets(t, nn, axis, _PARALLEL) for t, nn in zip(triangles, normals, strict=True)
+        ]
+        others = ((axis + 1) % 3, (axis + 2) % 3)
+        for a, b in pairs:
+            bar.update(1)
+            if not bounds_overlap(bounds[a], bounds[b], axes=others):
+                continue
+            if bounds[b][1, axis] < bounds[a][0, axis]:
+                continue  # b lies entirely behind a
+            if sweep_blocked(sets[a][0], sets[b][1]):
+                blocked[a, b, 2 * axis] = True
+                blocked[b, a, 2 * axis + 1] = True
+    bar.close()
+    tt = ~blocked
+    tt[np.arange(n), np.arange(n), :] = False
+    return tt
+
+
+def sweep_blocked(front: FaceSet, back: FaceSet) -> bool:
+    """Whether faces ``front`` of a part sweeping along ``+axis`` meet faces ``back``.
+
+    Parameters
+    ----------
+    front : FaceSet
+        Faces of the moving part that face ``+axis``.
+    back : FaceSet
+        Faces of the obstacle that face ``-axis``.
+
+    Returns
+    -------
+    bool
+        True iff some pair has overlapping projections with the obstacle face at or ahead
+        of the moving face somewhere on the overlap.
+    """
+    for ia, ib in box_pair_chunks(front.box, back.box):
+        ahead = back.hmax[ib] >= front.hmin[ia]
+        ia, ib = ia[ahead], ib[ahead]
+        # likeliest blockers first: obstacle face wholly ahead of the moving face
+        order = np.argsort(front.hmax[ia] - back.hmin[ib], kind="stable")
+        ia, ib = ia[order], ib[order]
+        for start in range(0, len(ia), _CHUNK):
+            sa, sb = ia[start : start + _CHUNK], ib[start : start + _CHUNK]
+            overlap, _, gap_max = height_gap_range(*front.take(sa), *back.take(sb))
+            if np.any(overlap & (gap_max >= 0.0)):
+                return True
+    return False
+
+
+def _collision_object(mesh: trimesh.Trimesh):
+    import fcl
+
+    model = fcl.BVHModel()
+    model.beginModel(len(mesh.vertices), len(mesh.faces))
+    model.addSubModel(
+        np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int32)
+    )
+    model.endModel()
+    return fcl.CollisionObject(model, fcl.Transform())
+
+
+def _intersect(a: trimesh.Trimesh, b: trimesh.Trimesh, obj_a=None, obj_b=None) -> bool:
+    """Whether closed meshes a and b share volume: surfaces cross or one holds the other."""
+    import fcl
+
+    obj_a = obj_a if obj_a is not None else _collision_object(a)
+    obj_b = obj_b if obj_b is not None else _collision_object(b)
+    if fcl.collide(obj_a, obj_b, fcl.CollisionRequest(), fcl.CollisionResult()):
+        return True
+    for inner, outer in ((a, b), (b, a)):
+        lo, hi = inner.bounds
+        olo, ohi = outer.bounds
+        inside_box = np.all(lo >= olo) and np.all(hi <= ohi)
+        if inside_box and outer.is_watertight and outer.contains(inner.vertices[:1])[0]:
+            return True
+    return False
+
+
+def check_interpenetration(
+    assembly: Assembly,
+    *,
+    penetration_tol: float | None = None,
+    eroded: list[trimesh.Trimesh] | None = None,
+) -> None:
+    """Raise if two parts overlap deeper than ``penetration_tol`` in the assembled pose.
+
+    Parts eroded by half the tolerance must be disjoint (FCL triangle tests for crossing
+    surfaces, a point-in-mesh test for one part inside another).
+
+    Raises
+    ------
+    ValueError
+        ``parts 'a' and 'b' interpenetrate by about X mm (tolerance Y mm)``.
+    """
+    _, ptol = resolve_tolerances(part_diagonals(assembly), None, penetration_tol)
+    if eroded is None:
+        eroded = eroded_meshes(assembly, ptol / 2.0)
+    objects = [_collision_object(m) for m in eroded]
+    bounds = [np.asarray(m.bounds) for m in eroded]
+    n = len(assembly)
+    for a in range(n):
+        for b in range(a + 1, n):
+            if not bounds_overlap(bounds[a], bounds[b]):
+                continue
+            if _intersect(eroded[a], eroded[b], objects[a], objects[b]):
+                pa, pb = assembly.parts[a], assembly.parts[b]
+                depth = _depth_estimate(pa.mesh, pb.mesh, ptol)
+                raise ValueError(
+                    f"parts {pa.id!r} and {pb.id!r} interpenetrate by {depth} "
+                    f"(penetration tolerance {ptol:.3g} mm)"
+                )
+
+
+def _depth_estimate(a: trimesh.Trimesh, b: trimesh.Trimesh, ptol: float) -> str:
+    """Overlap thickness: twice the largest erosion that leaves a and b intersecting."""
+    sizes = np.concatenate([np.ptp(a.bounds, axis=0), np.ptp(b.bounds, axis=0)])
+    lo, hi = ptol / 2.0, float(sizes.min()) / 4.0
+
+    def still(depth: float) -> bool:
+        ea = trimesh.Trimesh(offset_vertices(a, -depth), a.faces, process=False)
+        eb = trimesh.Trimesh(offset_vertices(b, -depth), b.faces, process=False)
+        return _intersect(ea, eb)
+
+    if hi <= lo or still(hi):
+        return f"at least {2 * max(hi, lo):.3g} mm"
+    for _ in range(14):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if still(mid) else (lo, mid)
+    return f"about {2 * lo:.3g} mm"

@@ -1,0 +1,151 @@
+"""All relations of an assembly, and the subassembly tests of eqs. 3-5 (DESIGN.md)."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+import numpy as np
+
+from cad.assembly import Assembly
+from cad.contact import contact_relation
+from cad.directions import DIRECTIONS
+from cad.freedom import check_interpenetration, eroded_meshes, part_diagonals
+from cad.freedom import translational_freedom as _freedom
+from cad.tolerances import resolve_tolerances
+
+
+@dataclass(frozen=True, eq=False)
+class Relations:
+    """Contact and translational freedom of every ordered pair of parts.
+
+    Attributes
+    ----------
+    parts : tuple[str, ...]
+        Part ids; index ``i`` of the tables is ``parts[i]``.
+    tc : np.ndarray
+        Bool, shape ``(n, n, 6)``: ``tc[i, j, d]`` = ``TC_d(i, j)``.
+    tt : np.ndarray
+        Bool, shape ``(n, n, 6)``: ``tt[i, j, d]`` = ``TT_d(i, j)``.
+    contact_tol, penetration_tol : float
+        Tolerances used, in mm.
+    units : str
+        Source length unit of the assembly (tables do not depend on it).
+    directions : tuple[str, ...]
+        ``("+x", "-x", "+y", "-y", "+z", "-z")``.
+    """
+
+    parts: tuple[str, ...]
+    tc: np.ndarray
+    tt: np.ndarray
+    contact_tol: float = 0.0
+    penetration_tol: float = 0.0
+    units: str = "mm"
+    directions: tuple[str, ...] = DIRECTIONS
+
+    def __post_init__(self) -> None:
+        n = len(self.parts)
+        for name in ("tc", "tt"):
+            table = np.asarray(getattr(self, name), dtype=bool)
+            if table.shape != (n, n, 6):
+                raise ValueError(f"{name} must have shape ({n}, {n}, 6), got {table.shape}")
+            table = table.copy()
+            table.setflags(write=False)
+            object.__setattr__(self, name, table)
+
+    def index(self, part: str | int) -> int:
+        """Table index of a part id (an int is returned as is, after a range check)."""
+        if isinstance(part, (int, np.integer)):
+            if not 0 <= int(part) < len(self.parts):
+                raise ValueError(f"part index {part} out of range")
+            return int(part)
+        try:
+            return self.parts.index(part)
+        except ValueError:
+            raise ValueError(f"unknown part {part!r}") from None
+
+    def to_dict(self) -> dict:
+        """JSON-ready dict: ``parts``, ``directions``, ``tc``, ``tt`` ([i][j][d]), tolerances."""
+        return {
+            "parts": list(self.parts),
+            "directions": list(self.directions),
+            "units": "mm",
+            "source_units": self.units,
+            "contact_tol_mm": self.contact_tol,
+            "penetration_tol_mm": self.penetration_tol,
+            "tc": self.tc.tolist(),
+            "tt": self.tt.tolist(),
+        }
+
+
+def compute_relations(
+    assembly: Assembly,
+    *,
+    contact_tol: float | None = None,
+    penetration_tol: float | None = None,
+    progress: bool = False,
+) -> Relations:
+    """Contact and translational freedom of an assembly.
+
+    Parameters
+    ----------
+    assembly : Assembly
+        ``n`` parts in assembled pose.
+    contact_tol : float, optional
+        Contact tolerance in mm (default 0.01 mm).
+    penetration_tol : float, optional
+        Penetration tolerance in mm (default ``max(0.05, 0.001 x median part diagonal)``).
+    progress : bool
+        Show tqdm progress bars over the pairs.
+
+    Returns
+    -------
+    Relations
+        ``tc`` and ``tt``, each shape ``(n, n, 6)``.
+
+    Raises
+    ------
+    ValueError
+        Two parts interpenetrate deeper than the penetration tolerance.
+    """
+    ctol, ptol = resolve_tolerances(part_diagonals(assembly), contact_tol, penetration_tol)
+    check_interpenetration(assembly, penetration_tol=ptol, eroded=eroded_meshes(assembly, ptol / 2))
+    tc = contact_relation(assembly, ctol, penetration_tol=ptol, progress=progress)
+    tt = _freedom(assembly, penetration_tol=ptol, progress=progress, check=False)
+    return Relations(
+        parts=assembly.ids,
+        tc=tc,
+        tt=tt,
+        contact_tol=ctol,
+        penetration_tol=ptol,
+        units=assembly.units,
+    )
+
+
+def _indices(
+    relations: Relations, p: str | int, subset: Iterable[str | int]
+) -> tuple[int, list[int]]:
+    ip = relations.index(p)
+    members = sorted({relations.index(j) for j in subset})
+    if not members:
+        raise ValueError("the subassembly S must not be empty")
+    if ip in members:
+        raise ValueError(f"part {relations.parts[ip]!r} is already in S")
+    return ip, members
+
+
+def rtc(relations: Relations, p: str | int, S: Iterable[str | int]) -> bool:
+    """Eq. 3: ``RTC(p, S) = OR_d OR_{j in S} TC_d(p, j)`` (p touches the subassembly)."""
+    ip, members = _indices(relations, p, S)
+    return bool(relations.tc[ip, members, :].any())
+
+
+def tt_set(relations: Relations, p: str | int, S: Iterable[str | int]) -> np.ndarray:
+    """Eq. 4: ``TT_d(p, S) = AND_{j in S} TT_d(p, j)``, bool array of shape ``(6,)``."""
+    ip, members = _indices(relations, p, S)
+    return relations.tt[ip, members, :].all(axis=0)
+
+
+def rtt(relations: Relations, p: str | int, S: Iterable[str | int]) -> bool:
+    """Eq. 5: ``RTT(p, S) = OR_d TT_d(p, S)`` (some straight direction is free)."""
+    return bool(tt_set(relations, p, S).any())

@@ -1,0 +1,82 @@
+"""Render :class:`cad.relations.Relations` as text, Markdown, CSV or JSON."""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+
+from cad.relations import Relations
+
+
+def _dirs(relations: Relations, row) -> str:
+    return " ".join(d for d, v in zip(relations.directions, row, strict=True) if v) or "-"
+
+
+def _header(relations: Relations) -> str:
+    return (
+        f"{len(relations.parts)} parts, source units {relations.units}, tolerances in mm: "
+        f"contact {relations.contact_tol:.3g}, penetration {relations.penetration_tol:.3g}"
+    )
+
+
+def _rows(relations: Relations) -> tuple[list[tuple[str, str, str, str]], int]:
+    """``(i, j, contact directions, free directions)`` for pairs worth listing."""
+    rows, quiet = [], 0
+    for a, pa in enumerate(relations.parts):
+        for b, pb in enumerate(relations.parts):
+            if a == b:
+                continue
+            tc, tt = relations.tc[a, b], relations.tt[a, b]
+            if not tc.any() and tt.all():
+                quiet += 1
+                continue
+            rows.append((pa, pb, _dirs(relations, tc), _dirs(relations, tt)))
+    return rows, quiet
+
+
+def relations_text(relations: Relations) -> str:
+    """Aligned listing: per ordered pair, contact directions and free directions."""
+    rows, quiet = _rows(relations)
+    head = ("i", "j", "TC: j touches i on side", "TT: i free past j along")
+    widths = [max(len(r[c]) for r in [head, *rows]) for c in range(4)]
+    lines = [_header(relations), ""]
+    for row in [head, tuple("-" * w for w in widths), *rows]:
+        lines.append("  ".join(cell.ljust(w) for cell, w in zip(row, widths, strict=True)).rstrip())
+    if quiet:
+        lines.append(f"({quiet} other ordered pairs: no contact, free in every direction)")
+    return "\n".join(lines) + "\n"
+
+
+def relations_markdown(relations: Relations) -> str:
+    """Markdown table of the same listing as :func:`relations_text`."""
+    rows, quiet = _rows(relations)
+    lines = [
+        _header(relations),
+        "",
+        "| i | j | TC: j touches i on side | TT: i free past j along |",
+        "|---|---|---|---|",
+    ]
+    lines += [f"| {a} | {b} | {c} | {t} |" for a, b, c, t in rows]
+    if quiet:
+        lines += ["", f"{quiet} other ordered pairs: no contact, free in every direction."]
+    return "\n".join(lines) + "\n"
+
+
+def relations_csv(relations: Relations) -> str:
+    """CSV, one row per ordered pair and relation: ``i,j,relation,+x,-x,+y,-y,+z,-z``."""
+    out = io.StringIO()
+    writer = csv.writer(out, lineterminator="\n")
+    writer.writerow(["i", "j", "relation", *relations.directions])
+    for a, pa in enumerate(relations.parts):
+        for b, pb in enumerate(relations.parts):
+            if a == b:
+                continue
+            for name, table in (("tc", relations.tc), ("tt", relations.tt)):
+                writer.writerow([pa, pb, name, *(int(v) for v in table[a, b])])
+    return out.getvalue()
+
+
+def relations_json(relations: Relations) -> str:
+    """One JSON object: ``parts``, ``directions``, ``units``, ``tc``, ``tt`` and tolerances."""
+    return json.dumps(relations.to_dict())

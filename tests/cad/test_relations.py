@@ -1,0 +1,193 @@
+"""Contact and translational freedom on small assemblies built in code."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from cad import DIRECTIONS, Assembly, compute_relations, rtc, rtt, tt_set
+from tests.cad import shapes
+
+
+def dirs(row: np.ndarray) -> set[str]:
+    """Direction labels where a (6,) bool row is true."""
+    return {d for d, v in zip(DIRECTIONS, row, strict=True) if v}
+
+
+def pair(rel, i: str, j: str) -> tuple[set[str], set[str]]:
+    """(contact directions, free directions) of the ordered pair (i, j)."""
+    a, b = rel.index(i), rel.index(j)
+    return dirs(rel.tc[a, b]), dirs(rel.tt[a, b])
+
+
+ALL = set(DIRECTIONS)
+SIDE = {"+x", "-x", "+y", "-y"}
+
+CASES = [
+    # (builder, i, j, expected TC_d(i, j) directions, expected TT_d(i, j) directions)
+    ("stacked", lambda: shapes.stacked_cubes(), "top", "bottom", {"-z"}, ALL - {"-z"}),
+    ("stacked", lambda: shapes.stacked_cubes(), "bottom", "top", {"+z"}, ALL - {"+z"}),
+    ("through hole", lambda: shapes.peg_in_plate(), "peg", "plate", SIDE, {"+z", "-z"}),
+    ("through hole", lambda: shapes.peg_in_plate(), "plate", "peg", SIDE, {"+z", "-z"}),
+    ("blind hole", lambda: shapes.peg_in_plate(blind=True), "peg", "plate", SIDE | {"-z"}, {"+z"}),
+    ("blind hole", lambda: shapes.peg_in_plate(blind=True), "plate", "peg", SIDE | {"+z"}, {"-z"}),
+    ("thin plate", lambda: shapes.thin_plate_on_path(), "block", "sheet", set(), ALL - {"+x"}),
+    ("thin plate", lambda: shapes.thin_plate_on_path(), "sheet", "block", set(), ALL - {"-x"}),
+    ("container", lambda: shapes.boxed_container(), "item", "tray", {"-z"}, {"+z"}),
+    ("container", lambda: shapes.boxed_container(), "item", "lid", set(), ALL - {"+z"}),
+    ("container", lambda: shapes.boxed_container(), "lid", "tray", {"-z"}, ALL - {"-z"}),
+    ("far apart", lambda: shapes.far_apart(), "a", "b", set(), ALL),
+    ("far apart", lambda: shapes.far_apart(), "c", "a", set(), ALL),
+    ("overlap 0.02", lambda: shapes.stacked_cubes(0.02), "top", "bottom", {"-z"}, ALL - {"-z"}),
+    ("overlap 0.02", lambda: shapes.stacked_cubes(0.02), "bottom", "top", {"+z"}, ALL - {"+z"}),
+]
+
+
+@pytest.mark.parametrize(
+    ("build", "i", "j", "contact", "free"),
+    [c[1:] for c in CASES],
+    ids=[f"{c[0]}:{c[2]}-{c[3]}" for c in CASES],
+)
+def test_pair_relations(build, i, j, contact, free):
+    rel = compute_relations(build())
+    assert pair(rel, i, j) == (contact, free)
+
+
+def test_diagonal_false_and_contact_symmetry():
+    rel = compute_relations(shapes.boxed_container())
+    n = len(rel.parts)
+    assert not rel.tc[np.arange(n), np.arange(n)].any()
+    assert not rel.tt[np.arange(n), np.arange(n)].any()
+    assert np.array_equal(rel.tc, rel.tc.transpose(1, 0, 2)[:, :, [1, 0, 3, 2, 5, 4]])
+
+
+def test_container_blocked_until_lid_removed():
+    rel = compute_relations(shapes.boxed_container())
+    assert not tt_set(rel, "item", {"tray", "lid"}).any()
+    assert not rtt(rel, "item", {"tray", "lid"})
+    assert dirs(tt_set(rel, "item", {"tray"})) == {"+z"}
+    assert rtt(rel, "item", {"tray"})
+    assert rtc(rel, "item", {"tray"})
+    assert not rtc(rel, "item", {"lid"})
+
+
+@pytest.mark.parametrize("length", [50.0, 200.0, 2000.0])
+def test_thin_plate_blocks_at_any_distance(length):
+    rel = compute_relations(shapes.thin_plate_on_path(length))
+    assert not rel.tt[rel.index("block"), rel.index("sheet"), 0]
+    assert rel.tt[rel.index("block"), rel.index("far")].all()
+
+
+@pytest.mark.parametrize(
+    ("bump", "slides"),
+    [(0.03, True), (0.1, False)],
+    ids=["bump within tolerance", "bump deeper than tolerance"],
+)
+def test_slide_over_bump(bump, slides):
+    ground = shapes.box_between((0, 0, 0), (100, 10, 10))
+    ridge = shapes.box_between((60, 0, 9), (70, 10, 10 + bump))
+    import trimesh
+
+    ground = trimesh.boolean.union([ground, ridge], engine="manifold")
+    slider = shapes.box_between((0, 0, 10), (10, 10, 20))
+    rel = compute_relations(Assembly.from_meshes({"ground": ground, "slider": slider}))
+    assert bool(rel.tt[rel.index("slider"), rel.index("ground"), 0]) is slides
+    assert rel.tt[rel.index("slider"), rel.index("ground"), 1]
+
+
+def test_tolerated_overlap_is_contact_and_sliding_free():
+    rel = compute_relations(shapes.stacked_cubes(0.02))
+    top, bottom = rel.index("top"), rel.index("bottom")
+    assert rel.tt[top, bottom, :4].all()
+    assert rel.tc[top, bottom, 5]
+
+
+def test_deep_overlap_names_pair_and_depth():
+    with pytest.raises(ValueError, match=r"'bottom' and 'top' interpenetrate by about 0\.5"):
+        compute_relations(shapes.stacked_cubes(0.5))
+
+
+def test_larger_tolerance_accepts_press_fit():
+    rel = compute_relations(shapes.stacked_cubes(0.3), penetration_tol=0.4)
+    assert pair(rel, "top", "bottom") == ({"-z"}, ALL - {"-z"})
+
+
+def test_inclined_contact_gives_both_leaning_axes():
+    import trimesh
+
+    turn = trimesh.transformations.rotation_matrix(np.pi / 4, (0, 1, 0))
+    lower = shapes.box((10, 10, 10))
+    lower.apply_transform(turn)
+    upper = shapes.box((10, 10, 10), (0, 0, 10))
+    upper.apply_transform(turn)  # stacked along the tilted normal (0.707, 0, 0.707)
+    rel = compute_relations(Assembly.from_meshes({"lower": lower, "upper": upper}))
+    contact, free = pair(rel, "lower", "upper")
+    assert contact == {"+x", "+z"}
+    assert free == {"-x", "+y", "-y", "-z"}
+
+
+def test_rotated_cube_on_plate():
+    import trimesh
+
+    cube = shapes.box((10, 10, 10), (0, 0, 5))
+    cube.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 5, (0, 0, 1)))
+    plate = shapes.box_between((-20, -20, -3), (20, 20, 0))
+    rel = compute_relations(Assembly.from_meshes({"cube": cube, "plate": plate}))
+    assert pair(rel, "cube", "plate") == ({"-z"}, ALL - {"-z"})
+
+
+def test_subassembly_arguments_checked():
+    rel = compute_relations(shapes.boxed_container())
+    with pytest.raises(ValueError, match="must not be empty"):
+        rtt(rel, "item", set())
+    with pytest.raises(ValueError, match="already in S"):
+        rtc(rel, "item", {"item", "tray"})
+    with pytest.raises(ValueError, match="unknown part"):
+        tt_set(rel, "nope", {"tray"})
+
+
+@pytest.mark.parametrize(("gap", "touching"), [(0.0, True), (0.005, True), (0.02, False)])
+def test_contact_tolerance_on_gap(gap, touching):
+    lower = shapes.box_between((0, 0, 0), (10, 10, 10))
+    upper = shapes.box_between((0, 0, 10 + gap), (10, 10, 20 + gap))
+    rel = compute_relations(Assembly.from_meshes({"lower": lower, "upper": upper}))
+    assert pair(rel, "upper", "lower")[0] == ({"-z"} if touching else set())
+    assert pair(rel, "upper", "lower")[1] == ALL - {"-z"}
+
+
+def test_small_part_inside_the_sweep_of_a_large_face_blocks():
+    plate = shapes.box_between((-50, -50, 100), (50, 50, 101))  # two triangles per face
+    pebble = shapes.box_between((0, 0, 0), (1, 1, 1))
+    rel = compute_relations(Assembly.from_meshes({"plate": plate, "pebble": pebble}))
+    assert pair(rel, "plate", "pebble")[1] == ALL - {"-z"}
+    assert pair(rel, "pebble", "plate")[1] == ALL - {"+z"}
+
+
+def test_part_buried_inside_another_is_an_error():
+    block = shapes.box_between((0, 0, 0), (10, 10, 10))
+    core = shapes.box_between((4, 4, 4), (6, 6, 6))
+    with pytest.raises(ValueError, match="'block' and 'core' interpenetrate"):
+        compute_relations(Assembly.from_meshes({"block": block, "core": core}))
+
+
+def test_progress_bar(capsys):
+    compute_relations(shapes.stacked_cubes(), progress=True)
+    assert "pair" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("hole_sections", "peg_sections"), [(64, 48), (32, 100), (100, 32)])
+def test_pin_drawn_at_hole_diameter_with_other_tessellation(hole_sections, peg_sections):
+    """Polygons of different counts overlap by up to R (1 - cos(pi / n)): still a fit."""
+    block = shapes.box_between((-20, -20, 0), (20, 20, 10))
+    plate = shapes.difference(block, shapes.cylinder(5, -1, 11, hole_sections))
+    peg = shapes.cylinder(5, 0, 15, peg_sections)
+    rel = compute_relations(Assembly.from_meshes({"plate": plate, "peg": peg}))
+    assert pair(rel, "peg", "plate") == (SIDE, {"+z", "-z"})
+
+
+def test_coarse_tessellation_overlap_beyond_tolerance_is_an_error():
+    block = shapes.box_between((-20, -20, 0), (20, 20, 10))
+    plate = shapes.difference(block, shapes.cylinder(5, -1, 11, 17))
+    peg = shapes.cylinder(5, 0, 15, 23)
+    with pytest.raises(ValueError, match=r"'plate' and 'peg' interpenetrate by about 0\.08"):
+        compute_relations(Assembly.from_meshes({"plate": plate, "peg": peg}))
