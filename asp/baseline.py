@@ -1,0 +1,572 @@
+"""The classical baseline with OR-Tools CP-SAT (``../shared/DESIGN.md``, "The classical baseline").
+
+Two models, each laid out as in the CP-SAT examples (data, model, variables, constraints,
+objective, solve):
+
+(a) :func:`min_cost_path`: the minimum-cost way through a game DAG, a unit flow with one
+    boolean per arc. On a DAG whose edges are all ``ANY`` the arcs are the DAG's edges and
+    the optimum is the TCT. With ``ROBOT``/``HUMAN`` edges the path runs over game states
+    ``(node, player on turn)``: an edge open to the player on turn flips the turn, and a
+    player without a move passes at zero cost (a forced move), so the optimum is the
+    cooperative value ``solve(dag).tct`` under the alternating turn model.
+
+(b) :func:`min_makespan`: the minimum-makespan schedule when agents work in parallel: an
+    optional interval per (task, allowed agent) with exactly one present, no overlap per
+    agent, precedence as ``end <= start``, renewable resources as cumulative constraints
+    (PSPLIB) and tool states as sequence-dependent setups (see :func:`min_makespan`).
+
+CP-SAT works on integers: costs and durations are scaled by the smallest power of ten
+(up to 10**6) that makes them integral, and scaled back in the results.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from asp.dag import ANY, HUMAN, ROBOT, GameDAG
+
+MAX_SCALE_DIGITS = 6
+
+
+@dataclass(frozen=True)
+class Task:
+    """A task to schedule.
+
+    Attributes
+    ----------
+    id, description : str
+    modes : tuple of (agent, duration)
+        Who may do it and how long it takes; agent ``""`` uses no agent (PSPLIB jobs).
+    demands : tuple of int
+        Demand on each renewable resource of the problem (same order).
+    requires, sets : tuple of (tool, value)
+        Tool state needed during the task / left after it.
+    """
+
+    id: str
+    modes: tuple[tuple[str, float], ...]
+    demands: tuple[int, ...] = ()
+    requires: tuple[tuple[str, str], ...] = ()
+    sets: tuple[tuple[str, str], ...] = ()
+    description: str = ""
+
+
+@dataclass(frozen=True)
+class ScheduleProblem:
+    """Tasks, precedences ``(before, after)`` (task indices), resources and tool states."""
+
+    name: str
+    tasks: tuple[Task, ...]
+    precedences: tuple[tuple[int, int], ...] = ()
+    resources: tuple[tuple[str, int], ...] = ()
+    tool_initial: tuple[tuple[str, str], ...] = ()
+    credit: str = ""
+
+
+@dataclass(frozen=True)
+class BaselineResult:
+    """Outcome of a CP-SAT solve.
+
+    Attributes
+    ----------
+    kind : str
+        ``"path"`` or ``"schedule"``.
+    status : str
+        CP-SAT status name (``OPTIMAL``, ``FEASIBLE``, ``INFEASIBLE``, ``UNKNOWN``, ...).
+    objective, bound : float or None
+        Best objective found and the proven bound (original units).
+    wall_s : float
+        Wall time of the solve, seconds.
+    detail : dict
+        ``path`` (node ids) and ``edges`` for a path; ``schedule`` (one dict per task with
+        ``task, agent, start, end``) and the lower bounds for a schedule.
+    """
+
+    kind: str
+    name: str
+    status: str
+    objective: float | None
+    bound: float | None
+    wall_s: float
+    detail: dict = field(default_factory=dict)
+    credit: str = ""
+
+    def to_dict(self) -> dict:
+        out = {
+            "kind": self.kind,
+            "name": self.name,
+            "status": self.status,
+            "objective": _num(self.objective),
+            "bound": _num(self.bound),
+            "wall_s": round(self.wall_s, 3),
+        }
+        out.update(self.detail)
+        if self.credit:
+            out["credit"] = self.credit
+        return out
+
+
+def _num(x):
+    if x is None:
+        return None
+    x = float(x)
+    return int(x) if x.is_integer() else round(x, 6)
+
+
+def integer_scale(values) -> int:
+    """Smallest power of ten (<= 10**6) making every value integral (else 10**6, rounded)."""
+    arr = np.asarray(list(values), dtype=np.float64)
+    for k in range(MAX_SCALE_DIGITS + 1):
+        scaled = arr * 10**k
+        if np.all(np.abs(scaled - np.round(scaled)) <= 1e-9 * np.maximum(1.0, np.abs(scaled))):
+            return 10**k
+    return 10**MAX_SCALE_DIGITS
+
+
+def _solver(time_limit: float, workers: int, seed: int):
+    from ortools.sat.python import cp_model
+
+    if workers < 1:
+        raise ValueError(f"workers: expected a positive integer, got {workers}")
+    if not time_limit > 0:
+        raise ValueError(f"time_limit: expected a positive number of seconds, got {time_limit}")
+    solver = cp_model.CpSolver()
+    solver.parameters.max_time_in_seconds = float(time_limit)
+    solver.parameters.num_workers = int(workers)
+    solver.parameters.random_seed = int(seed)
+    return solver
+
+
+def _status(solver, status) -> tuple[str, bool]:
+    from ortools.sat.python import cp_model
+
+    return solver.status_name(status), status in (cp_model.OPTIMAL, cp_model.FEASIBLE)
+
+
+# --------------------------------------------------------------------------- (a) path
+
+
+def path_arcs(dag: GameDAG) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, int, list]:
+    """The arcs the path model runs over.
+
+    Returns
+    -------
+    tail, head : (a,) int64
+        Arc end points: node indices when every edge is ``ANY``, else game states
+        ``2 * node + player``.
+    cost : (a,) float64
+    edge : (a,) int64
+        The DAG edge of each arc, or -1 for a pass.
+    source : int
+        The start (state).
+    sinks : list of int
+        The end node (or its two game states).
+    """
+    src = dag.sources
+    if dag.n_edges == 0 or np.all(dag.sides == ANY):
+        return (
+            src,
+            dag.targets.copy(),
+            dag.costs.copy(),
+            np.arange(dag.n_edges, dtype=np.int64),
+            dag.start,
+            [dag.end],
+        )
+    tails, heads, costs, edges = [], [], [], []
+    for p in (ROBOT, HUMAN):
+        allowed = (dag.sides == ANY) | (dag.sides == p)
+        e = np.flatnonzero(allowed)
+        tails.append(2 * src[e] + p)
+        heads.append(2 * dag.targets[e] + (1 - p))
+        costs.append(dag.costs[e])
+        edges.append(e)
+        has_move = np.zeros(dag.n_nodes, dtype=bool)
+        has_move[src[e]] = True
+        passing = np.flatnonzero(~has_move)
+        passing = passing[passing != dag.end]
+        tails.append(2 * passing + p)
+        heads.append(2 * passing + (1 - p))
+        costs.append(np.zeros(passing.size))
+        edges.append(np.full(passing.size, -1, dtype=np.int64))
+    return (
+        np.concatenate(tails),
+        np.concatenate(heads),
+        np.concatenate(costs),
+        np.concatenate(edges),
+        2 * dag.start + ROBOT,
+        [2 * dag.end + ROBOT, 2 * dag.end + HUMAN],
+    )
+
+
+def min_cost_path(
+    dag: GameDAG, *, time_limit: float = 60.0, workers: int = 1, seed: int = 0
+) -> BaselineResult:
+    """Minimum-cost path from start to end of a game DAG with CP-SAT.
+
+    Equals ``asp.solve.solve(dag).tct`` (the cooperative value under the turn model).
+    """
+    from ortools.sat.python import cp_model
+
+    # Data: the arcs (DAG edges, or game-state moves and passes) and integer costs.
+    tail, head, cost, edge, source, sinks = path_arcs(dag)
+    scale = integer_scale(cost) if cost.size else 1
+    icost = np.round(cost * scale).astype(np.int64)
+
+    # Model.
+    model = cp_model.CpModel()
+
+    # Variables: use[a] is true iff the path takes arc a.
+    use = [model.new_bool_var(f"use_{a}") for a in range(tail.size)]
+
+    # Constraints: a unit of flow leaves the source, reaches one sink and is conserved
+    # everywhere else. The arc graph is acyclic (passes only where a player has no move,
+    # and then the other player has one), so the flow is a simple path.
+    out_arcs: dict[int, list[int]] = {}
+    in_arcs: dict[int, list[int]] = {}
+    for a, (u, v) in enumerate(zip(tail.tolist(), head.tolist(), strict=True)):
+        out_arcs.setdefault(u, []).append(a)
+        in_arcs.setdefault(v, []).append(a)
+    sink_set = set(sinks)
+    for u in set(out_arcs) | set(in_arcs):
+        if u in sink_set:
+            continue
+        outflow = sum(use[a] for a in out_arcs.get(u, []))
+        inflow = sum(use[a] for a in in_arcs.get(u, []))
+        model.add(outflow - inflow == (1 if u == source else 0))
+    model.add(sum(use[a] for s in sinks for a in in_arcs.get(s, [])) == 1)
+
+    # Objective: total cost of the arcs taken.
+    model.minimize(sum(int(c) * x for c, x in zip(icost.tolist(), use, strict=True)))
+
+    # Solve.
+    solver = _solver(time_limit, workers, seed)
+    t0 = time.perf_counter()
+    status = solver.solve(model)
+    wall = time.perf_counter() - t0
+    name, found = _status(solver, status)
+    detail: dict = {"arcs": int(tail.size), "scale": scale}
+    objective = bound = None
+    if found:
+        objective = solver.objective_value / scale
+        bound = solver.best_objective_bound / scale
+        taken = {int(tail[a]): a for a in range(tail.size) if solver.boolean_value(use[a])}
+        state, nodes, edges = source, [], []
+        game_states = len(sinks) == 2
+        while state not in sink_set:
+            a = taken[state]
+            node = state // 2 if game_states else state
+            if edge[a] >= 0:
+                nodes.append(dag.node_ids[node])
+                edges.append(int(edge[a]))
+            state = int(head[a])
+        nodes.append(dag.node_ids[dag.end])
+        detail.update(path=[_plain(x) for x in nodes], edges=edges)
+        if dag.operations is not None:
+            detail["operations"] = [dag.edge_label(e) for e in edges]
+    return BaselineResult(
+        kind="path",
+        name=str(dag.metadata.get("assembly", dag.metadata.get("source", "game DAG"))),
+        status=name,
+        objective=objective,
+        bound=bound,
+        wall_s=wall,
+        detail=detail,
+        credit=str(dag.metadata.get("credit", "")),
+    )
+
+
+def _plain(x):
+    return x.item() if hasattr(x, "item") else x
+
+
+# --------------------------------------------------------------------------- (b) schedule
+
+
+def min_makespan(
+    problem: ScheduleProblem,
+    *,
+    time_limit: float = 60.0,
+    workers: int = 1,
+    seed: int = 0,
+) -> BaselineResult:
+    """Minimum-makespan schedule with CP-SAT.
+
+    Tool states as sequence-dependent setups: for a tool ``T``, a *setter* is a task that
+    sets ``T`` and a *user* a task that requires a value of ``T``. Every setter is ordered
+    (a disjunction, one boolean ``before[s, u]``) against every other setter and every user,
+    so no tool change overlaps another change or a task that relies on the tool. A user
+    ``u`` that needs ``T = v`` sees the value of the last setter that ends before it starts
+    (or the initial value if none does), so:
+
+    - if the initial value is not ``v``, some setter of ``v`` ends before ``u`` starts;
+    - if a setter ``s`` of another value ends before ``u``, some setter ``s'`` of ``v`` lies
+      between them: ``before[s, s'] and before[s', u]``.
+
+    A task that both requires and sets a tool (``R1.bit: hex -> cross``) is a user at its
+    start and a setter at its end.
+    """
+    from ortools.sat.python import cp_model
+
+    # Data: integer durations, the horizon.
+    tasks = problem.tasks
+    all_durations = [d for t in tasks for _, d in t.modes]
+    scale = integer_scale(all_durations) if all_durations else 1
+    dur = [[round(d * scale) for _, d in t.modes] for t in tasks]
+    horizon = max(1, sum(max(d) for d in dur))
+    if len(problem.resources) and any(len(t.demands) != len(problem.resources) for t in tasks):
+        raise ValueError(f"{problem.name}: every task needs one demand per resource")
+
+    # Model.
+    model = cp_model.CpModel()
+
+    # Variables: start[i], end[i] of task i; present[i][m] true iff task i is done in mode m
+    # (by that mode's agent); interval[i][m] the (optional) interval of that mode.
+    start = [model.new_int_var(0, horizon, f"start_{t.id}") for t in tasks]
+    end = [model.new_int_var(0, horizon, f"end_{t.id}") for t in tasks]
+    present: list[list] = []
+    interval: list[list] = []
+    for i, t in enumerate(tasks):
+        if len(t.modes) == 1:
+            lits = [model.new_constant(1)]
+            ivs = [model.new_interval_var(start[i], dur[i][0], end[i], f"iv_{t.id}")]
+        else:
+            lits = [model.new_bool_var(f"mode_{t.id}_{a}") for a, _ in t.modes]
+            ivs = [
+                model.new_optional_interval_var(start[i], d, end[i], lit, f"iv_{t.id}_{a}")
+                for (a, _), d, lit in zip(t.modes, dur[i], lits, strict=True)
+            ]
+            # Constraint: exactly one mode (agent) does the task.
+            model.add_exactly_one(lits)
+        present.append(lits)
+        interval.append(ivs)
+
+    # Constraints: no overlap per agent.
+    by_agent: dict[str, list] = {}
+    for i, t in enumerate(tasks):
+        for m, (a, _) in enumerate(t.modes):
+            if a:
+                by_agent.setdefault(a, []).append(interval[i][m])
+    for ivs in by_agent.values():
+        if len(ivs) > 1:
+            model.add_no_overlap(ivs)
+
+    # Constraints: precedence, end <= start.
+    for a, b in problem.precedences:
+        model.add(end[a] <= start[b])
+
+    # Constraints: renewable resources (cumulative).
+    for r, (_, capacity) in enumerate(problem.resources):
+        ivs = [interval[i][0] for i, t in enumerate(tasks) if t.demands[r] > 0]
+        demands = [t.demands[r] for t in tasks if t.demands[r] > 0]
+        if ivs:
+            model.add_cumulative(ivs, demands, capacity)
+
+    # Constraints: tool states (sequence-dependent setups, see the docstring).
+    _tool_constraints(model, problem, start, end)
+
+    # Objective: the makespan.
+    makespan = model.new_int_var(0, horizon, "makespan")
+    model.add_max_equality(makespan, end)
+    model.minimize(makespan)
+
+    # Solve.
+    solver = _solver(time_limit, workers, seed)
+    t0 = time.perf_counter()
+    status = solver.solve(model)
+    wall = time.perf_counter() - t0
+    name, found = _status(solver, status)
+    objective = bound = None
+    detail: dict = {"tasks": len(tasks), "scale": scale}
+    if found:
+        objective = solver.objective_value / scale
+        bound = solver.best_objective_bound / scale
+        rows = []
+        for i, t in enumerate(tasks):
+            m = next(m for m, lit in enumerate(present[i]) if solver.boolean_value(lit))
+            rows.append(
+                {
+                    "task": t.id,
+                    "agent": t.modes[m][0],
+                    "start": _num(solver.value(start[i]) / scale),
+                    "end": _num(solver.value(end[i]) / scale),
+                }
+            )
+        rows.sort(key=lambda r: (r["start"], r["end"], r["task"]))
+        detail["schedule"] = rows
+    return BaselineResult(
+        kind="schedule",
+        name=problem.name,
+        status=name,
+        objective=objective,
+        bound=bound,
+        wall_s=wall,
+        detail=detail,
+        credit=problem.credit,
+    )
+
+
+def _tool_constraints(model, problem: ScheduleProblem, start, end) -> None:
+    tasks = problem.tasks
+    initial = dict(problem.tool_initial)
+    tools = sorted({t for task in tasks for t, _ in (*task.requires, *task.sets)})
+    for tool in tools:
+        setters = {i: v for i, task in enumerate(tasks) for t, v in task.sets if t == tool}
+        users = {i: v for i, task in enumerate(tasks) for t, v in task.requires if t == tool}
+        if tool not in initial:
+            raise ValueError(f"{problem.name}: tool {tool!r} has no initial value")
+        # Variables: before[(s, u)] true iff setter s ends before task u starts (else u ends
+        # before s starts). One boolean per unordered pair of setters.
+        before: dict[tuple[int, int], object] = {}
+
+        def order(s: int, u: int, tool=tool, before=before, setters=setters):
+            if (s, u) in before:
+                return before[s, u]
+            if (u, s) in before and u in setters:
+                return before[u, s].Not()
+            lit = model.new_bool_var(f"before_{tool}_{tasks[s].id}_{tasks[u].id}")
+            model.add(end[s] <= start[u]).only_enforce_if(lit)
+            model.add(end[u] <= start[s]).only_enforce_if(lit.Not())
+            before[s, u] = lit
+            return lit
+
+        for s in setters:
+            for u in set(setters) | set(users):
+                if u != s:
+                    order(s, u)
+        for u, v in users.items():
+            good = [s for s, w in setters.items() if w == v and s != u]
+            if initial[tool] != v:
+                if not good:
+                    raise ValueError(
+                        f"{problem.name}: task {tasks[u].id} needs {tool} = {v} but no other "
+                        "task sets it"
+                    )
+                model.add_bool_or([order(s, u) for s in good])
+            for s, w in setters.items():
+                if s == u or w == v:
+                    continue
+                # Variables: between[s, s2, u] true iff setter s2 (of v) lies between s and u.
+                between = []
+                for s2 in good:
+                    if s2 == s:
+                        continue
+                    z = model.new_bool_var(f"between_{tool}_{tasks[s2].id}_{tasks[u].id}")
+                    model.add_implication(z, order(s, s2))
+                    model.add_implication(z, order(s2, u))
+                    between.append(z)
+                model.add_bool_or(between).only_enforce_if(order(s, u))
+
+
+# --------------------------------------------------------------------------- assemblies
+
+
+@dataclass(frozen=True)
+class AssemblySchedule:
+    """The schedule problem of an assembly and its state-graph lower bounds.
+
+    Attributes
+    ----------
+    problem : ScheduleProblem
+    chain_bound : float
+        Longest chain of (minimum) durations through the precedences implied by the state
+        graph.
+    load_bound : float
+        Largest total duration of the operations only one agent may do.
+    """
+
+    problem: ScheduleProblem
+    chain_bound: float
+    load_bound: float
+
+    @property
+    def lower_bound(self) -> float:
+        return max(self.chain_bound, self.load_bound)
+
+
+def assembly_schedule(spec, graph=None) -> AssemblySchedule:
+    """The scheduling problem of an assembly spec.
+
+    Precedences are the explicit ``after`` ones plus, when the state graph is given, every
+    precedence it implies (operation ``a`` before ``b`` when every completable state with
+    ``b`` done has ``a`` done: geometry and tool logic that act as plain precedence).
+    Geometric alternatives that are not plain precedences (``a`` or ``c`` before ``b``) are
+    relaxed. Under the tool model the bit-change times are part of the changing operations.
+    """
+    ops = spec.operations
+    n = len(ops)
+    index = {op.id: i for i, op in enumerate(ops)}
+    pred = [{index[a] for a in op.after} for op in ops]
+    if graph is not None:
+        for b, mask in enumerate(implied_predecessors(graph)):
+            pred[b] |= {a for a in range(n) if mask >> a & 1}
+    change = {t.name: t.change_time for t in spec.tools}
+    tasks = []
+    for op in ops:
+        extra = sum(change[t] for t, _ in op.sets)
+        tasks.append(
+            Task(
+                id=op.id,
+                modes=tuple((a, d + extra) for a, d in op.durations),
+                requires=op.requires,
+                sets=op.sets,
+                description=op.description,
+            )
+        )
+    precedences = tuple((a, b) for b in range(n) for a in sorted(pred[b]))
+    problem = ScheduleProblem(
+        name=spec.name,
+        tasks=tuple(tasks),
+        precedences=precedences,
+        tool_initial=tuple((t.name, t.initial) for t in spec.tools),
+        credit=spec.credit,
+    )
+    shortest = [min(d for _, d in t.modes) for t in tasks]
+    finish = [0.0] * n
+    for b in _topo(pred):
+        finish[b] = shortest[b] + max((finish[a] for a in pred[b]), default=0.0)
+    load: dict[str, float] = {}
+    for t in tasks:
+        if len(t.modes) == 1:
+            load[t.modes[0][0]] = load.get(t.modes[0][0], 0.0) + t.modes[0][1]
+    return AssemblySchedule(
+        problem=problem,
+        chain_bound=max(finish, default=0.0),
+        load_bound=max(load.values(), default=0.0),
+    )
+
+
+def implied_predecessors(graph) -> list[int]:
+    """Per operation, the bitmask of operations done in every completable state where it is."""
+    keys = graph.keys[graph.coreachable()]
+    done = np.uint64(graph.model.done_mask)
+    out = []
+    for b in range(graph.model.n_ops):
+        with_b = keys[(keys >> np.uint64(b)) & np.uint64(1) == np.uint64(1)]
+        mask = int(np.bitwise_and.reduce(with_b & done)) if with_b.size else 0
+        out.append(mask & ~(1 << b))
+    return out
+
+
+def _topo(pred: list[set[int]]) -> list[int]:
+    order, seen = [], set()
+
+    def visit(b: int) -> None:
+        stack = [(b, iter(sorted(pred[b])))]
+        seen.add(b)
+        while stack:
+            node, it = stack[-1]
+            nxt = next((a for a in it if a not in seen), None)
+            if nxt is None:
+                stack.pop()
+                order.append(node)
+            else:
+                seen.add(nxt)
+                stack.append((nxt, iter(sorted(pred[nxt]))))
+
+    for b in range(len(pred)):
+        if b not in seen:
+            visit(b)
+    return order

@@ -1,0 +1,393 @@
+"""Feasible insertions and enabled operations, as a few integer operations per (state, op).
+
+Geometry (``../shared/DESIGN.md``, "Directions and relations"): a part ``p`` placed into the
+assembled set ``S`` (not empty) is feasible iff
+
+- RTC: ``p`` touches some ``j`` in ``S`` (any direction);
+- RTT: some direction ``d`` is free, ``TT_d(p, j)`` for every ``j`` in ``S`` (``p`` is inserted
+  along ``-d``);
+
+and the enabled optimisation constraints hold (switches in the spec):
+
+- topological: the base part is placed first (every other part needs it in ``S``), and
+  the explicit ``after`` predecessors are done;
+- stability: ``p`` rests on a part of ``S`` below it, ``TC_g(p, j)`` with ``g`` the gravity
+  direction (skipped for operations marked ``held``: an agent holds the part);
+- functional: the free direction must be one the gripper approaches from
+  (``gripper_approach``).
+
+Everything is precomputed as per-part bitmasks over the spec's parts (bit ``j`` = part ``j``):
+``contact[p]`` (parts ``p`` touches), ``blocked[p, d]`` (parts that block ``p`` along ``d``),
+``support[p]`` (parts ``p`` rests on). With ``S`` a uint64 bitset the checks are
+``S & contact != 0``, ``OR_d (S & blocked[d] == 0)`` and ``S & support != 0``.
+
+An assembly state packs the done operations (bit ``i`` = operation ``i``) and the tool
+values (a small field per tool above the operation bits) into one uint64 key.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from asp.spec import DIRECTIONS, AssemblySpec, tool_values
+
+MAX_BITS = 64
+"""Operations plus tool-state bits that fit the uint64 state key."""
+
+
+@dataclass(frozen=True, eq=False)
+class InsertionOracle:
+    """Per-part bitmasks of the geometric insertion test.
+
+    Attributes
+    ----------
+    parts : tuple of str, length n
+        Part ids (bit ``j`` is part ``parts[j]``).
+    contact : (n,) uint64
+        Parts each part touches in some direction.
+    blocked : (n, 6) uint64
+        Parts that block each part's motion along each direction.
+    support : (n,) uint64
+        Parts each part rests on (contact along gravity).
+    directions : (6,) bool
+        Directions a part may be inserted from (all six unless functional is on).
+    base : int
+        Index of the base part, or -1.
+    geometric, topological, stability : bool
+        Which checks apply (geometric: relations were given).
+    """
+
+    parts: tuple[str, ...]
+    contact: np.ndarray
+    blocked: np.ndarray
+    support: np.ndarray
+    directions: np.ndarray
+    base: int
+    geometric: bool
+    topological: bool
+    stability: bool
+
+    def index(self, part: str) -> int:
+        try:
+            return self.parts.index(part)
+        except ValueError:
+            raise ValueError(f"unknown part {part!r}") from None
+
+    def feasible(self, p: int, assembled: np.ndarray, held: bool = False) -> np.ndarray:
+        """Whether part ``p`` may be inserted into each set.
+
+        Parameters
+        ----------
+        p : int
+            Part index.
+        assembled : (k,) uint64
+            Bitsets of assembled parts.
+        held : bool
+            Skip the stability check.
+
+        Returns
+        -------
+        (k,) bool
+        """
+        s = np.asarray(assembled, dtype=np.uint64)
+        zero = np.uint64(0)
+        ok = np.ones(s.shape, dtype=bool)
+        if self.topological and self.base >= 0 and p != self.base:
+            ok &= (s & np.uint64(1 << self.base)) != zero
+        if self.geometric:
+            geo = (s & self.contact[p]) != zero
+            free = np.zeros(s.shape, dtype=bool)
+            for d in np.flatnonzero(self.directions):
+                free |= (s & self.blocked[p, d]) == zero
+            geo &= free
+            if self.stability and not held:
+                geo &= (s & self.support[p]) != zero
+            ok &= geo | (s == zero)
+        return ok
+
+    def reasons(self, p: int, assembled: int, held: bool = False) -> list[str]:
+        """Why part ``p`` cannot be inserted into the set ``assembled`` (empty if it can)."""
+        s = int(assembled)
+        out = []
+        if self.topological and self.base >= 0 and p != self.base and not s >> self.base & 1:
+            out.append(f"the base part {self.parts[self.base]} is not placed yet")
+        if not self.geometric or s == 0:
+            return out
+        if not s & int(self.contact[p]):
+            out.append("no contact with the assembled parts")
+        free = [DIRECTIONS[d] for d in range(6) if not s & int(self.blocked[p, d])]
+        allowed = [d for d in free if self.directions[DIRECTIONS.index(d)]]
+        if not free:
+            out.append("no free direction")
+        elif not allowed:
+            out.append(f"free only along {', '.join(free)}, which the gripper cannot approach")
+        if self.stability and not held and not s & int(self.support[p]):
+            out.append("nothing to rest on below it")
+        return out
+
+
+def insertion_oracle(spec: AssemblySpec, relations=None) -> InsertionOracle:
+    """Precompute the per-part masks of ``spec`` from cad relations (or none: topology only).
+
+    Parameters
+    ----------
+    relations : cad Relations, optional
+        ``.parts`` (ids), ``.tc`` and ``.tt`` bool arrays ``(n, n, 6)``. Its parts must include
+        every part an operation places and the base part.
+    """
+    parts = spec.part_ids or tuple(dict.fromkeys(spec.placed_parts))
+    n = len(parts)
+    if n > MAX_BITS:
+        raise ValueError(f"{spec.source}: parts: {n} parts, at most {MAX_BITS} are supported")
+    contact = np.zeros(n, dtype=np.uint64)
+    blocked = np.zeros((n, 6), dtype=np.uint64)
+    support = np.zeros(n, dtype=np.uint64)
+    directions = np.ones(6, dtype=bool)
+    c = spec.constraints
+    if c.functional:
+        directions[:] = [d in spec.gripper_approach for d in DIRECTIONS]
+    geometric = relations is not None
+    if geometric:
+        rel_ids = tuple(str(x) for x in relations.parts)
+        tc = np.asarray(relations.tc, dtype=bool)
+        tt = np.asarray(relations.tt, dtype=bool)
+        m = len(rel_ids)
+        if tc.shape != (m, m, 6) or tt.shape != (m, m, 6):
+            raise ValueError(
+                f"relations: expected tc and tt of shape ({m}, {m}, 6), got {tc.shape} and "
+                f"{tt.shape}"
+            )
+        needed = set(spec.placed_parts) | ({spec.base_part} if spec.base_part else set())
+        missing = sorted(needed - set(rel_ids))
+        if missing:
+            raise ValueError(
+                f"{spec.source}: parts: no geometry (relations) for part {missing[0]!r}"
+            )
+        g = DIRECTIONS.index(spec.gravity)
+        weights = [1 << k for k in range(n)]
+        ridx = [rel_ids.index(pid) if pid in rel_ids else -1 for pid in parts]
+        for a, ra in enumerate(ridx):
+            if ra < 0:
+                continue
+            cmask, smask, bmask = 0, 0, [0] * 6
+            for b, rb in enumerate(ridx):
+                if rb < 0 or b == a:
+                    continue
+                if tc[ra, rb].any():
+                    cmask |= weights[b]
+                if tc[ra, rb, g]:
+                    smask |= weights[b]
+                for d in range(6):
+                    if not tt[ra, rb, d]:
+                        bmask[d] |= weights[b]
+            contact[a], support[a] = cmask, smask
+            blocked[a] = bmask
+    base = parts.index(spec.base_part) if spec.base_part in parts else -1
+    return InsertionOracle(
+        parts=parts,
+        contact=contact,
+        blocked=blocked,
+        support=support,
+        directions=directions,
+        base=base,
+        geometric=geometric,
+        topological=c.topological,
+        stability=c.stability,
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class OperationModel:
+    """The spec compiled to bit operations: which operations are enabled in which states.
+
+    State key layout (uint64): bit ``i`` (``i < n_ops``) is operation ``i`` done; tool ``t``
+    keeps its value index (into ``tool_values[t]``) in ``tool_bits[t]`` bits at
+    ``tool_shift[t]``.
+
+    Attributes
+    ----------
+    op_bits : (n_ops,) uint64
+        ``1 << i``.
+    pred_masks : (n_ops,) uint64
+        Explicit predecessors of each operation (zero when topological is off).
+    op_parts : (n_ops,) uint64
+        Parts each operation places.
+    requires_mask, requires_value : (n_ops,) uint64
+        Tool fields an operation reads and the values they must hold.
+    sets_mask, sets_value : (n_ops,) uint64
+        Tool fields an operation writes and the values it writes.
+    start_key : int
+        Nothing done, every tool at its initial value.
+    initial_parts : int
+        The base part when no operation places it (it is on the fixture from the start).
+    """
+
+    spec: AssemblySpec
+    oracle: InsertionOracle
+    op_bits: np.ndarray
+    pred_masks: np.ndarray
+    op_parts: np.ndarray
+    part_lists: tuple[tuple[int, ...], ...]
+    requires_mask: np.ndarray
+    requires_value: np.ndarray
+    sets_mask: np.ndarray
+    sets_value: np.ndarray
+    tool_names: tuple[str, ...]
+    tool_values: tuple[tuple[str, ...], ...]
+    tool_shift: tuple[int, ...]
+    tool_bits: tuple[int, ...]
+    start_key: int
+    initial_parts: int
+
+    @property
+    def n_ops(self) -> int:
+        return len(self.spec.operations)
+
+    @property
+    def done_mask(self) -> int:
+        return (1 << self.n_ops) - 1
+
+    def enabled(self, keys: np.ndarray, parts: np.ndarray) -> np.ndarray:
+        """Which operations may be done next in each state.
+
+        Parameters
+        ----------
+        keys : (k,) uint64
+            State keys.
+        parts : (k,) uint64
+            Assembled-part bitsets of those states.
+
+        Returns
+        -------
+        (k, n_ops) bool
+        """
+        keys = np.asarray(keys, dtype=np.uint64)[:, None]
+        zero = np.uint64(0)
+        ok = (keys & self.op_bits[None, :]) == zero
+        ok &= (keys & self.pred_masks[None, :]) == self.pred_masks[None, :]
+        if self.tool_names:
+            ok &= (keys & self.requires_mask[None, :]) == self.requires_value[None, :]
+        for i, plist in enumerate(self.part_lists):
+            if not plist:
+                continue
+            col = ok[:, i]
+            rows = np.flatnonzero(col)
+            if rows.size == 0:
+                continue
+            s = np.asarray(parts, dtype=np.uint64)[rows]
+            good = np.ones(rows.size, dtype=bool)
+            held = self.spec.operations[i].held
+            for p in plist:
+                good &= self.oracle.feasible(p, s, held=held)
+                s = s | np.uint64(1 << p)
+            col[rows] = good
+        return ok
+
+    def successor_keys(self, keys: np.ndarray, ops: np.ndarray) -> np.ndarray:
+        """(k,) uint64: the state after doing operation ``ops[k]`` in state ``keys[k]``."""
+        keys = np.asarray(keys, dtype=np.uint64)
+        return (keys | self.op_bits[ops]) & ~self.sets_mask[ops] | self.sets_value[ops]
+
+    def tool_changes(self, keys: np.ndarray, ops: np.ndarray) -> np.ndarray:
+        """(k, n_tools) bool: whether operation ``ops[k]`` changes each tool's value."""
+        keys = np.asarray(keys, dtype=np.uint64)
+        out = np.zeros((keys.shape[0], len(self.tool_names)), dtype=bool)
+        for t, (shift, bits) in enumerate(zip(self.tool_shift, self.tool_bits, strict=True)):
+            field = np.uint64(((1 << bits) - 1) << shift)
+            writes = (self.sets_mask[ops] & field) != np.uint64(0)
+            out[:, t] = writes & ((keys & field) != (self.sets_value[ops] & field))
+        return out
+
+    def tool_state(self, key: int) -> dict[str, str]:
+        """Tool values of the state ``key``."""
+        return {
+            name: vals[(int(key) >> shift) & ((1 << bits) - 1)]
+            for name, vals, shift, bits in zip(
+                self.tool_names, self.tool_values, self.tool_shift, self.tool_bits, strict=True
+            )
+        }
+
+    def done_ops(self, key: int) -> list[str]:
+        """Ids of the operations done in the state ``key``, in spec order."""
+        key = int(key)
+        return [op.id for i, op in enumerate(self.spec.operations) if key >> i & 1]
+
+
+def operation_model(spec: AssemblySpec, relations=None) -> OperationModel:
+    """Compile ``spec`` (and the cad relations, if any) into an :class:`OperationModel`.
+
+    Raises
+    ------
+    ValueError
+        More operations plus tool-state bits than fit a 64-bit state key.
+    """
+    ops = spec.operations
+    n_ops = len(ops)
+    values = tool_values(spec)
+    names = tuple(values)
+    bits = tuple(max(1, math.ceil(math.log2(len(values[t])))) for t in names)
+    shifts, pos = [], n_ops
+    for b in bits:
+        shifts.append(pos)
+        pos += b
+    if pos > MAX_BITS:
+        raise ValueError(
+            f"{spec.source}: operations: {n_ops} operations and {pos - n_ops} tool-state bits "
+            f"exceed the {MAX_BITS}-bit state key; split the assembly into subassemblies"
+        )
+    oracle = insertion_oracle(spec, relations)
+    index = {op.id: i for i, op in enumerate(ops)}
+    pidx = {p: k for k, p in enumerate(oracle.parts)}
+    topo = spec.constraints.topological
+    pred = [sum(1 << index[a] for a in op.after) if topo else 0 for op in ops]
+    part_lists = tuple(tuple(pidx[p] for p in op.parts) for op in ops)
+    req_m, req_v, set_m, set_v = [], [], [], []
+    tindex = {t: k for k, t in enumerate(names)}
+    for op in ops:
+        for pairs, mlist, vlist in ((op.requires, req_m, req_v), (op.sets, set_m, set_v)):
+            m = v = 0
+            for t, val in pairs:
+                k = tindex[t]
+                m |= ((1 << bits[k]) - 1) << shifts[k]
+                v |= values[t].index(val) << shifts[k]
+            mlist.append(m)
+            vlist.append(v)
+    placed = set(spec.placed_parts)
+    initial_parts = 0
+    if oracle.base >= 0 and spec.base_part not in placed:
+        initial_parts = 1 << oracle.base
+    u64 = np.uint64
+    return OperationModel(
+        spec=spec,
+        oracle=oracle,
+        op_bits=np.array([1 << i for i in range(n_ops)], dtype=u64),
+        pred_masks=np.array(pred, dtype=u64),
+        op_parts=np.array([sum(1 << p for p in pl) for pl in part_lists], dtype=u64),
+        part_lists=part_lists,
+        requires_mask=np.array(req_m, dtype=u64),
+        requires_value=np.array(req_v, dtype=u64),
+        sets_mask=np.array(set_m, dtype=u64),
+        sets_value=np.array(set_v, dtype=u64),
+        tool_names=names,
+        tool_values=tuple(values[t] for t in names),
+        tool_shift=tuple(shifts),
+        tool_bits=bits,
+        start_key=0,
+        initial_parts=initial_parts,
+    )
+
+
+def load_relations(spec: AssemblySpec, *, progress: bool = False):
+    """Compute the cad relations of ``spec``'s parts (``None`` when it has no geometry).
+
+    Reads the meshes through ``cad.load_assembly`` on the spec's ``assembly.yaml``.
+    """
+    if not spec.has_geometry:
+        return None
+    import cad
+
+    assembly = cad.load_assembly(spec.source, units=spec.units)
+    return cad.compute_relations(assembly, progress=progress)

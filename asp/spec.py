@@ -1,0 +1,559 @@
+"""The assembly specification: parts, agents, operations, tools and switches (``assembly.yaml``).
+
+An ``assembly.yaml`` names everything the planner needs besides the part geometry::
+
+    name: vacuum pump                  # free text
+    units: mm                          # read by cad/ (ignored here)
+    parts:                             # the same list cad.load_assembly reads
+      - {id: BD, name: Main body, file: meshes/BD.stl, quantity: 1, type: component}
+    agents:                            # name -> side (human, robot; any for open tasks)
+      H: {side: human}
+      R1: {side: robot, description: UR3e with screwdriver}
+    tools:                             # tool state: initial value, time to change it
+      R1.bit: {initial: hex, change_time: 0}
+    base_part: BD                      # placed first (or there from the start)
+    gravity: -z                        # one of +x -x +y -y +z -z
+    gripper_approach: [+z, -z]         # directions d a part may leave along (inserted along -d)
+    constraints: {topological: true, stability: true, functional: true}
+    turn_model: alternate
+    cost: steps                        # or time
+    operations:
+      - id: "1.2"                      # ids are strings (1.10 stays "1.10")
+        description: Replace hex bit with cross bit on R1
+        agents: {H: 15}                # allowed agents and their durations
+        requires: {R1.bit: hex}        # tool state needed (optional)
+        sets: {R1.bit: cross}          # tool state after the operation (optional)
+        after: ["1.1"]                 # explicit predecessors (optional)
+      - id: "1.4"
+        agents: {H: 12}
+        part: [PC, VT1]                # part(s) placed, in this order (optional)
+        held: false                    # true: an agent holds the part, no stability check
+
+Semantics:
+
+- An operation may start when all its ``after`` operations are done, every ``requires``
+  tool has the value named, and every part it places is a feasible insertion
+  (:mod:`asp.feasibility`). Afterwards the ``sets`` tools have their new values.
+- Under ``cost: time`` a move costs the agent's duration plus the tool's ``change_time``
+  for every tool whose value the operation actually changes.
+- If no operation places the base part, it is on the fixture from the start.
+
+:func:`load_spec` validates everything and raises a one-line ``ValueError`` naming the
+file, the key and the offending operation or part.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import networkx as nx
+import yaml
+
+DIRECTIONS = ("+x", "-x", "+y", "-y", "+z", "-z")
+"""Direction order everywhere (same as ``cad.DIRECTIONS``)."""
+SIDES = ("human", "robot", "any")
+COST_MODELS = ("steps", "time")
+CONSTRAINT_KEYS = ("topological", "stability", "functional")
+SPEC_FILE = "assembly.yaml"
+
+
+@dataclass(frozen=True)
+class Part:
+    """A part of the bill of materials (``parts:`` entry)."""
+
+    id: str
+    name: str = ""
+    file: str | None = None
+    quantity: int = 1
+    type: str = ""
+
+
+@dataclass(frozen=True)
+class Agent:
+    """An agent: ``H``, ``R1``, ... with its side (``human``, ``robot`` or ``any``)."""
+
+    name: str
+    side: str
+    description: str = ""
+
+
+@dataclass(frozen=True)
+class Tool:
+    """A tool state variable such as ``R1.bit``: its initial value and change time."""
+
+    name: str
+    initial: str
+    change_time: float = 0.0
+
+
+@dataclass(frozen=True)
+class Operation:
+    """One assembly operation.
+
+    Attributes
+    ----------
+    id, description : str
+    durations : tuple of (agent, duration)
+        The agents allowed to do it and how long each takes.
+    parts : tuple of str
+        Parts placed, in order (may be empty).
+    requires, sets : tuple of (tool, value)
+        Tool states needed before / set after the operation.
+    after : tuple of str
+        Explicit predecessor operation ids.
+    held : bool
+        An agent holds the placed part: the stability constraint does not apply.
+    """
+
+    id: str
+    description: str
+    durations: tuple[tuple[str, float], ...]
+    parts: tuple[str, ...] = ()
+    requires: tuple[tuple[str, str], ...] = ()
+    sets: tuple[tuple[str, str], ...] = ()
+    after: tuple[str, ...] = ()
+    held: bool = False
+
+    @property
+    def agents(self) -> tuple[str, ...]:
+        return tuple(a for a, _ in self.durations)
+
+    def duration(self, agent: str) -> float:
+        for a, d in self.durations:
+            if a == agent:
+                return d
+        raise ValueError(f"operation {self.id!r}: agent {agent!r} may not do it")
+
+
+@dataclass(frozen=True)
+class Constraints:
+    """Switches of the optimisation constraints (RTC and RTT are always applied)."""
+
+    topological: bool = True
+    stability: bool = True
+    functional: bool = True
+
+
+@dataclass(frozen=True)
+class AssemblySpec:
+    """A validated assembly specification (see the module docstring for the YAML)."""
+
+    name: str
+    operations: tuple[Operation, ...]
+    agents: tuple[Agent, ...]
+    parts: tuple[Part, ...] = ()
+    tools: tuple[Tool, ...] = ()
+    base_part: str | None = None
+    gravity: str = "-z"
+    gripper_approach: tuple[str, ...] = DIRECTIONS
+    constraints: Constraints = field(default_factory=Constraints)
+    turn_model: str = "alternate"
+    cost: str = "steps"
+    source: str = ""
+    units: str | None = None
+    credit: str = ""
+
+    @property
+    def op_ids(self) -> tuple[str, ...]:
+        return tuple(op.id for op in self.operations)
+
+    def op_index(self, op_id: str) -> int:
+        for i, op in enumerate(self.operations):
+            if op.id == str(op_id):
+                return i
+        raise ValueError(f"unknown operation {op_id!r}")
+
+    def operation(self, op_id: str) -> Operation:
+        return self.operations[self.op_index(op_id)]
+
+    def agent(self, name: str) -> Agent:
+        for a in self.agents:
+            if a.name == name:
+                return a
+        raise ValueError(f"unknown agent {name!r}")
+
+    def tool(self, name: str) -> Tool:
+        for t in self.tools:
+            if t.name == name:
+                return t
+        raise ValueError(f"unknown tool {name!r}")
+
+    @property
+    def part_ids(self) -> tuple[str, ...]:
+        return tuple(p.id for p in self.parts)
+
+    @property
+    def placed_parts(self) -> tuple[str, ...]:
+        """Parts placed by some operation, in operation order."""
+        return tuple(p for op in self.operations for p in op.parts)
+
+    @property
+    def has_geometry(self) -> bool:
+        """True when some operation places a part that has a mesh file."""
+        files = {p.id for p in self.parts if p.file}
+        return any(p in files for p in self.placed_parts)
+
+    @property
+    def folder(self) -> Path | None:
+        return Path(self.source).parent if self.source else None
+
+
+# --------------------------------------------------------------------------- loading
+
+
+class _Loader(yaml.SafeLoader):
+    """SafeLoader that keeps decimal-looking scalars as strings (``1.10`` stays ``"1.10"``)."""
+
+
+_Loader.yaml_implicit_resolvers = {
+    key: [(tag, regexp) for tag, regexp in resolvers if tag != "tag:yaml.org,2002:float"]
+    for key, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.copy().items()
+}
+
+
+def resolve_spec_path(path: str | os.PathLike[str]) -> Path:
+    """The ``assembly.yaml`` of ``path`` (a folder holding one, or the file itself)."""
+    path = Path(path)
+    if path.is_dir():
+        candidate = path / SPEC_FILE
+        if not candidate.is_file():
+            raise FileNotFoundError(f"{path}: no {SPEC_FILE} in this folder")
+        return candidate
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no such file or folder")
+    return path
+
+
+def load_spec(path: str | os.PathLike[str]) -> AssemblySpec:
+    """Load and validate an assembly: a folder with ``assembly.yaml``, the YAML, or a ``.IN2``.
+
+    Raises
+    ------
+    FileNotFoundError
+        The path does not exist.
+    ValueError
+        One line naming the file, the key and the offending operation or part.
+    """
+    path = Path(path)
+    if path.suffix.lower() == ".in2":
+        from asp.salbp import salbp_spec
+
+        return salbp_spec(path)
+    path = resolve_spec_path(path)
+    try:
+        data = yaml.load(path.read_text(encoding="utf-8"), Loader=_Loader)
+    except yaml.YAMLError as exc:
+        first = " ".join(str(exc).split())
+        raise ValueError(f"{path}: malformed YAML ({first})") from None
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"{path}: not a UTF-8 text file ({exc.reason})") from None
+    return spec_from_dict(data, source=str(path))
+
+
+def spec_from_dict(data: dict, source: str = "<dict>") -> AssemblySpec:
+    """Build and validate an :class:`AssemblySpec` from a parsed YAML mapping."""
+    return _Parser(source).parse(data)
+
+
+class _Parser:
+    def __init__(self, source: str):
+        self.source = source
+
+    def fail(self, key: str, message: str) -> ValueError:
+        return ValueError(f"{self.source}: {key}: {message}")
+
+    # ------------------------------------------------------------------ scalars
+    def number(self, value, key: str, *, minimum: float = 0.0) -> float:
+        try:
+            x = float(value)
+        except (TypeError, ValueError):
+            raise self.fail(key, f"expected a number, got {value!r}") from None
+        if not x >= minimum or x == float("inf"):
+            raise self.fail(key, f"expected a finite number >= {minimum:g}, got {value!r}")
+        return x
+
+    def text(self, value, key: str) -> str:
+        if value is None or isinstance(value, dict | list):
+            raise self.fail(key, f"expected a name, got {value!r}")
+        out = str(value).strip()
+        if not out:
+            raise self.fail(key, "expected a non-empty name")
+        return out
+
+    def mapping(self, value, key: str) -> dict:
+        if value is None:
+            return {}
+        if not isinstance(value, dict):
+            raise self.fail(key, f"expected a mapping, got {type(value).__name__}")
+        return value
+
+    def direction(self, value, key: str) -> str:
+        d = str(value).strip().lower()
+        if d in ("x", "y", "z"):
+            d = "+" + d
+        if d not in DIRECTIONS:
+            raise self.fail(key, f"expected one of {' '.join(DIRECTIONS)}, got {value!r}")
+        return d
+
+    # ------------------------------------------------------------------ sections
+    def parse(self, data) -> AssemblySpec:
+        if not isinstance(data, dict):
+            raise ValueError(f"{self.source}: expected a YAML mapping at the top level")
+        parts = self.parts(data.get("parts"))
+        agents = self.agents(data.get("agents"))
+        tools = self.tools(data.get("tools"))
+        ops = self.operations(data.get("operations"), parts, agents, tools)
+        part_ids = {p.id for p in parts}
+        base = data.get("base_part")
+        if base is not None:
+            base = self.text(base, "base_part")
+            if base not in part_ids:
+                raise self.fail("base_part", f"unknown part {base!r}")
+        elif parts and any(op.parts for op in ops):
+            base = parts[0].id
+        gravity = self.direction(data.get("gravity", "-z"), "gravity")
+        approach_raw = data.get("gripper_approach", list(DIRECTIONS))
+        if isinstance(approach_raw, str):
+            approach_raw = [approach_raw]
+        if not isinstance(approach_raw, list) or not approach_raw:
+            raise self.fail("gripper_approach", "expected a non-empty list of directions")
+        approach = tuple(dict.fromkeys(self.direction(d, "gripper_approach") for d in approach_raw))
+        cons = self.mapping(data.get("constraints"), "constraints")
+        for key in cons:
+            if key not in CONSTRAINT_KEYS:
+                raise self.fail(
+                    "constraints", f"unknown switch {key!r}: expected {', '.join(CONSTRAINT_KEYS)}"
+                )
+        flags = {}
+        for key in CONSTRAINT_KEYS:
+            value = cons.get(key, True)
+            if not isinstance(value, bool):
+                raise self.fail(f"constraints.{key}", f"expected true or false, got {value!r}")
+            flags[key] = value
+        turn = str(data.get("turn_model", "alternate"))
+        if turn != "alternate":
+            raise self.fail("turn_model", f"expected 'alternate', got {turn!r}")
+        cost = str(data.get("cost", "steps"))
+        if cost not in COST_MODELS:
+            raise self.fail("cost", f"expected 'steps' or 'time', got {cost!r}")
+        return AssemblySpec(
+            name=str(data.get("name") or Path(self.source).parent.name or "assembly"),
+            operations=ops,
+            agents=agents,
+            parts=parts,
+            tools=tools,
+            base_part=base,
+            gravity=gravity,
+            gripper_approach=approach,
+            constraints=Constraints(**flags),
+            turn_model=turn,
+            cost=cost,
+            source=self.source,
+            units=None if data.get("units") is None else str(data.get("units")),
+            credit=str(data.get("credit", "")),
+        )
+
+    def parts(self, raw) -> tuple[Part, ...]:
+        if raw is None:
+            return ()
+        if not isinstance(raw, list):
+            raise self.fail("parts", "expected a list of {id, name, file, quantity, type}")
+        out, seen = [], set()
+        for k, item in enumerate(raw):
+            if isinstance(item, str):
+                item = {"id": item}
+            if not isinstance(item, dict) or "id" not in item:
+                raise self.fail(f"parts[{k}]", "expected a mapping with an 'id'")
+            pid = self.text(item["id"], f"parts[{k}].id")
+            if pid in seen:
+                raise self.fail("parts", f"duplicate part id {pid!r}")
+            seen.add(pid)
+            qty = item.get("quantity", 1)
+            if not isinstance(qty, int) or isinstance(qty, bool) or qty < 1:
+                raise self.fail(
+                    f"parts[{pid}].quantity", f"expected a positive integer, got {qty!r}"
+                )
+            out.append(
+                Part(
+                    id=pid,
+                    name=str(item.get("name") or pid),
+                    file=None if item.get("file") is None else str(item["file"]),
+                    quantity=qty,
+                    type=str(item.get("type") or ""),
+                )
+            )
+        return tuple(out)
+
+    def agents(self, raw) -> tuple[Agent, ...]:
+        if isinstance(raw, list):
+            items = []
+            for k, item in enumerate(raw):
+                if not isinstance(item, dict) or not ({"name", "id"} & set(item)):
+                    raise self.fail(f"agents[{k}]", "expected a mapping with a 'name'")
+                items.append((item.get("name", item.get("id")), item))
+        else:
+            items = list(self.mapping(raw, "agents").items())
+        if not items:
+            raise self.fail("agents", "expected at least one agent")
+        out, seen = [], set()
+        for name, item in items:
+            name = self.text(name, "agents")
+            if name in seen:
+                raise self.fail("agents", f"duplicate agent {name!r}")
+            seen.add(name)
+            if isinstance(item, str):
+                item = {"side": item}
+            item = self.mapping(item, f"agents.{name}")
+            side = str(item.get("side", "")).lower()
+            if side not in SIDES:
+                raise self.fail(
+                    f"agents.{name}.side", f"expected human, robot or any, got {item.get('side')!r}"
+                )
+            out.append(Agent(name=name, side=side, description=str(item.get("description", ""))))
+        return tuple(out)
+
+    def tools(self, raw) -> tuple[Tool, ...]:
+        out = []
+        for name, item in self.mapping(raw, "tools").items():
+            name = self.text(name, "tools")
+            item = self.mapping(item, f"tools.{name}")
+            if "initial" not in item:
+                raise self.fail(f"tools.{name}", "missing 'initial' value")
+            out.append(
+                Tool(
+                    name=name,
+                    initial=self.text(item["initial"], f"tools.{name}.initial"),
+                    change_time=self.number(
+                        item.get("change_time", 0), f"tools.{name}.change_time"
+                    ),
+                )
+            )
+        return tuple(out)
+
+    def operations(self, raw, parts, agents, tools) -> tuple[Operation, ...]:
+        if not isinstance(raw, list) or not raw:
+            raise self.fail("operations", "expected a non-empty list")
+        agent_names = {a.name for a in agents}
+        part_ids = {p.id for p in parts}
+        tool_names = {t.name for t in tools}
+        ops: list[Operation] = []
+        seen: set[str] = set()
+        placed_by: dict[str, str] = {}
+        for k, item in enumerate(raw):
+            if not isinstance(item, dict) or "id" not in item:
+                raise self.fail(f"operations[{k}]", "expected a mapping with an 'id'")
+            oid = self.text(item["id"], f"operations[{k}].id")
+            where = f"operations[{oid}]"
+            if oid in seen:
+                raise self.fail("operations", f"duplicate operation id {oid!r}")
+            seen.add(oid)
+            unknown = set(item) - {
+                "id", "description", "agents", "part", "parts", "requires", "sets", "after",
+                "held",
+            }  # fmt: skip
+            if unknown:
+                raise self.fail(where, f"unknown key {sorted(unknown)[0]!r}")
+            agents_raw = self.mapping(item.get("agents"), f"{where}.agents")
+            if not agents_raw:
+                raise self.fail(f"{where}.agents", "no agent may do this operation")
+            durations = []
+            for a, d in agents_raw.items():
+                a = str(a)
+                if a not in agent_names:
+                    raise self.fail(f"{where}.agents", f"unknown agent {a!r}")
+                durations.append((a, self.number(d, f"{where}.agents.{a}")))
+            placed = item.get("part", item.get("parts"))
+            if placed is None:
+                placed = []
+            elif not isinstance(placed, list):
+                placed = [placed]
+            placed = tuple(self.text(p, f"{where}.part") for p in placed)
+            for p in placed:
+                if p not in part_ids:
+                    raise self.fail(f"{where}.part", f"unknown part {p!r}")
+                if p in placed_by:
+                    raise self.fail(
+                        f"{where}.part", f"part {p!r} is already placed by operation "
+                        f"{placed_by[p]!r}"
+                    )  # fmt: skip
+                placed_by[p] = oid
+            tool_pairs = {}
+            for key in ("requires", "sets"):
+                pairs = []
+                for t, v in self.mapping(item.get(key), f"{where}.{key}").items():
+                    t = str(t)
+                    if t not in tool_names:
+                        raise self.fail(f"{where}.{key}", f"unknown tool {t!r}")
+                    pairs.append((t, self.text(v, f"{where}.{key}.{t}")))
+                tool_pairs[key] = tuple(pairs)
+            after_raw = item.get("after") or []
+            if not isinstance(after_raw, list):
+                after_raw = [after_raw]
+            held = item.get("held", False)
+            if not isinstance(held, bool):
+                raise self.fail(f"{where}.held", f"expected true or false, got {held!r}")
+            ops.append(
+                Operation(
+                    id=oid,
+                    description=str(item.get("description") or ""),
+                    durations=tuple(durations),
+                    parts=placed,
+                    requires=tool_pairs["requires"],
+                    sets=tool_pairs["sets"],
+                    after=tuple(dict.fromkeys(self.text(a, f"{where}.after") for a in after_raw)),
+                    held=held,
+                )
+            )
+        self.check_predecessors(ops)
+        self.check_tools(ops, tools)
+        return tuple(ops)
+
+    def check_predecessors(self, ops: list[Operation]) -> None:
+        check_predecessors(ops, self.source)
+
+    def check_tools(self, ops: list[Operation], tools: tuple[Tool, ...]) -> None:
+        values = {t.name: {t.initial} for t in tools}
+        for op in ops:
+            for t, v in op.sets:
+                values[t].add(v)
+        for op in ops:
+            for t, v in op.requires:
+                if v not in values[t]:
+                    raise self.fail(
+                        f"operations[{op.id}].requires",
+                        f"tool value {t} = {v!r} is needed but never set nor initial",
+                    )
+
+
+def check_predecessors(ops, source: str) -> None:
+    """Raise ``ValueError`` for an unknown, self or cyclic predecessor (naming the cycle)."""
+    ids = {op.id for op in ops}
+    g = nx.DiGraph()
+    g.add_nodes_from(op.id for op in ops)
+    for op in ops:
+        for a in op.after:
+            if a not in ids:
+                raise ValueError(f"{source}: operations[{op.id}].after: unknown predecessor {a!r}")
+            if a == op.id:
+                raise ValueError(f"{source}: operations[{op.id}].after: operation precedes itself")
+            g.add_edge(a, op.id)
+    try:
+        cycle = nx.find_cycle(g)
+    except nx.NetworkXNoCycle:
+        return
+    names = [u for u, _ in cycle] + [cycle[0][0]]
+    raise ValueError(
+        f"{source}: operations[{cycle[0][1]}].after: cyclic predecessors: " + " -> ".join(names)
+    )
+
+
+def tool_values(spec: AssemblySpec) -> dict[str, tuple[str, ...]]:
+    """Every value each tool can take: the initial one first, then in order of appearance."""
+    out = {t.name: [t.initial] for t in spec.tools}
+    for op in spec.operations:
+        for t, v in (*op.sets, *op.requires):
+            if v not in out[t]:
+                out[t].append(v)
+    return {k: tuple(v) for k, v in out.items()}
