@@ -46,12 +46,14 @@ def _load(assembly: Path, *, progress: bool):
 @app.command("graph")
 def graph_command(
     assembly: Path = typer.Argument(..., help="Folder with assembly.yaml, the YAML, or a .IN2."),
-    output: Path = typer.Option(..., "--output", "-o", help="Game DAG file (.json or .graphml)."),
+    output: Path | None = typer.Option(
+        None, "--output", "-o", help="Game DAG file to write (.json or .graphml)."
+    ),
     fmt: OutputFormat = typer.Option(OutputFormat.json, "--format", help="Output format."),
     cost: CostModel | None = typer.Option(None, "--cost", help="Cost model (default: spec's)."),
     progress: bool = typer.Option(False, "--progress", help="Print progress on stderr."),
 ) -> None:
-    """Build the assembly state graph and the game DAG; write the DAG, print the sizes."""
+    """Build the assembly state graph and the game DAG; print the sizes, write the DAG."""
     from asp.game import game_dag
     from asp.io import save_dag
     from asp.state_graph import build_state_graph
@@ -61,7 +63,8 @@ def graph_command(
     graph = build_state_graph(spec, relations, progress=progress)
     sequences = graph.count_sequences()
     dag = game_dag(graph, cost=None if cost is None else cost.value)
-    save_dag(dag, output)
+    if output is not None:
+        save_dag(dag, output)
     result = {
         "assembly": spec.name,
         "operations": len(spec.operations),
@@ -72,7 +75,7 @@ def graph_command(
         "game_nodes": dag.n_nodes,
         "game_edges": dag.n_edges,
         "cost": dag.cost_model,
-        "output": str(output),
+        "output": None if output is None else str(output),
         "wall_s": round(time.perf_counter() - t0, 3),
     }
     if spec.credit:
@@ -85,7 +88,8 @@ def graph_command(
         f"{graph.n_transitions:,} transitions, {sequences:,} feasible sequences"
     )
     typer.echo(
-        f"game DAG ({dag.cost_model}): {dag.n_nodes:,} nodes, {dag.n_edges:,} edges -> {output}"
+        f"game DAG ({dag.cost_model}): {dag.n_nodes:,} nodes, {dag.n_edges:,} edges"
+        + ("" if output is None else f" -> {output}")
     )
     if spec.credit:
         typer.echo(spec.credit)

@@ -238,3 +238,16 @@ def test_too_many_operations():
 def test_state_limit():
     with pytest.raises(ValueError, match="exceeds 100 states"):
         build_state_graph(precedence_spec(10, []), max_states=100)
+
+
+def test_figure2_unfolding_one_state_per_set_of_done_operations():
+    # Paper, Figure 2: A -> B -> C and A -> C -> B are both admissible. The unfolding has
+    # one state per set of done operations ({}, {A}, {A,B}, {A,C}, {A,B,C}): both orders
+    # meet again in {A,B,C} instead of duplicating it.
+    graph = build_state_graph(precedence_spec(3, [(0, 1), (0, 2)]))
+    assert graph.n_states == 5 and graph.n_transitions == 5
+    assert graph.count_sequences() == 2
+    assert sorted(map(tuple, graph.sequences(limit=10))) == [(0, 1, 2), (0, 2, 1)]
+    dag = game_dag(graph)
+    in_degree = np.bincount(dag.targets, minlength=dag.n_nodes)
+    assert in_degree[dag.end] == 2 and dag.n_nodes == 5
