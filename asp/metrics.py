@@ -12,6 +12,7 @@ For a robot policy (by default the robust one):
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass
 
 import numpy as np
@@ -149,7 +150,8 @@ def _reachable_states(dag, robot_policy, h_indptr, h_edges) -> np.ndarray | None
 def resilience_ratio(costs: np.ndarray | dict, wcpl: float) -> float:
     """Share (0..1) of games with cost <= ``wcpl``: from sampled costs or an exact distribution."""
     if isinstance(costs, dict):
-        return float(sum(p for c, p in costs.items() if c <= wcpl + 1e-9))
+        # Products of move probabilities carry rounding error: 1.0 must read as 1.0.
+        return round(math.fsum(p for c, p in costs.items() if c <= wcpl + 1e-9), 12)
     costs = np.asarray(costs, dtype=np.float64)
     return float(np.mean(costs <= wcpl + 1e-9))
 

@@ -4,7 +4,8 @@ The generator draws ``layers`` inner layers of 1..``max_nodes`` candidate nodes,
 every node 1..``max_actions`` out-edges to later layers: early nodes draw more actions,
 targets prefer the next layer. Only the nodes reachable from the start are kept, so every
 node but the start has an in-edge; every node but the end has an out-edge because edges
-only go forward and the last inner layer feeds the end. Ids are renumbered layer by layer:
+only go forward and the last inner layer feeds the end (no skip lands on the end, so TCT is
+at least 2). Ids are renumbered layer by layer:
 node 0 is the start, the last node the end.
 
 All randomness comes from one ``numpy.random.Generator(PCG64(seed))``, so the same
@@ -68,10 +69,11 @@ def synthetic_dag(layers: int, max_nodes: int, max_actions: int, seed: int = 0) 
         k = 1 + rng.binomial(max_actions - 1, p_more)
         chosen: list[int] = []
         for _ in range(k):
-            if layer + 1 == layers + 1 or rng.random() < NEXT_LAYER_PROBABILITY:
+            # Skips land on a later inner layer; only the last inner layer feeds the end.
+            if layer + 2 > layers or rng.random() < NEXT_LAYER_PROBABILITY:
                 target_layer = layer + 1
             else:
-                target_layer = int(rng.integers(layer + 2, layers + 2))
+                target_layer = int(rng.integers(layer + 2, layers + 1))
             v = int(first[target_layer] + rng.integers(sizes[target_layer]))
             if v not in chosen:
                 chosen.append(v)

@@ -44,6 +44,8 @@ def test_structure_invariants(layers, max_nodes, max_actions, seed):
     assert np.all(layer[dag.targets] > layer[dag.sources])  # edges go to later layers
     assert np.all(np.diff(layer) >= 0)  # ids layer by layer
     assert np.all(np.bincount(layer)[1:-1] <= max_nodes)
+    # Skips land on inner layers: the start never links straight to the end.
+    assert dag.end not in dag.targets[dag.indptr[0] : dag.indptr[1]] or layers == 0
 
 
 @pytest.mark.parametrize("bad", [{"layers": 0}, {"max_nodes": -1}, {"max_actions": 0}])
