@@ -1,0 +1,57 @@
+"""Tabulate a learned policy: one forward pass over all nodes.
+
+A policy over a game DAG with ``n`` nodes is small enough to hold as a table. The trainer
+tabulates the frozen opponent once per phase (instead of a network call per step) and the
+greedy policies after each cycle (for the exact metrics of :mod:`asp.solve`).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import torch
+
+from arl.envs import Observer
+from arl.game import NO_MOVE, GameTables
+
+
+def action_probabilities(model, tables: GameTables, player: int, observer: Observer) -> np.ndarray:
+    """(n, max_moves) float64: the model's action distribution at every node.
+
+    Invalid actions get probability 0 (the rest renormalised); rows of nodes where
+    ``player`` has no move are all zero.
+
+    Parameters
+    ----------
+    model : SB3 ``PPO`` or sb3-contrib ``MaskablePPO``
+    tables : GameTables
+    player : int
+        The side ``model`` plays (``ROBOT`` or ``HUMAN``).
+    observer : Observer
+        Maps nodes to the model's observations.
+    """
+    obs = observer.batch(np.arange(tables.n))
+    policy = model.policy
+    with torch.no_grad():
+        obs_tensor, _ = policy.obs_to_tensor(obs)
+        probs = policy.get_distribution(obs_tensor).distribution.probs.cpu().numpy()
+    mask = tables.masks(player)
+    probs = np.where(mask, probs.astype(np.float64), 0.0)
+    total = probs.sum(axis=1, keepdims=True)
+    uniform = mask / np.maximum(mask.sum(axis=1, keepdims=True), 1)
+    return np.where(total > 0, probs / np.where(total > 0, total, 1.0), uniform)
+
+
+def greedy_policy(probs: np.ndarray, tables: GameTables, player: int) -> np.ndarray:
+    """(n,) int64 edge indices of the most probable valid action (``NO_MOVE`` where none).
+
+    Ties go to the lower action index.
+    """
+    return tables.to_edges(player, probs.argmax(axis=1)).astype(np.int64)
+
+
+def tabulate(model, tables: GameTables, player: int, observer: Observer) -> np.ndarray:
+    """The greedy policy of ``model`` as (n,) edge indices (``NO_MOVE`` where no move)."""
+    return greedy_policy(action_probabilities(model, tables, player, observer), tables, player)
+
+
+__all__ = ["NO_MOVE", "action_probabilities", "greedy_policy", "tabulate"]

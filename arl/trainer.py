@@ -1,0 +1,541 @@
+"""Alternating PPO (paper, section 3.4, Figure 5), certified against the exact game.
+
+Each cycle trains the robot against the frozen human, then the human against the frozen
+robot, both with SB3 PPO; after each cycle the greedy policies are tabulated over all nodes
+and scored exactly with :mod:`asp.solve`: the WCPL of greedy robot vs greedy human (the
+paper's) and the certified WCPL of the robot against an exact best-response human.
+
+The stop rule never looks at the exact solution: it reads the rewards (``paper``) or the
+stability of the learned policies (``fast``), see :class:`arl.config.TrainConfig`.
+
+Reproducibility: every phase reseeds numpy, torch, the model's action space and the
+environments from ``(seed, cycle, side)`` and starts fresh games, so the same seed gives
+the same cycle log (with deterministic torch settings), and a resumed run continues exactly
+as the uninterrupted run would have.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+from stable_baselines3.common.callbacks import BaseCallback
+from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv
+
+from arl.config import TrainConfig, get_config
+from arl.envs import GameVecEnv, Observer, TurnEnv
+from arl.game import AGENTS, NO_MOVE, GameTables
+from arl.tabulate import action_probabilities, greedy_policy
+from asp.atomic import write_bytes, write_text
+from asp.dag import HUMAN, ROBOT, GameDAG
+from asp.solve import certified_worst_case, play, solve
+
+LOG_VERSION = 1
+CycleCallback = Callable[[dict], bool | None]
+"""Called after every cycle with its log record; returning ``False`` stops training."""
+
+
+@dataclass(frozen=True, eq=False)
+class TrainResult:
+    """The outcome of :func:`train`.
+
+    Attributes
+    ----------
+    robot_policy, human_policy : (n,) int64
+        Greedy tabulated policies as edge indices (``NO_MOVE = -1`` where the side has no
+        move).
+    cycles : list of dict
+        Per cycle: ``cycle``, ``robot_mean_reward``, ``human_mean_reward``, ``wcpl``,
+        ``certified_wcpl``, ``wall_s`` (of the cycle), ``elapsed_s``, ``timesteps``
+        (cumulative, both sides), ``robot_episodes``, ``human_episodes``, ``policy_hash``.
+    episode_rewards : dict
+        ``{"robot": [...], "human": [...]}``: the reward of every training game played from
+        the start (Figure 11 of the paper).
+    wall_s : float
+        Training time, over all runs of a resumed training.
+    converged : bool
+        Whether the stop rule fired (else ``max_cycles`` or the callback ended it).
+    wcpl : float
+        Cost of greedy robot vs greedy human (:func:`asp.solve.play`).
+    certified_wcpl : float
+        Cost of the greedy robot against an exact best-response human.
+    minimax : float
+        The game value W* (for reference; never used in training).
+    config : TrainConfig
+    seed : int
+    output : Path or None
+    models : dict
+        ``{"robot": model, "human": model}`` (SB3 models; ``None`` for a side without
+        moves).
+    """
+
+    robot_policy: np.ndarray
+    human_policy: np.ndarray
+    cycles: list[dict]
+    episode_rewards: dict[str, list[float]]
+    wall_s: float
+    converged: bool
+    wcpl: float
+    certified_wcpl: float
+    minimax: float
+    config: TrainConfig
+    seed: int
+    output: Path | None = None
+    models: dict[str, Any] = field(default_factory=dict, repr=False)
+
+    @property
+    def robust_optimal(self) -> bool:
+        """Whether the certified WCPL equals W*."""
+        return abs(self.certified_wcpl - self.minimax) <= 1e-9
+
+
+class _EpisodeRecorder(BaseCallback):
+    """Collects the ``info["episode"]`` rewards of the games played during ``learn``."""
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.rewards: list[float] = []
+
+    def _on_step(self) -> bool:
+        for info in self.locals.get("infos", ()):
+            if "episode" in info:
+                self.rewards.append(float(info["episode"]["r"]))
+        return True
+
+
+# ---------------------------------------------------------------------------- helpers
+
+
+def graph_summary(dag: GameDAG) -> dict:
+    """Size, ends, cost model and a fingerprint of the arrays (checked on resume)."""
+    digest = hashlib.sha256()
+    for arr in (dag.indptr, dag.targets, dag.costs, dag.sides):
+        digest.update(np.ascontiguousarray(arr).tobytes())
+    digest.update(f"{dag.start},{dag.end}".encode())
+    return {
+        "nodes": dag.n_nodes,
+        "edges": dag.n_edges,
+        "start": _plain(dag.node_ids[dag.start]),
+        "end": _plain(dag.node_ids[dag.end]),
+        "cost_model": dag.cost_model,
+        "fingerprint": digest.hexdigest()[:16],
+        "metadata": json.loads(json.dumps(dag.metadata, default=str)),
+    }
+
+
+def _plain(x):
+    return x.item() if hasattr(x, "item") else x
+
+
+def _phase_seed(seed: int, cycle: int, player: int) -> int:
+    return int(np.random.SeedSequence([seed, cycle, player]).generate_state(1)[0])
+
+
+def _algo_class(config: TrainConfig):
+    if config.algo == "maskable_ppo":
+        from sb3_contrib import MaskablePPO
+
+        return MaskablePPO
+    from stable_baselines3 import PPO
+
+    return PPO
+
+
+def _make_env(dag: GameDAG, player: int, config: TrainConfig, seed: int) -> VecEnv:
+    if config.vectorized:
+        return GameVecEnv(
+            dag,
+            AGENTS[player],
+            config.n_envs,
+            obs=config.obs,
+            reward=config.reward,
+            explore_starts=config.explore_starts,
+            seed=seed,
+        )
+
+    def factory() -> TurnEnv:
+        return TurnEnv(
+            dag,
+            AGENTS[player],
+            obs=config.obs,
+            reward=config.reward,
+            explore_starts=config.explore_starts,
+            opponent_deterministic=config.opponent_deterministic,
+        )
+
+    return DummyVecEnv([factory])
+
+
+def _make_model(config: TrainConfig, env: VecEnv, seed: int, tb: Path | None):
+    return _algo_class(config)(
+        "MlpPolicy",
+        env,
+        learning_rate=config.learning_rate,
+        n_steps=config.n_steps,
+        batch_size=config.batch_size,
+        n_epochs=config.n_epochs,
+        gamma=config.gamma,
+        gae_lambda=config.gae_lambda,
+        clip_range=config.clip_range,
+        ent_coef=config.ent_coef,
+        policy_kwargs={"net_arch": list(config.net_arch)},
+        tensorboard_log=None if tb is None else str(tb),
+        seed=seed,
+        device="cpu",
+        verbose=0,
+    )
+
+
+def _save_model(model, path: Path) -> None:
+    buffer = io.BytesIO()
+    model.save(buffer)
+    write_bytes(path, buffer.getvalue())
+
+
+def robot_reach(tables: GameTables, robot_policy: np.ndarray) -> np.ndarray:
+    """(n,) bool: nodes where the robot is on turn, with a move, in some state reachable
+    when it follows ``robot_policy`` against any human."""
+    n, targets = tables.n, tables.dag.targets
+    seen = np.zeros((n, 2), dtype=bool)
+    stack = [(tables.start, ROBOT)]
+    seen[tables.start, ROBOT] = True
+    while stack:
+        v, p = stack.pop()
+        if v == tables.end:
+            continue
+        count = tables.n_moves[p, v]
+        if count == 0:
+            heads = [v]
+        elif p == ROBOT:
+            heads = [int(targets[robot_policy[v]])]
+        else:
+            heads = targets[tables.moves[p, v, :count]].tolist()
+        for t in heads:
+            if not seen[t, 1 - p]:
+                seen[t, 1 - p] = True
+                stack.append((t, 1 - p))
+    return seen[:, ROBOT] & (tables.n_moves[ROBOT] > 0)
+
+
+def policy_hash(tables: GameTables, robot_policy: np.ndarray) -> str:
+    """Short digest of the robot's moves at the states it can reach (the stop rule's key)."""
+    reach = robot_reach(tables, robot_policy)
+    data = np.where(reach, robot_policy, -2).astype(np.int64).tobytes()
+    return hashlib.sha256(data).hexdigest()[:12]
+
+
+def should_stop(cycles: list[dict], config: TrainConfig) -> bool:
+    """The stop rule of ``config`` applied to the cycle log so far."""
+    w = config.window
+    if len(cycles) < max(w, config.min_cycles):
+        return False
+    last = cycles[-w:]
+    if config.stop == "policy":
+        keys = {(c["policy_hash"], c["wcpl"]) for c in last}
+        return len(keys) == 1
+    for key in ("robot_mean_reward", "human_mean_reward"):
+        values = [c[key] for c in last]
+        if any(v is None or not np.isfinite(v) for v in values):
+            if key == "human_mean_reward" and all(v is None for v in values):
+                continue  # the human never moves: only the robot's rewards count
+            return False
+        if max(values) - min(values) > config.tolerance:
+            return False
+    return True
+
+
+def _mean(values: list[float]) -> float | None:
+    return float(np.mean(values)) if values else None
+
+
+# ---------------------------------------------------------------------------- training
+
+
+def train(
+    dag: GameDAG,
+    config: str | TrainConfig = "paper",
+    seed: int = 0,
+    output: str | Path | None = None,
+    progress: bool = False,
+    resume: bool = False,
+    callback: CycleCallback | None = None,
+) -> TrainResult:
+    """Train a robust robot policy by alternating PPO against a learned adversarial human.
+
+    Parameters
+    ----------
+    dag : GameDAG
+        Any game DAG (synthetic, assembly-derived, ``steps`` or ``time`` costs).
+    config : "paper", "fast" or TrainConfig
+    seed : int
+        Seeds models, environments, numpy and torch.
+    output : path, optional
+        Run folder: ``robot.zip``, ``human.zip``, ``log.json``, ``tb/``, ``rewards.png``,
+        rewritten (atomically) after every cycle.
+    progress : bool
+        Show a tqdm bar of cycles.
+    resume : bool
+        Continue the run saved in ``output`` (same graph, seed and config but for
+        ``max_cycles``).
+    callback : callable, optional
+        ``callback(record) -> bool | None`` after each cycle; ``False`` stops training.
+
+    Returns
+    -------
+    TrainResult
+    """
+    cfg = get_config(config)
+    out = None if output is None else Path(output)
+    if resume and out is None:
+        raise ValueError("resume: expected an output folder to resume from")
+    tables = GameTables.from_dag(dag)
+    observer = Observer(dag, cfg.obs)
+    summary = graph_summary(dag)
+    minimax = solve(dag).minimax  # for the log only: training never reads it
+    learners = [p for p in (ROBOT, HUMAN) if tables.can_move_somewhere(p)]
+    tb = None if out is None else out / "tb"
+
+    envs = {p: _make_env(dag, p, cfg, seed + p) for p in learners}
+    models: dict[int, Any] = {}
+    cycles: list[dict] = []
+    rewards: dict[str, list[float]] = {"robot": [], "human": []}
+    wall_before = 0.0
+    if resume:
+        log = _load_log(out, summary, seed, cfg)
+        cycles, rewards, wall_before = log["cycles"], log["episode_rewards"], log["wall_s"]
+        for p in learners:
+            models[p] = _algo_class(cfg).load(
+                out / f"{AGENTS[p]}.zip", env=envs[p], device="cpu", tensorboard_log=tb
+            )
+    else:
+        for p in learners:
+            models[p] = _make_model(cfg, envs[p], seed + p, tb)
+
+    def greedy(p: int) -> np.ndarray:
+        if p not in models:
+            return np.full(tables.n, NO_MOVE, dtype=np.int64)
+        return greedy_policy(action_probabilities(models[p], tables, p, observer), tables, p)
+
+    def freeze_opponent(learner: int) -> None:
+        """Set the other side's current policy as the learner's frozen opponent."""
+        other = models.get(1 - learner)
+        env = envs[learner]
+        if isinstance(env, GameVecEnv):  # tabulated once: one forward pass over all nodes
+            table = None
+            if other is not None:
+                probs = action_probabilities(other, tables, 1 - learner, observer)
+                table = greedy_policy(probs, tables, 1 - learner)
+                table = table if cfg.opponent_deterministic else probs
+            env.set_opponent(table, cfg.opponent_epsilon)
+        else:  # the paper's: the frozen SB3 model is called at every opponent move
+            env.env_method("set_opponent", other)
+
+    def save_log(elapsed: float) -> None:
+        log = {
+            "format": "asmplan-arl-run",
+            "version": LOG_VERSION,
+            "seed": seed,
+            "config": cfg.to_dict(),
+            "graph": summary,
+            "minimax": minimax,
+            "converged": converged,
+            "wall_s": elapsed,
+            "cycles": cycles,
+            "robot_policy": robot_policy.tolist(),
+            "human_policy": human_policy.tolist(),
+            "episode_rewards": rewards,
+        }
+        write_text(out / "log.json", json.dumps(log, indent=1) + "\n")
+
+    robot_policy, human_policy = greedy(ROBOT), greedy(HUMAN)
+    converged = should_stop(cycles, cfg)
+    stopped = False
+    start = time.perf_counter()
+    bar = _progress(range(len(cycles), cfg.max_cycles), progress, len(cycles), cfg.max_cycles)
+    for cycle in bar:
+        if converged or stopped:
+            break
+        t0 = time.perf_counter()
+        means: dict[int, float | None] = {ROBOT: None, HUMAN: None}
+        counts = {ROBOT: 0, HUMAN: 0}
+        # Phase 1 trains the robot against the frozen human, phase 2 the reverse.
+        for learner in learners:
+            model = models[learner]
+            freeze_opponent(learner)
+            model.set_random_seed(_phase_seed(seed, cycle, learner))
+            model._last_obs = None  # fresh games, so that a resumed run repeats this phase
+            recorder = _EpisodeRecorder()
+            model.learn(
+                cfg.phase_steps,
+                callback=recorder,
+                reset_num_timesteps=False,
+                tb_log_name=AGENTS[learner],
+            )
+            rewards[AGENTS[learner]].extend(recorder.rewards)
+            means[learner], counts[learner] = _mean(recorder.rewards), len(recorder.rewards)
+
+        # Check: tabulate the greedy policies and score them exactly.
+        robot_policy, human_policy = greedy(ROBOT), greedy(HUMAN)
+        _, wcpl = play(dag, robot_policy, human_policy)
+        record = {
+            "cycle": cycle + 1,
+            "robot_mean_reward": means[ROBOT],
+            "human_mean_reward": means[HUMAN],
+            "wcpl": float(wcpl),
+            "certified_wcpl": certified_worst_case(dag, robot_policy),
+            "wall_s": time.perf_counter() - t0,
+            "elapsed_s": wall_before + time.perf_counter() - start,
+            "timesteps": int(sum(m.num_timesteps for m in models.values())),
+            "robot_episodes": counts[ROBOT],
+            "human_episodes": counts[HUMAN],
+            "policy_hash": policy_hash(tables, robot_policy),
+        }
+        cycles.append(record)
+        converged = should_stop(cycles, cfg)
+        if callback is not None and callback(record) is False:
+            stopped = True
+        if out is not None:
+            for p, model in models.items():
+                _save_model(model, out / f"{AGENTS[p]}.zip")
+            save_log(record["elapsed_s"])
+        if progress:
+            bar.set_postfix(wcpl=record["wcpl"], certified=record["certified_wcpl"])
+
+    _, wcpl = play(dag, robot_policy, human_policy)
+    result = TrainResult(
+        robot_policy=robot_policy,
+        human_policy=human_policy,
+        cycles=cycles,
+        episode_rewards=rewards,
+        wall_s=wall_before + time.perf_counter() - start,
+        converged=converged,
+        wcpl=float(wcpl),
+        certified_wcpl=certified_worst_case(dag, robot_policy),
+        minimax=minimax,
+        config=cfg,
+        seed=seed,
+        output=out,
+        models={AGENTS[p]: m for p, m in models.items()},
+    )
+    if out is not None:
+        save_log(result.wall_s)
+        from arl.plots import plot_rewards
+
+        plot_rewards(rewards, out / "rewards.png")
+    for env in envs.values():
+        env.close()
+    return result
+
+
+def _progress(iterable, enabled: bool, initial: int, total: int):
+    if not enabled:
+        return iterable
+    from tqdm.auto import tqdm
+
+    return tqdm(iterable, initial=initial, total=total, desc="cycles", unit="cycle")
+
+
+def read_log(output: str | Path) -> dict:
+    """The ``log.json`` of a run folder (``ValueError`` if missing or not a run log)."""
+    path = Path(output) / "log.json"
+    if not path.is_file():
+        raise ValueError(f"{output}: no log.json (not a training run folder)")
+    try:
+        log = json.loads(path.read_text(encoding="utf-8"))
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{path}: not valid JSON ({exc})") from None
+    if log.get("format") != "asmplan-arl-run":
+        raise ValueError(f"{path}: expected an asmplan-arl-run log")
+    return log
+
+
+def _load_log(out: Path, summary: dict, seed: int, cfg: TrainConfig) -> dict:
+    log = read_log(out)
+    if log["graph"]["fingerprint"] != summary["fingerprint"]:
+        raise ValueError(f"resume: {out} was trained on a different graph")
+    if log["seed"] != seed:
+        raise ValueError(f"resume: {out} was trained with seed {log['seed']}, not {seed}")
+    saved = TrainConfig.from_dict(log["config"])
+    if saved.replace(max_cycles=cfg.max_cycles) != cfg:
+        diff = [k for k, v in cfg.to_dict().items() if saved.to_dict()[k] != v]
+        raise ValueError(f"resume: config differs from the saved run in {', '.join(diff)}")
+    return log
+
+
+# ---------------------------------------------------------------------------- evaluation
+
+
+def load_policies(dag: GameDAG, model_dir: str | Path) -> tuple[np.ndarray, np.ndarray]:
+    """Greedy robot and human policies of a run folder, tabulated from its saved models.
+
+    Raises ``ValueError`` if the folder is not a run or was trained on another graph.
+    """
+    model_dir = Path(model_dir)
+    log = read_log(model_dir)
+    if log["graph"]["fingerprint"] != graph_summary(dag)["fingerprint"]:
+        raise ValueError(f"{model_dir} was trained on a different graph")
+    cfg = TrainConfig.from_dict(log["config"])
+    tables = GameTables.from_dag(dag)
+    observer = Observer(dag, cfg.obs)
+    policies = []
+    for p in (ROBOT, HUMAN):
+        path = model_dir / f"{AGENTS[p]}.zip"
+        if not tables.can_move_somewhere(p):
+            policies.append(np.full(tables.n, NO_MOVE, dtype=np.int64))
+            continue
+        if not path.is_file():
+            raise ValueError(f"{model_dir}: missing {path.name}")
+        model = _algo_class(cfg).load(path, device="cpu")
+        probs = action_probabilities(model, tables, p, observer)
+        policies.append(greedy_policy(probs, tables, p))
+    return policies[0], policies[1]
+
+
+def evaluate(
+    dag: GameDAG,
+    robot_policy_or_model_dir: np.ndarray | str | Path,
+    *,
+    human_policy: np.ndarray | None = None,
+    n_games: int = 1000,
+    seed: int = 0,
+) -> dict:
+    """All metrics of a learned robot policy (``asp.metrics.plan_metrics``) as a dict.
+
+    Parameters
+    ----------
+    dag : GameDAG
+    robot_policy_or_model_dir : (n,) edge indices, or a run folder of :func:`train`
+        For a run folder the greedy policies are tabulated from ``robot.zip`` and
+        ``human.zip``.
+    human_policy : (n,) edge indices, optional
+        The learned human (a run folder supplies its own); with it ``wcpl`` is the paper's
+        greedy-vs-greedy cost, without it the certified one.
+
+    Returns
+    -------
+    dict
+        ``tct, minimax, wcpl, certified_wcpl, avg_random, max_random, rr, rr_certified,
+        robust_optimal, ...`` (every :class:`asp.metrics.PlanMetrics` field) plus
+        ``robot_policy`` (edge indices).
+    """
+    from asp.metrics import plan_metrics
+
+    target = robot_policy_or_model_dir
+    if isinstance(target, str | Path):
+        robot_policy, human_policy = load_policies(dag, target)
+    else:
+        robot_policy = np.asarray(target, dtype=np.int64)
+    wcpl = None
+    if human_policy is not None:
+        _, wcpl = play(dag, robot_policy, np.asarray(human_policy, dtype=np.int64))
+    metrics = plan_metrics(dag, robot_policy=robot_policy, wcpl=wcpl, n_games=n_games, seed=seed)
+    out = metrics.to_dict()
+    out["robot_policy"] = robot_policy.tolist()
+    return out
