@@ -27,6 +27,7 @@ from typing import Any
 
 import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
+from stable_baselines3.common.logger import Logger
 from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv
 
 from arl.config import TrainConfig, get_config
@@ -317,6 +318,10 @@ def train(
     else:
         for p in learners:
             models[p] = _make_model(cfg, envs[p], seed + p, tb)
+    if tb is None:
+        # Without a log folder SB3 would make an empty /tmp/SB3-<time> folder per learn().
+        for model in models.values():
+            model.set_logger(Logger(folder=None, output_formats=[]))
 
     def greedy(p: int) -> np.ndarray:
         if p not in models:
