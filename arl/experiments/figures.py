@@ -22,6 +22,7 @@ from matplotlib.figure import Figure
 
 from arl.experiments.paper_values import paper_table3_row, paper_table4_row
 from arl.experiments.tasks import ResultRow
+from arl.plots import moving_average
 
 MOVING_AVERAGE = 50
 ROBOT_COLOR, HUMAN_COLOR = "tab:blue", "tab:orange"
@@ -49,17 +50,6 @@ def paper_row(row: ResultRow):
     if row.experiment == "table4":
         return paper_table4_row(row.trial)
     return paper_table3_row(row.layers, row.max_nodes) if row.trial == 1 else None
-
-
-def moving_average(values: Sequence[float], window: int = MOVING_AVERAGE) -> np.ndarray:
-    """Trailing moving average (shorter windows over the first ``window - 1`` values)."""
-    x = np.asarray(values, dtype=np.float64)
-    if x.size == 0:
-        return x
-    c = np.cumsum(np.insert(x, 0, 0.0))
-    idx = np.arange(1, x.size + 1)
-    lo = np.maximum(idx - window, 0)
-    return (c[idx] - c[lo]) / (idx - lo)
 
 
 def _png(fig: Figure) -> bytes:

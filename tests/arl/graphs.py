@@ -1,25 +1,7 @@
 """Small game DAGs for the arl tests."""
 
 from asp.dag import ANY, HUMAN, ROBOT, GameDAG, from_edges
-
-FIGURE4_EDGES = [
-    (1, 2),
-    (1, 3),
-    (2, 9),
-    (2, 6),
-    (6, 7),
-    (7, 8),
-    (8, 9),
-    (3, 4),
-    (3, 5),
-    (4, 9),
-    (5, 9),
-]
-
-
-def figure4() -> GameDAG:
-    """The paper's Figure 4: fast path 1-2-9, robust choice 3 (start 1, end 9), W* = 3."""
-    return from_edges(list(range(1, 10)), FIGURE4_EDGES, start=1, end=9)
+from tests.asp.figures import FIGURE4_EDGES, figure4  # noqa: F401  (re-exported)
 
 
 def sided_time_dag() -> GameDAG:
