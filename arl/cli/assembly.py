@@ -243,6 +243,7 @@ def plan_command(
         from asp.solve import play
 
         write_text(output / "plan.json", json.dumps(plan, indent=1) + "\n")
+        written = [output / "plan.json"]
         if dag.n_nodes <= MAX_PLOT_NODES:
             path, _ = play(dag, solution.robot_policy, solution.human_policy)
             edges = _path_edges(dag, path)
@@ -253,9 +254,10 @@ def plan_command(
                 title=f"{spec.name}: game DAG ({dag.cost_model}), robust plan in red, "
                 f"TCT {solution.tct:g}, W* {solution.minimax:g}",
             )
+            written.append(output / "dag.png")
         else:
             _progress(f"  dag.png skipped: {dag.n_nodes} nodes > {MAX_PLOT_NODES}")
-        typer.echo(f"wrote {output / 'plan.json'} and {output / 'dag.png'}")
+        typer.echo("wrote " + " and ".join(str(p) for p in written))
     _progress(f"done in {time.perf_counter() - t0:.1f} s")
 
 
