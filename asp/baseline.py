@@ -538,15 +538,25 @@ def assembly_schedule(spec, graph=None) -> AssemblySchedule:
     )
 
 
-def implied_predecessors(graph) -> list[int]:
-    """Per operation, the bitmask of operations done in every completable state where it is."""
-    keys = graph.keys[graph.coreachable()]
-    done = np.uint64(graph.model.done_mask)
+def implied_predecessors(graph, chunk: int = 1 << 20) -> list[int]:
+    """Per operation, the bitmask of operations done in every completable state where it is.
+
+    Works on the done-table of the live states in chunks of ``chunk`` states, so it needs
+    ``chunk x n_ops`` bytes whatever the key width.
+    """
+    n = graph.model.n_ops
+    live = np.flatnonzero(graph.coreachable())
+    # violated[b, a]: some live state has b done and a not done.
+    violated = np.zeros((n, n), dtype=bool)
+    present = np.zeros(n, dtype=bool)
+    for lo in range(0, live.size, chunk):
+        done = graph.model.done_matrix(graph.keys[live[lo : lo + chunk]]).astype(np.float32)
+        violated |= (done.T @ (1.0 - done)) > 0
+        present |= done.any(axis=0)
     out = []
-    for b in range(graph.model.n_ops):
-        with_b = keys[(keys >> np.uint64(b)) & np.uint64(1) == np.uint64(1)]
-        mask = int(np.bitwise_and.reduce(with_b & done)) if with_b.size else 0
-        out.append(mask & ~(1 << b))
+    for b in range(n):
+        after = np.flatnonzero(~violated[b]) if present[b] else np.empty(0, dtype=np.int64)
+        out.append(sum(1 << int(a) for a in after if a != b))
     return out
 
 

@@ -22,7 +22,8 @@ Everything is precomputed as per-part bitmasks over the spec's parts (bit ``j`` 
 ``S & contact != 0``, ``OR_d (S & blocked[d] == 0)`` and ``S & support != 0``.
 
 An assembly state packs the done operations (bit ``i`` = operation ``i``) and the tool
-values (a small field per tool above the operation bits) into one uint64 key.
+values (a small field per tool above the operation bits) into a key of ``W = ceil(bits / 64)``
+uint64 words (one word, the fast path, up to 64 bits; see :class:`OperationModel`).
 """
 
 from __future__ import annotations
@@ -34,8 +35,12 @@ import numpy as np
 
 from asp.spec import DIRECTIONS, AssemblySpec, tool_values
 
-MAX_BITS = 64
-"""Operations plus tool-state bits that fit the uint64 state key."""
+WORD_BITS = 64
+"""Bits per word of a state key (a state key is ``W`` uint64 words)."""
+MAX_PARTS = 64
+"""Parts that fit the uint64 assembled-part bitset of the insertion checks."""
+MAX_OPS = 32767
+"""Operations that fit the int16 operation index of the transitions."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -140,8 +145,8 @@ def insertion_oracle(spec: AssemblySpec, relations=None) -> InsertionOracle:
     """
     parts = spec.part_ids or tuple(dict.fromkeys(spec.placed_parts))
     n = len(parts)
-    if n > MAX_BITS:
-        raise ValueError(f"{spec.source}: parts: {n} parts, at most {MAX_BITS} are supported")
+    if n > MAX_PARTS:
+        raise ValueError(f"{spec.source}: parts: {n} parts, at most {MAX_PARTS} are supported")
     contact = np.zeros(n, dtype=np.uint64)
     blocked = np.zeros((n, 6), dtype=np.uint64)
     support = np.zeros(n, dtype=np.uint64)
@@ -203,26 +208,31 @@ def insertion_oracle(spec: AssemblySpec, relations=None) -> InsertionOracle:
 class OperationModel:
     """The spec compiled to bit operations: which operations are enabled in which states.
 
-    State key layout (uint64): bit ``i`` (``i < n_ops``) is operation ``i`` done; tool ``t``
-    keeps its value index (into ``tool_values[t]``) in ``tool_bits[t]`` bits at
-    ``tool_shift[t]``.
+    State key layout: ``W = n_words`` uint64 words, ``ceil(n_bits / 64)``; key bit ``b`` is
+    bit ``b % 64`` of word ``b // 64``. A set of ``k`` states is a ``(k, W)`` uint64 array (one
+    row per state); :meth:`pack` and :meth:`unpack` convert to and from Python ints. Bit ``i``
+    (``i < n_ops``) is operation ``i`` done; tool ``t`` keeps its value index (into
+    ``tool_values[t]``) in ``tool_bits[t]`` bits at key bit ``tool_shift[t]`` (a tool field
+    never straddles two words). With ``W == 1`` every method runs on the single word column.
 
     Attributes
     ----------
-    op_bits : (n_ops,) uint64
-        ``1 << i``.
-    pred_masks : (n_ops,) uint64
+    op_bits : (n_ops, W) uint64
+        Operation ``i``'s own bit.
+    pred_masks : (n_ops, W) uint64
         Explicit predecessors of each operation (zero when topological is off).
     op_parts : (n_ops,) uint64
         Parts each operation places.
-    requires_mask, requires_value : (n_ops,) uint64
+    requires_mask, requires_value : (n_ops, W) uint64
         Tool fields an operation reads and the values they must hold.
-    sets_mask, sets_value : (n_ops,) uint64
+    sets_mask, sets_value : (n_ops, W) uint64
         Tool fields an operation writes and the values it writes.
     start_key : int
         Nothing done, every tool at its initial value.
     initial_parts : int
         The base part when no operation places it (it is on the fixture from the start).
+    n_bits : int
+        Key bits used (operations, tool fields and the padding that keeps fields in one word).
     """
 
     spec: AssemblySpec
@@ -241,22 +251,85 @@ class OperationModel:
     tool_bits: tuple[int, ...]
     start_key: int
     initial_parts: int
+    n_bits: int
 
     @property
     def n_ops(self) -> int:
         return len(self.spec.operations)
 
     @property
+    def n_words(self) -> int:
+        """``W``: uint64 words per state key."""
+        return int(self.op_bits.shape[1])
+
+    @property
     def done_mask(self) -> int:
         return (1 << self.n_ops) - 1
 
+    # ------------------------------------------------------------------ keys
+    def pack(self, values) -> np.ndarray:
+        """(k, W) uint64 keys of the Python ints ``values``."""
+        rows = [_split(int(v), self.n_words) for v in values]
+        return np.array(rows, dtype=np.uint64).reshape(-1, self.n_words)
+
+    def unpack(self, key) -> int:
+        """The Python int of a key: a (W,) row of words, or already an int."""
+        if isinstance(key, int | np.integer):
+            return int(key)
+        return sum(int(w) << (WORD_BITS * k) for k, w in enumerate(np.asarray(key).reshape(-1)))
+
+    def _keys(self, keys) -> np.ndarray:
+        keys = np.asarray(keys, dtype=np.uint64)
+        if keys.ndim == 1:
+            if self.n_words != 1:
+                raise ValueError(f"expected (k, {self.n_words}) state keys, got {keys.shape}")
+            keys = keys[:, None]
+        if keys.ndim != 2 or keys.shape[1] != self.n_words:
+            raise ValueError(f"expected (k, {self.n_words}) state keys, got {keys.shape}")
+        return keys
+
+    def has_op(self, keys: np.ndarray, i: int) -> np.ndarray:
+        """(k,) bool: whether operation ``i`` is done in each state."""
+        keys = self._keys(keys)
+        word, bit = divmod(int(i), WORD_BITS)
+        return (keys[:, word] & np.uint64(1 << bit)) != np.uint64(0)
+
+    def done_matrix(self, keys: np.ndarray) -> np.ndarray:
+        """(k, n_ops) bool: which operations are done in each state."""
+        keys = self._keys(keys)
+        as_bytes = np.ascontiguousarray(keys).astype("<u8", copy=False).view(np.uint8)
+        bits = np.unpackbits(as_bytes, axis=1, bitorder="little")
+        return bits[:, : self.n_ops].astype(bool)
+
+    def is_complete(self, keys: np.ndarray) -> np.ndarray:
+        """(k,) bool: states with every operation done."""
+        keys = self._keys(keys)
+        ok = np.ones(keys.shape[0], dtype=bool)
+        for w, m in enumerate(_split(self.done_mask, self.n_words)):
+            if m:
+                ok &= (keys[:, w] & np.uint64(m)) == np.uint64(m)
+        return ok
+
+    def ready(self, keys: np.ndarray, i: int) -> np.ndarray:
+        """(k,) bool: operation ``i`` not done, its predecessors done and its tools ready."""
+        keys = self._keys(keys)
+        ok = ~self.has_op(keys, i)
+        for w in range(self.n_words):
+            pm, rm, rv = self.pred_masks[i, w], self.requires_mask[i, w], self.requires_value[i, w]
+            if pm:
+                ok &= (keys[:, w] & pm) == pm
+            if rm:
+                ok &= (keys[:, w] & rm) == rv
+        return ok
+
+    # ------------------------------------------------------------------ transitions
     def enabled(self, keys: np.ndarray, parts: np.ndarray) -> np.ndarray:
         """Which operations may be done next in each state.
 
         Parameters
         ----------
-        keys : (k,) uint64
-            State keys.
+        keys : (k, W) uint64
+            State keys (``(k,)`` is accepted when ``W == 1``).
         parts : (k,) uint64
             Assembled-part bitsets of those states.
 
@@ -264,80 +337,130 @@ class OperationModel:
         -------
         (k, n_ops) bool
         """
-        keys = np.asarray(keys, dtype=np.uint64)[:, None]
+        keys = self._keys(keys)
         zero = np.uint64(0)
-        ok = (keys & self.op_bits[None, :]) == zero
-        ok &= (keys & self.pred_masks[None, :]) == self.pred_masks[None, :]
-        if self.tool_names:
-            ok &= (keys & self.requires_mask[None, :]) == self.requires_value[None, :]
+        if self.n_words == 1:  # the fast path: one broadcast test per mask
+            col = keys[:, :1]
+            ok = (col & self.op_bits[:, 0]) == zero
+            pred = self.pred_masks[:, 0]
+            if pred.any():
+                ok &= (col & pred) == pred
+            if self.tool_names:
+                ok &= (col & self.requires_mask[:, 0]) == self.requires_value[:, 0]
+        else:
+            ok = np.empty((keys.shape[0], self.n_ops), dtype=bool)
+            for w in range(self.n_words):
+                lo, hi = w * WORD_BITS, min(self.n_ops, (w + 1) * WORD_BITS)
+                if lo < hi:
+                    ok[:, lo:hi] = (keys[:, w : w + 1] & self.op_bits[lo:hi, w]) == zero
+            checks = [(self.pred_masks, self.pred_masks)]
+            if self.tool_names:
+                checks.append((self.requires_mask, self.requires_value))
+            for w in range(self.n_words):
+                col = keys[:, w : w + 1]
+                for masks, values in checks:
+                    cols = np.flatnonzero(masks[:, w])
+                    if cols.size == 0:
+                        continue
+                    if cols.size == self.n_ops:
+                        ok &= (col & masks[:, w]) == values[:, w]
+                    else:
+                        ok[:, cols] &= (col & masks[cols, w]) == values[cols, w]
+        parts = np.asarray(parts, dtype=np.uint64)
         for i, plist in enumerate(self.part_lists):
             if not plist:
                 continue
-            col = ok[:, i]
-            rows = np.flatnonzero(col)
+            column = ok[:, i]
+            rows = np.flatnonzero(column)
             if rows.size == 0:
                 continue
-            s = np.asarray(parts, dtype=np.uint64)[rows]
+            s = parts[rows]
             good = np.ones(rows.size, dtype=bool)
             held = self.spec.operations[i].held
             for p in plist:
                 good &= self.oracle.feasible(p, s, held=held)
                 s = s | np.uint64(1 << p)
-            col[rows] = good
+            column[rows] = good
         return ok
 
     def successor_keys(self, keys: np.ndarray, ops: np.ndarray) -> np.ndarray:
-        """(k,) uint64: the state after doing operation ``ops[k]`` in state ``keys[k]``."""
-        keys = np.asarray(keys, dtype=np.uint64)
-        return (keys | self.op_bits[ops]) & ~self.sets_mask[ops] | self.sets_value[ops]
+        """(k, W) uint64: the state after doing operation ``ops[k]`` in state ``keys[k]``."""
+        keys = self._keys(keys)
+        ops = np.asarray(ops)
+        if self.n_words == 1:
+            out = keys[:, 0] | self.op_bits[ops, 0]
+            if self.tool_names:
+                out &= ~self.sets_mask[ops, 0]
+                out |= self.sets_value[ops, 0]
+            return out[:, None]
+        out = keys | self.op_bits[ops]
+        if self.tool_names:
+            out &= ~self.sets_mask[ops]
+            out |= self.sets_value[ops]
+        return out
 
     def tool_changes(self, keys: np.ndarray, ops: np.ndarray) -> np.ndarray:
         """(k, n_tools) bool: whether operation ``ops[k]`` changes each tool's value."""
-        keys = np.asarray(keys, dtype=np.uint64)
+        keys = self._keys(keys)
+        ops = np.asarray(ops)
         out = np.zeros((keys.shape[0], len(self.tool_names)), dtype=bool)
         for t, (shift, bits) in enumerate(zip(self.tool_shift, self.tool_bits, strict=True)):
-            field = np.uint64(((1 << bits) - 1) << shift)
-            writes = (self.sets_mask[ops] & field) != np.uint64(0)
-            out[:, t] = writes & ((keys & field) != (self.sets_value[ops] & field))
+            w, local = divmod(shift, WORD_BITS)
+            field = np.uint64(((1 << bits) - 1) << local)
+            writes = (self.sets_mask[ops, w] & field) != np.uint64(0)
+            out[:, t] = writes & ((keys[:, w] & field) != (self.sets_value[ops, w] & field))
         return out
 
-    def tool_state(self, key: int) -> dict[str, str]:
-        """Tool values of the state ``key``."""
+    def tool_state(self, key) -> dict[str, str]:
+        """Tool values of the state ``key`` (an int or a (W,) row)."""
+        key = self.unpack(key)
         return {
-            name: vals[(int(key) >> shift) & ((1 << bits) - 1)]
+            name: vals[(key >> shift) & ((1 << bits) - 1)]
             for name, vals, shift, bits in zip(
                 self.tool_names, self.tool_values, self.tool_shift, self.tool_bits, strict=True
             )
         }
 
-    def done_ops(self, key: int) -> list[str]:
-        """Ids of the operations done in the state ``key``, in spec order."""
-        key = int(key)
+    def done_ops(self, key) -> list[str]:
+        """Ids of the operations done in the state ``key`` (an int or a (W,) row), in order."""
+        key = self.unpack(key)
         return [op.id for i, op in enumerate(self.spec.operations) if key >> i & 1]
 
 
-def operation_model(spec: AssemblySpec, relations=None) -> OperationModel:
+def _split(value: int, n_words: int) -> list[int]:
+    """The ``n_words`` 64-bit words of ``value``, least significant first."""
+    mask = (1 << WORD_BITS) - 1
+    return [(value >> (WORD_BITS * k)) & mask for k in range(n_words)]
+
+
+def operation_model(spec: AssemblySpec, relations=None, *, _min_words: int = 1) -> OperationModel:
     """Compile ``spec`` (and the cad relations, if any) into an :class:`OperationModel`.
+
+    The state key takes as many 64-bit words as the operations and tool fields need
+    (``_min_words`` forces more, for tests of the multi-word path).
 
     Raises
     ------
     ValueError
-        More operations plus tool-state bits than fit a 64-bit state key.
+        More operations than the transition table's int16 operation index holds.
     """
     ops = spec.operations
     n_ops = len(ops)
+    if n_ops > MAX_OPS:
+        raise ValueError(
+            f"{spec.source}: operations: {n_ops} operations, at most {MAX_OPS:,} are supported; "
+            f"split the assembly into subassemblies"
+        )
     values = tool_values(spec)
     names = tuple(values)
     bits = tuple(max(1, math.ceil(math.log2(len(values[t])))) for t in names)
     shifts, pos = [], n_ops
     for b in bits:
+        if pos // WORD_BITS != (pos + b - 1) // WORD_BITS:  # keep each field in one word
+            pos = (pos // WORD_BITS + 1) * WORD_BITS
         shifts.append(pos)
         pos += b
-    if pos > MAX_BITS:
-        raise ValueError(
-            f"{spec.source}: operations: {n_ops} operations and {pos - n_ops} tool-state bits "
-            f"exceed the {MAX_BITS}-bit state key; split the assembly into subassemblies"
-        )
+    n_words = max(1, math.ceil(pos / WORD_BITS), int(_min_words))
     oracle = insertion_oracle(spec, relations)
     index = {op.id: i for i, op in enumerate(ops)}
     pidx = {p: k for k, p in enumerate(oracle.parts)}
@@ -359,24 +482,29 @@ def operation_model(spec: AssemblySpec, relations=None) -> OperationModel:
     initial_parts = 0
     if oracle.base >= 0 and spec.base_part not in placed:
         initial_parts = 1 << oracle.base
-    u64 = np.uint64
+
+    def table(ints: list[int]) -> np.ndarray:
+        rows = [_split(x, n_words) for x in ints]
+        return np.array(rows, dtype=np.uint64).reshape(len(ints), n_words)
+
     return OperationModel(
         spec=spec,
         oracle=oracle,
-        op_bits=np.array([1 << i for i in range(n_ops)], dtype=u64),
-        pred_masks=np.array(pred, dtype=u64),
-        op_parts=np.array([sum(1 << p for p in pl) for pl in part_lists], dtype=u64),
+        op_bits=table([1 << i for i in range(n_ops)]),
+        pred_masks=table(pred),
+        op_parts=np.array([sum(1 << p for p in pl) for pl in part_lists], dtype=np.uint64),
         part_lists=part_lists,
-        requires_mask=np.array(req_m, dtype=u64),
-        requires_value=np.array(req_v, dtype=u64),
-        sets_mask=np.array(set_m, dtype=u64),
-        sets_value=np.array(set_v, dtype=u64),
+        requires_mask=table(req_m),
+        requires_value=table(req_v),
+        sets_mask=table(set_m),
+        sets_value=table(set_v),
         tool_names=names,
         tool_values=tuple(values[t] for t in names),
         tool_shift=tuple(shifts),
         tool_bits=bits,
         start_key=0,
         initial_parts=initial_parts,
+        n_bits=pos,
     )
 
 

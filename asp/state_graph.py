@@ -1,22 +1,26 @@
 """The assembly state graph and the assembly sequence table (AST).
 
-A state is the set of operations done plus the tool values, packed into one uint64 key
-(:class:`asp.feasibility.OperationModel`). Starting from the empty assembly, the graph is
+A state is the set of operations done plus the tool values, packed into a key of
+``W = ceil(bits / 64)`` uint64 words (:class:`asp.feasibility.OperationModel`; ``W == 1``, up to
+64 operations and tool bits, is the fast path). Starting from the empty assembly, the graph is
 built breadth-first, one layer (states with ``k`` operations done) at a time: every state of
 the layer x every operation is tested at once with bit operations, the successor keys are
-computed the same way, and ``np.unique`` merges states reached in different orders.
+computed the same way, and sorting the keys (``np.unique`` on one word, ``np.lexsort`` on the
+words otherwise) merges states reached in different orders.
 
-States are numbered layer by layer (sorted by key within a layer), so every transition goes
-from a lower to a higher index. The number of complete sequences is counted exactly by
-dynamic programming over the layers, in modular arithmetic over a few 57-bit primes joined
-by the Chinese remainder theorem (the count never exceeds ``n_ops!``, which fixes how many
-primes are needed), so even astronomically large counts are exact Python ints.
+States are numbered layer by layer (sorted by key, as an integer, within a layer), so every
+transition goes from a layer to the next, from a lower to a higher index. The number of
+complete sequences is counted exactly by dynamic programming over the layers (two layers of
+counts in memory at a time), in modular arithmetic over a few primes of at most 57 bits
+joined by the Chinese remainder theorem (the count never exceeds ``n_ops!``, which fixes how
+many primes are needed), so even astronomically large counts are exact Python ints.
 """
 
 from __future__ import annotations
 
 import math
 import sys
+import time
 from dataclasses import dataclass
 
 import numpy as np
@@ -26,6 +30,8 @@ from asp.spec import AssemblySpec
 
 DEFAULT_MAX_STATES = 20_000_000
 """Above this many states the build stops with a ``ValueError``."""
+_CHUNK_CELLS = 1 << 25
+"""States x operations tested at once (bounds the enabled-table memory of a layer)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -36,8 +42,9 @@ class StateGraph:
     ----------
     model : OperationModel
         The compiled spec (key layout, enabled operations).
-    keys : (N,) uint64
-        State keys, layer by layer; state 0 is the start.
+    keys : (N, W) uint64
+        State keys (``W`` words each, see :class:`asp.feasibility.OperationModel`), layer by
+        layer; state 0 is the start.
     parts : (N,) uint64
         Assembled-part bitset of each state.
     layer_ptr : (L + 2,) int64
@@ -71,8 +78,11 @@ class StateGraph:
     @property
     def complete(self) -> np.ndarray:
         """(N,) bool: states with every operation done."""
-        mask = np.uint64(self.model.done_mask)
-        return (self.keys & mask) == mask
+        return self.model.is_complete(self.keys)
+
+    def key(self, state: int) -> int:
+        """The key of a state as a Python int (bit ``i`` = operation ``i`` done, then tools)."""
+        return self.model.unpack(self.keys[state])
 
     @property
     def indptr(self) -> np.ndarray:
@@ -91,9 +101,7 @@ class StateGraph:
             if lo == hi:
                 continue
             s, d = self.src[lo:hi], self.dst[lo:hi]
-            hit = np.zeros(self.n_states, dtype=bool)
-            hit[s[alive[d]]] = True
-            alive |= hit
+            alive[s[alive[d]]] = True  # sources are in the layer before their targets
         return alive
 
     def count_sequences(self) -> int:
@@ -101,33 +109,35 @@ class StateGraph:
         done = self.complete
         if not done.any():
             return 0
-        primes = _primes_for(self.model.n_ops)
+        n_ops = self.model.n_ops
+        primes = _primes_for(n_ops)
         mods = np.array(primes, dtype=np.uint64)
-        counts = np.zeros((self.n_states, len(primes)), dtype=np.uint64)
-        counts[0] = 1
-        bounds = np.searchsorted(self.src, self.layer_ptr)
-        for layer in range(len(self.layer_ptr) - 1):
+        ptr = self.layer_ptr
+        # Transitions only join consecutive layers: keep the counts of one layer at a time.
+        counts = np.ones((1, len(primes)), dtype=np.uint64)
+        bounds = np.searchsorted(self.src, ptr)
+        for layer in range(len(ptr) - 2):
             lo, hi = bounds[layer], bounds[layer + 1]
-            if lo == hi:
-                continue
-            d = self.dst[lo:hi]
-            order = np.argsort(d, kind="stable")
-            d_sorted = d[order]
-            vals = counts[self.src[lo:hi][order]]
-            starts = np.flatnonzero(np.r_[True, d_sorted[1:] != d_sorted[:-1]])
-            # Each term < 2**57 and at most 64 terms: the sum fits uint64.
-            sums = np.add.reduceat(vals, starts, axis=0) % mods
-            counts[d_sorted[starts]] = sums
-        total = np.zeros(len(primes), dtype=object)
-        for row in counts[done]:
-            total += row.astype(object)
-        residues = [int(r) % p for r, p in zip(total, primes, strict=True)]
+            nxt = np.zeros((int(ptr[layer + 2] - ptr[layer + 1]), len(primes)), dtype=np.uint64)
+            if lo < hi:
+                d = self.dst[lo:hi] - ptr[layer + 1]
+                order = np.argsort(d, kind="stable")
+                d_sorted = d[order]
+                vals = counts[self.src[lo:hi][order] - ptr[layer]]
+                starts = np.flatnonzero(np.r_[True, d_sorted[1:] != d_sorted[:-1]])
+                # Each term < p < 2**bits, at most n_ops terms: the sum fits uint64.
+                nxt[d_sorted[starts]] = np.add.reduceat(vals, starts, axis=0) % mods
+            counts = nxt
+        rows = counts[done[ptr[-2] : ptr[-1]]]  # complete states are all in the last layer
+        sums = rows.astype(object).sum(axis=0)
+        residues = [int(x) % p for x, p in zip(sums, primes, strict=True)]
         return _crt(residues, primes)
 
     def sequences(self, limit: int = 10) -> list[list[str]]:
         """Up to ``limit`` complete sequences (operation ids), in lexicographic operation order."""
         ids = self.spec.op_ids
         alive = self.coreachable()
+        complete = self.complete
         indptr = self.indptr
         out: list[list[str]] = []
         stack: list[tuple[int, list[int]]] = [(0, [])]
@@ -135,7 +145,7 @@ class StateGraph:
             v, seq = stack.pop()
             lo, hi = int(indptr[v]), int(indptr[v + 1])
             if lo == hi:
-                if self.complete[v]:
+                if complete[v]:
                     out.append([ids[i] for i in seq])
                 continue
             for e in range(hi - 1, lo - 1, -1):
@@ -146,7 +156,7 @@ class StateGraph:
 
     def label(self, state: int) -> str:
         """A readable description of a state: the done operations and the tool values."""
-        key = int(self.keys[state])
+        key = self.key(state)
         done = self.model.done_ops(key)
         text = "{" + " ".join(done) + "}" if done else "start"
         tools = self.model.tool_state(key)
@@ -173,58 +183,76 @@ def build_state_graph(
     model : OperationModel, optional
         A precompiled model (overrides ``relations``).
     max_states : int
-        Stop with a ``ValueError`` beyond this many states.
+        Stop with a one-line ``ValueError`` (states reached, layer, what to do) beyond this
+        many states; a layer sure to go over is not built at all.
     progress : bool
-        Print the layer sizes on stderr.
+        Print the key width and, per layer, the states, transitions and seconds on stderr.
     check : bool
         Raise a ``ValueError`` naming the parts that can never be inserted when no complete
         sequence exists.
     """
     model = operation_model(spec, relations) if model is None else model
-    keys = np.array([model.start_key], dtype=np.uint64)
+    n_ops, n_words = model.n_ops, model.n_words
+    index_type = np.int32 if max_states < 2**31 else np.int64
+    keys = model.pack([model.start_key])
     parts = np.array([model.initial_parts], dtype=np.uint64)
     key_layers, part_layers = [keys], [parts]
     src_l, dst_l, op_l = [], [], []
     offset, total = 0, 1
-    for layer in range(model.n_ops):
-        enabled = model.enabled(keys, parts)
-        si, oi = np.nonzero(enabled)
+    t0 = time.perf_counter()
+    if progress:
+        print(
+            f"state graph: {n_ops} operations, {model.n_bits} key bits in {n_words} word(s)",
+            file=sys.stderr,
+        )
+    chunk = max(1, _CHUNK_CELLS // max(1, n_ops))
+    for layer in range(n_ops):
+        si_l, oi_l = [], []
+        for lo in range(0, keys.shape[0], chunk):
+            si, oi = np.nonzero(model.enabled(keys[lo : lo + chunk], parts[lo : lo + chunk]))
+            si_l.append(si.astype(index_type) + index_type(lo))
+            oi_l.append(oi.astype(np.int16))
+        si = np.concatenate(si_l) if len(si_l) > 1 else si_l[0]
+        oi = np.concatenate(oi_l) if len(oi_l) > 1 else oi_l[0]
         if si.size == 0:
             break
-        new = model.successor_keys(keys[si], oi)
-        uniq, inv = np.unique(new, return_inverse=True)
-        inv = inv.reshape(-1)
+        # A state of layer l + 1 has at most l + 1 predecessors: stop before building a layer
+        # that is sure to go over the limit (its successor keys alone may not fit in memory).
+        at_least = total - (-si.size // (layer + 1))
+        if at_least > max_states:
+            raise _too_many(spec, max_states, f"at least {at_least:,}", layer, n_words)
+        uniq, inv = _unique_rows(model.successor_keys(keys[si], oi))
+        if total + uniq.shape[0] > max_states:
+            raise _too_many(spec, max_states, f"{total + uniq.shape[0]:,}", layer, n_words)
         new_parts = np.empty(uniq.shape[0], dtype=np.uint64)
         new_parts[inv] = parts[si] | model.op_parts[oi]
-        src_l.append((si + offset).astype(np.int32))
-        dst_l.append((inv + offset + keys.shape[0]).astype(np.int32))
-        op_l.append(oi.astype(np.int16))
+        del si_l, oi_l
+        n_new = int(si.size)
+        src_l.append(si + index_type(offset))
+        dst_l.append(inv.astype(index_type) + index_type(offset + keys.shape[0]))
+        op_l.append(oi)
+        del si, oi, inv
         offset += keys.shape[0]
         keys, parts = uniq, new_parts
         key_layers.append(keys)
         part_layers.append(parts)
         total += keys.shape[0]
-        if total > max_states:
-            raise ValueError(
-                f"{spec.source}: the state graph exceeds {max_states:,} states (layer {layer + 1})"
-            )
         if progress:
             print(
-                f"  layer {layer + 1}/{model.n_ops}: {keys.shape[0]:,} states, "
-                f"{si.size:,} transitions",
+                f"  layer {layer + 1}/{n_ops}: {keys.shape[0]:,} states, {n_new:,} "
+                f"transitions ({total:,} states so far, {time.perf_counter() - t0:.1f} s)",
                 file=sys.stderr,
             )
     layer_ptr = np.zeros(len(key_layers) + 1, dtype=np.int64)
     np.cumsum([k.shape[0] for k in key_layers], out=layer_ptr[1:])
-    empty32 = np.empty(0, dtype=np.int32)
     graph = StateGraph(
         model=model,
-        keys=np.concatenate(key_layers),
-        parts=np.concatenate(part_layers),
+        keys=_join(key_layers, np.uint64),
+        parts=_join(part_layers, np.uint64),
         layer_ptr=layer_ptr,
-        src=np.concatenate(src_l) if src_l else empty32,
-        dst=np.concatenate(dst_l) if dst_l else empty32,
-        op=np.concatenate(op_l) if op_l else np.empty(0, dtype=np.int16),
+        src=_join(src_l, index_type),
+        dst=_join(dst_l, index_type),
+        op=_join(op_l, np.int16),
     )
     if check and not graph.complete.any():
         raise ValueError(infeasibility_report(graph))
@@ -235,17 +263,12 @@ def infeasibility_report(graph: StateGraph) -> str:
     """One line naming the operations (and parts) that can never be done, and why."""
     model = graph.model
     spec = model.spec
-    ever = int(np.bitwise_or.reduce(graph.keys)) if graph.n_states else 0
+    ever = model.unpack(np.bitwise_or.reduce(graph.keys, axis=0)) if graph.n_states else 0
     never = [i for i in range(model.n_ops) if not ever >> i & 1]
     problems = []
-    zero = np.uint64(0)
     for i in never:
         op = spec.operations[i]
-        keys = graph.keys
-        ready = (keys & model.op_bits[i]) == zero
-        ready &= (keys & model.pred_masks[i]) == model.pred_masks[i]
-        ready &= (keys & model.requires_mask[i]) == model.requires_value[i]
-        rows = np.flatnonzero(ready)
+        rows = np.flatnonzero(model.ready(graph.keys, i))
         if not op.parts:
             if rows.size == 0:
                 problems.append(f"operation {op.id} never has its predecessors and tools ready")
@@ -270,9 +293,42 @@ def infeasibility_report(graph: StateGraph) -> str:
     return f"{spec.source}: infeasible assembly, no complete sequence: " + "; ".join(problems)
 
 
+def _join(layers: list[np.ndarray], dtype) -> np.ndarray:
+    """Concatenate the per-layer arrays and empty the list (one array's copy at a time)."""
+    out = np.concatenate(layers) if layers else np.empty(0, dtype=dtype)
+    layers.clear()
+    return out
+
+
+def _unique_rows(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Distinct rows of the (m, W) keys in increasing integer order, and each row's index."""
+    if keys.shape[1] == 1:
+        uniq, inv = np.unique(keys[:, 0], return_inverse=True)
+        return uniq[:, None], inv.reshape(-1)
+    order = np.lexsort(keys.T)  # the last word (most significant) is the primary key
+    ordered = keys[order]
+    first = np.empty(keys.shape[0], dtype=bool)
+    first[:1] = True
+    np.any(ordered[1:] != ordered[:-1], axis=1, out=first[1:])
+    inv = np.empty(keys.shape[0], dtype=np.int64)
+    inv[order] = np.cumsum(first) - 1
+    return ordered[first], inv
+
+
+def _too_many(spec: AssemblySpec, limit: int, reached: str, layer: int, n_words: int):
+    """The one-line error of a state graph over ``max_states``."""
+    n_ops = len(spec.operations)
+    return ValueError(
+        f"{spec.source}: the state graph exceeds the limit of {limit:,} states: {reached} "
+        f"states after layer {layer + 1} of {n_ops}; raise max_states if memory allows "
+        f"(the graph takes {8 * n_words + 8} bytes a state plus 10 a transition), or add "
+        f"precedences or split the assembly into subassemblies"
+    )
+
+
 # --------------------------------------------------------------------------- exact counting
 
-_PRIME_BITS = 57
+_MAX_PRIME_BITS = 57
 
 
 def _is_prime(n: int) -> bool:
@@ -298,19 +354,25 @@ def _is_prime(n: int) -> bool:
     return True
 
 
-_PRIMES: list[int] = []
+_PRIMES: dict[int, list[int]] = {}
 
 
 def _primes_for(n_ops: int) -> list[int]:
-    """Enough distinct primes below 2**57 that their product exceeds ``n_ops!``."""
+    """Enough distinct primes that their product exceeds ``n_ops!``.
+
+    The primes are below ``2**bits`` with ``n_ops * 2**bits <= 2**64``, so summing the counts
+    of a state's at most ``n_ops`` predecessors never overflows uint64.
+    """
+    bits = min(_MAX_PRIME_BITS, 64 - max(1, n_ops).bit_length())
     need = math.lgamma(n_ops + 1) / math.log(2) + 2
-    k = max(1, math.ceil(need / (_PRIME_BITS - 1)))
-    candidate = (1 << _PRIME_BITS) - 1 if not _PRIMES else _PRIMES[-1] - 2
-    while len(_PRIMES) < k:
+    k = max(1, math.ceil(need / (bits - 1)))
+    found = _PRIMES.setdefault(bits, [])
+    candidate = (1 << bits) - 1 if not found else found[-1] - 2
+    while len(found) < k:
         if _is_prime(candidate):
-            _PRIMES.append(candidate)
+            found.append(candidate)
         candidate -= 2
-    return _PRIMES[:k]
+    return found[:k]
 
 
 def _crt(residues: list[int], primes: list[int]) -> int:

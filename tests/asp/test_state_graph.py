@@ -230,14 +230,20 @@ def test_any_side_for_open_tasks():
     assert set(dag.agents) == {"any"}
 
 
-def test_too_many_operations():
-    with pytest.raises(ValueError, match="65 operations .* exceed the 64-bit state key"):
-        operation_model(precedence_spec(65, []))
+def test_more_than_64_operations_take_two_words():
+    model = operation_model(precedence_spec(65, [(k, k + 1) for k in range(64)]))
+    assert model.n_words == 2 and model.op_bits.shape == (65, 2)
+    graph = build_state_graph(precedence_spec(65, [(k, k + 1) for k in range(64)]))
+    assert graph.keys.shape == (66, 2) and graph.count_sequences() == 1
 
 
 def test_state_limit():
-    with pytest.raises(ValueError, match="exceeds 100 states"):
+    # 10 free operations: 1 + 10 + 45 = 56 states after layer 2, 176 after layer 3.
+    with pytest.raises(ValueError, match="exceeds the limit of 100 states") as info:
         build_state_graph(precedence_spec(10, []), max_states=100)
+    message = str(info.value)
+    assert "176 states after layer 3 of 10" in message and "raise max_states" in message
+    assert "\n" not in message
 
 
 def test_figure2_unfolding_one_state_per_set_of_done_operations():
