@@ -7,9 +7,14 @@ Along each axis, a face of i whose outward normal has a component of at least
 degrees of ``d``) along ``d`` is paired with a face of j whose normal has at least that
 component along ``-d``. If their projections along ``d`` overlap and somewhere on the
 overlap the gap between them, measured along the face normal (gap along ``d`` times the
-mean normal component), lies in ``[-penetration_tol, contact_tol]``, then j touches i on
-its ``d`` side: ``TC_d(i, j)`` and, by the same evidence, ``TC_-d(j, i)``. The range of
-the gap over the overlap polygon is exact (:func:`cad.projection.height_gap_range`).
+mean normal component), lies in ``[-tol(i, j), contact_tol]``, then j touches i on
+its ``d`` side: ``TC_d(i, j)`` and, by the same evidence, ``TC_-d(j, i)``. A negative gap
+(overlap) counts only where the two faces overlap with positive area; faces that merely meet
+along an edge count only within the contact tolerance, so a step or a hole continued in the
+next part at a slightly different depth is not taken for a sideways contact. Here
+``tol(i, j)`` is the pair's penetration tolerance, by default the sum of the two parts'
+shrinks (:mod:`cad.tolerances`). The range of the gap over the overlap polygon is exact
+(:func:`cad.projection.height_gap_range`).
 
 So a face contact on an axis-aligned plane gives exactly its axis direction; a face on an
 inclined plane gives every axis direction its normal leans towards by at least 0.25 (a
@@ -25,10 +30,9 @@ from __future__ import annotations
 import numpy as np
 
 from cad.assembly import Assembly
-from cad.faces import FaceSet, axis_face_sets, bounds_overlap, unit_normals
-from cad.freedom import part_diagonals
+from cad.faces import FaceSet, axis_face_sets, bounds_overlap, crop_pair, unit_normals
 from cad.progress import progress_bar
-from cad.projection import box_pair_chunks, height_gap_range
+from cad.projection import box_pair_chunks, height_gap_range, overlap_share
 from cad.tolerances import CONTACT_NORMAL_MIN, resolve_tolerances
 
 _CHUNK = 4096
@@ -50,9 +54,9 @@ def contact_relation(
     tol : float, optional
         Contact tolerance in mm: largest gap that still counts as touching (default
         :data:`cad.tolerances.DEFAULT_CONTACT_TOL_MM`, 0.01 mm).
-    penetration_tol : float, optional
-        Largest overlap in mm that counts as touching (default
-        :func:`cad.tolerances.default_penetration_tol`).
+    penetration_tol : float or Tolerances, optional
+        Largest overlap in mm that counts as touching, for every pair; default the
+        per-part rule of :mod:`cad.tolerances` (``s_i + s_j`` for the pair).
     progress : bool
         Show a progress bar over the pairs.
 
@@ -63,13 +67,13 @@ def contact_relation(
         the ``d`` side of i (order ``+x,-x,+y,-y,+z,-z``). ``tc[i, j, d] ==
         tc[j, i, d ^ 1]``; the diagonal is false.
     """
-    ctol, ptol = resolve_tolerances(part_diagonals(assembly), tol, penetration_tol)
+    tols = resolve_tolerances(assembly, tol, penetration_tol)
+    ctol = tols.contact
     n = len(assembly)
     tc = np.zeros((n, n, 6), dtype=bool)
     triangles = [np.asarray(p.mesh.triangles, dtype=float) for p in assembly.parts]
     normals = [unit_normals(t) for t in triangles]
     bounds = [p.bounds for p in assembly.parts]
-    reach = (ctol + ptol) / CONTACT_NORMAL_MIN
     pairs = [(a, b) for a in range(n) for b in range(n) if a != b]
     bar = progress_bar(progress, 3 * len(pairs), "contact")
     for axis in range(3):
@@ -79,7 +83,8 @@ def contact_relation(
         ]
         for a, b in pairs:
             bar.update(1)
-            if not bounds_overlap(bounds[a], bounds[b], pad=reach):
+            ptol = tols.pair(a, b)
+            if not bounds_overlap(bounds[a], bounds[b], pad=(ctol + ptol) / CONTACT_NORMAL_MIN):
                 continue
             if faces_touch(sets[a][0], sets[b][1], ctol, ptol):
                 tc[a, b, 2 * axis] = True
@@ -106,16 +111,44 @@ def faces_touch(front: FaceSet, back: FaceSet, contact_tol: float, penetration_t
     """
     lo = -penetration_tol / CONTACT_NORMAL_MIN
     hi = contact_tol / CONTACT_NORMAL_MIN
+    front, back = crop_pair(front, back, lo, hi)
     for ia, ib in box_pair_chunks(front.box, back.box):
         near = (back.hmin[ib] - front.hmax[ia] <= hi) & (back.hmax[ib] - front.hmin[ia] >= lo)
         ia, ib = ia[near], ib[near]
+        order = np.argsort(-overlap_share(front.box[ia], back.box[ib]), kind="stable")
+        ia, ib = ia[order], ib[order]
         for start in range(0, len(ia), _CHUNK):
             sa, sb = ia[start : start + _CHUNK], ib[start : start + _CHUNK]
-            overlap, gap_min, gap_max = height_gap_range(*front.take(sa), *back.take(sb))
+            p_uv, p_h = front.take(sa)
+            q_uv, q_h = back.take(sb)
+            overlap, gap_min, gap_max = height_gap_range(p_uv, p_h, q_uv, q_h)
             cosine = 0.5 * (front.nk[sa] - back.nk[sb])
-            hit = (
-                overlap & (gap_min * cosine <= contact_tol) & (gap_max * cosine >= -penetration_tol)
-            )
-            if np.any(hit):
+            lower, upper = gap_min * cosine, gap_max * cosine
+            # Touching within the contact tolerance: a shared face, edge or point.
+            if np.any(overlap & (lower <= contact_tol) & (upper >= -contact_tol)):
                 return True
+            # Overlapping up to the penetration tolerance counts only where the faces
+            # overlap with positive area: faces merely meeting along an edge at different
+            # depths (a step, a hole continued in the next part) are not a contact.
+            deep = overlap & (lower <= contact_tol) & (upper >= -penetration_tol)
+            if np.any(deep):
+                k = np.flatnonzero(deep)
+                inner, g_min, g_max = height_gap_range(
+                    _shrink(p_uv[k]), p_h[k], _shrink(q_uv[k]), q_h[k]
+                )
+                hit = inner & (g_min * cosine[k] <= contact_tol)
+                hit &= g_max * cosine[k] >= -penetration_tol
+                if np.any(hit):
+                    return True
     return False
+
+
+_AREA_SHRINK = 1e-4
+"""Projected triangles are scaled about their centroids by ``1 - _AREA_SHRINK`` to tell a
+shared area (still overlapping) from a shared edge or point (no longer overlapping)."""
+
+
+def _shrink(uv: np.ndarray) -> np.ndarray:
+    """Triangles ``(N, 3, 2)`` scaled slightly about their centroids."""
+    centre = uv.mean(axis=1, keepdims=True)
+    return centre + (uv - centre) * (1.0 - _AREA_SHRINK)

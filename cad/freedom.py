@@ -2,9 +2,11 @@
 
 Method (exact, no sampling of the motion)
 -----------------------------------------
-1. Tolerance by erosion. Every part is eroded by ``r = penetration_tol / 2``: each face
-   plane moves inwards by ``r`` (:mod:`cad.offset`). Two parts whose surfaces overlap by
-   at most ``penetration_tol`` are then disjoint, and a motion is *blocked* iff it drives
+1. Tolerance by erosion. Every part p is eroded by its shrink ``s_p``: each face plane
+   moves inwards by ``s_p`` (:mod:`cad.offset`). By default ``s_p`` follows the part's own
+   size and thickness (:mod:`cad.tolerances`); an explicit ``penetration_tol`` gives every
+   part ``penetration_tol / 2``. Two parts whose surfaces overlap by at most the pair's
+   tolerance ``s_i + s_j`` are then disjoint, and a motion is *blocked* iff it drives
    the eroded parts into each other. Sliding along a shared face (or one overlapping by a
    few hundredths) therefore stays free, moving into it is blocked, and a slide that
    drives deeper than the tolerance is blocked. The eroded parts must be disjoint in the
@@ -21,9 +23,11 @@ Method (exact, no sampling of the motion)
    :func:`cad.projection.height_gap_range` enumerates exactly. The test needs no step
    size and no sweep length: a plate of any thickness anywhere ahead is found (the path
    goes beyond the assembly's bounding box, i.e. to infinity for this test).
-3. Broad phase: part bounding boxes, then overlapping 2-D triangle boxes
-   (:func:`cad.projection.box_pair_chunks`); each ordered pair stops at the first blocking
-   triangle pair.
+3. Broad phase: part bounding boxes; then each face set is cut to the region the other
+   part's faces span (:func:`cad.faces.crop_pair`, linear); then overlapping 2-D triangle
+   boxes (:func:`cad.projection.box_pair_chunks`, brute force for small sets, an
+   anisotropic grid for large ones, about linear in faces plus overlapping pairs); each
+   ordered pair stops at the first blocking triangle pair.
 
 Relative motion makes the relation antisymmetric in direction: i moving along ``d``
 into j is j moving along ``-d`` into i, so ``TT_d(i, j) == TT_-d(j, i)`` for any shapes,
@@ -36,10 +40,10 @@ import numpy as np
 import trimesh
 
 from cad.assembly import Assembly
-from cad.faces import FaceSet, axis_face_sets, bounds_overlap, unit_normals
+from cad.faces import FaceSet, axis_face_sets, bounds_overlap, crop_pair, unit_normals
 from cad.offset import offset_vertices
 from cad.progress import progress_bar
-from cad.projection import box_pair_chunks, height_gap_range
+from cad.projection import box_pair_chunks, height_gap_range, overlap_share
 from cad.tolerances import resolve_tolerances
 
 _PARALLEL = 1e-9
@@ -52,11 +56,17 @@ def part_diagonals(assembly: Assembly) -> np.ndarray:
     return np.array([np.linalg.norm(np.ptp(p.bounds, axis=0)) for p in assembly.parts])
 
 
-def eroded_meshes(assembly: Assembly, depth: float) -> list[trimesh.Trimesh]:
-    """Every part with its faces moved inwards by ``depth`` mm (same topology)."""
+def eroded_meshes(assembly: Assembly, depth) -> list[trimesh.Trimesh]:
+    """Every part with its faces moved inwards by ``depth`` mm (same topology).
+
+    ``depth`` is one number for every part, or one per part (e.g. ``Tolerances.shrink``).
+    """
+    depths = np.broadcast_to(np.asarray(depth, dtype=float), (len(assembly),))
     return [
-        trimesh.Trimesh(vertices=offset_vertices(p.mesh, -depth), faces=p.mesh.faces, process=False)
-        for p in assembly.parts
+        trimesh.Trimesh(
+            vertices=offset_vertices(p.mesh, -float(d)), faces=p.mesh.faces, process=False
+        )
+        for p, d in zip(assembly.parts, depths, strict=True)
     ]
 
 
@@ -73,9 +83,9 @@ def translational_freedom(
     ----------
     assembly : Assembly
         ``n`` parts in assembled pose (mm).
-    penetration_tol : float, optional
-        Overlap depth in mm that still counts as touching (default
-        :func:`cad.tolerances.default_penetration_tol`).
+    penetration_tol : float or Tolerances, optional
+        Overlap depth in mm that still counts as touching, for every pair; default the
+        per-part rule of :mod:`cad.tolerances` (a pair tolerates ``s_i + s_j``).
     progress : bool
         Show a progress bar over the pairs.
     check : bool
@@ -93,10 +103,10 @@ def translational_freedom(
     ValueError
         Two parts interpenetrate deeper than the tolerance (when ``check``).
     """
-    _, ptol = resolve_tolerances(part_diagonals(assembly), None, penetration_tol)
-    eroded = eroded_meshes(assembly, ptol / 2.0)
+    tols = resolve_tolerances(assembly, None, penetration_tol)
+    eroded = eroded_meshes(assembly, tols.shrink)
     if check:
-        check_interpenetration(assembly, penetration_tol=ptol, eroded=eroded)
+        check_interpenetration(assembly, penetration_tol=tols, eroded=eroded)
     n = len(assembly)
     blocked = np.zeros((n, n, 6), dtype=bool)
     triangles = [np.asarray(m.triangles, dtype=float) for m in eroded]
@@ -140,11 +150,14 @@ def sweep_blocked(front: FaceSet, back: FaceSet) -> bool:
         True iff some pair has overlapping projections with the obstacle face at or ahead
         of the moving face somewhere on the overlap.
     """
+    front, back = crop_pair(front, back, 0.0, np.inf)
     for ia, ib in box_pair_chunks(front.box, back.box):
         ahead = back.hmax[ib] >= front.hmin[ia]
         ia, ib = ia[ahead], ib[ahead]
-        # likeliest blockers first: obstacle face wholly ahead of the moving face
-        order = np.argsort(front.hmax[ia] - back.hmin[ib], kind="stable")
+        # likeliest blockers first: obstacle face wholly ahead of the moving face, and
+        # boxes that overlap by a large share (long slivers crossing rarely overlap)
+        wholly = back.hmin[ib] >= front.hmax[ia]
+        order = np.argsort(-(overlap_share(front.box[ia], back.box[ib]) + wholly), kind="stable")
         ia, ib = ia[order], ib[order]
         for start in range(0, len(ia), _CHUNK):
             sa, sb = ia[start : start + _CHUNK], ib[start : start + _CHUNK]
@@ -186,22 +199,24 @@ def _intersect(a: trimesh.Trimesh, b: trimesh.Trimesh, obj_a=None, obj_b=None) -
 def check_interpenetration(
     assembly: Assembly,
     *,
-    penetration_tol: float | None = None,
+    penetration_tol=None,
     eroded: list[trimesh.Trimesh] | None = None,
 ) -> None:
-    """Raise if two parts overlap deeper than ``penetration_tol`` in the assembled pose.
+    """Raise if two parts overlap deeper than their tolerance in the assembled pose.
 
-    Parts eroded by half the tolerance must be disjoint (FCL triangle tests for crossing
-    surfaces, a point-in-mesh test for one part inside another).
+    Parts eroded by their shrinks (:mod:`cad.tolerances`; ``penetration_tol / 2`` each if
+    a number is given) must be disjoint (FCL triangle tests for crossing surfaces, a
+    point-in-mesh test for one part inside another).
 
     Raises
     ------
     ValueError
-        ``parts 'a' and 'b' interpenetrate by about X mm (tolerance Y mm)``.
+        One line: ``parts 'a' and 'b' interpenetrate by about X mm (penetration tolerance
+        of this pair Y mm)``.
     """
-    _, ptol = resolve_tolerances(part_diagonals(assembly), None, penetration_tol)
+    tols = resolve_tolerances(assembly, None, penetration_tol)
     if eroded is None:
-        eroded = eroded_meshes(assembly, ptol / 2.0)
+        eroded = eroded_meshes(assembly, tols.shrink)
     objects = [_collision_object(m) for m in eroded]
     bounds = [np.asarray(m.bounds) for m in eroded]
     n = len(assembly)
@@ -211,25 +226,26 @@ def check_interpenetration(
                 continue
             if _intersect(eroded[a], eroded[b], objects[a], objects[b]):
                 pa, pb = assembly.parts[a], assembly.parts[b]
+                ptol = tols.pair(a, b)
                 depth = _depth_estimate(pa.mesh, pb.mesh, ptol)
                 raise ValueError(
                     f"parts {pa.id!r} and {pb.id!r} interpenetrate by {depth} "
-                    f"(penetration tolerance {ptol:.3g} mm)"
+                    f"(penetration tolerance of this pair {ptol:.3g} mm)"
                 )
 
 
 def _depth_estimate(a: trimesh.Trimesh, b: trimesh.Trimesh, ptol: float) -> str:
-    """Overlap thickness: twice the largest erosion that leaves a and b intersecting."""
+    """Overlap thickness: twice the largest equal erosion that leaves a and b intersecting."""
     sizes = np.concatenate([np.ptp(a.bounds, axis=0), np.ptp(b.bounds, axis=0)])
-    lo, hi = ptol / 2.0, float(sizes.min()) / 4.0
+    lo, hi = 0.0, float(sizes.min()) / 4.0
 
     def still(depth: float) -> bool:
         ea = trimesh.Trimesh(offset_vertices(a, -depth), a.faces, process=False)
         eb = trimesh.Trimesh(offset_vertices(b, -depth), b.faces, process=False)
         return _intersect(ea, eb)
 
-    if hi <= lo or still(hi):
-        return f"at least {2 * max(hi, lo):.3g} mm"
+    if hi <= ptol / 2.0 or still(hi):
+        return f"at least {2 * max(hi, ptol / 2.0):.3g} mm"
     for _ in range(14):
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if still(mid) else (lo, mid)

@@ -10,7 +10,7 @@ import numpy as np
 from cad.assembly import Assembly
 from cad.contact import contact_relation
 from cad.directions import DIRECTIONS
-from cad.freedom import check_interpenetration, eroded_meshes, part_diagonals
+from cad.freedom import check_interpenetration, eroded_meshes
 from cad.freedom import translational_freedom as _freedom
 from cad.tolerances import resolve_tolerances
 
@@ -27,8 +27,13 @@ class Relations:
         Bool, shape ``(n, n, 6)``: ``tc[i, j, d]`` = ``TC_d(i, j)``.
     tt : np.ndarray
         Bool, shape ``(n, n, 6)``: ``tt[i, j, d]`` = ``TT_d(i, j)``.
-    contact_tol, penetration_tol : float
-        Tolerances used, in mm.
+    contact_tol : float
+        Contact tolerance used, in mm.
+    penetration_tol : float
+        Largest penetration tolerance of any pair, in mm (the explicit value if one was
+        given); pair ``(i, j)`` tolerates ``part_shrink[i] + part_shrink[j]``.
+    part_shrink : tuple[float, ...]
+        Shrink of each part in mm (:mod:`cad.tolerances`).
     units : str
         Source length unit of the assembly (tables do not depend on it).
     directions : tuple[str, ...]
@@ -41,6 +46,7 @@ class Relations:
     contact_tol: float = 0.0
     penetration_tol: float = 0.0
     units: str = "mm"
+    part_shrink: tuple[float, ...] = ()
     directions: tuple[str, ...] = DIRECTIONS
 
     def __post_init__(self) -> None:
@@ -73,6 +79,7 @@ class Relations:
             "source_units": self.units,
             "contact_tol_mm": self.contact_tol,
             "penetration_tol_mm": self.penetration_tol,
+            "part_shrink_mm": list(self.part_shrink),
             "tc": self.tc.tolist(),
             "tt": self.tt.tolist(),
         }
@@ -94,7 +101,9 @@ def compute_relations(
     contact_tol : float, optional
         Contact tolerance in mm (default 0.01 mm).
     penetration_tol : float, optional
-        Penetration tolerance in mm (default ``max(0.05, 0.001 x median part diagonal)``).
+        Penetration tolerance in mm for every pair. Default: per part, a shrink
+        ``s_p = min(max(0.025, 0.003 x diagonal), 0.25, 0.1 x thickness)`` mm, and pair
+        ``(i, j)`` tolerates ``s_i + s_j`` (:mod:`cad.tolerances`).
     progress : bool
         Show tqdm progress bars over the pairs.
 
@@ -108,17 +117,20 @@ def compute_relations(
     ValueError
         Two parts interpenetrate deeper than the penetration tolerance.
     """
-    ctol, ptol = resolve_tolerances(part_diagonals(assembly), contact_tol, penetration_tol)
-    check_interpenetration(assembly, penetration_tol=ptol, eroded=eroded_meshes(assembly, ptol / 2))
-    tc = contact_relation(assembly, ctol, penetration_tol=ptol, progress=progress)
-    tt = _freedom(assembly, penetration_tol=ptol, progress=progress, check=False)
+    tols = resolve_tolerances(assembly, contact_tol, penetration_tol)
+    check_interpenetration(
+        assembly, penetration_tol=tols, eroded=eroded_meshes(assembly, tols.shrink)
+    )
+    tc = contact_relation(assembly, penetration_tol=tols, progress=progress)
+    tt = _freedom(assembly, penetration_tol=tols, progress=progress, check=False)
     return Relations(
         parts=assembly.ids,
         tc=tc,
         tt=tt,
-        contact_tol=ctol,
-        penetration_tol=ptol,
+        contact_tol=tols.contact,
+        penetration_tol=tols.penetration,
         units=assembly.units,
+        part_shrink=tuple(float(x) for x in tols.shrink),
     )
 
 

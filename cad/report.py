@@ -16,7 +16,8 @@ def _dirs(relations: Relations, row) -> str:
 def _header(relations: Relations) -> str:
     return (
         f"{len(relations.parts)} parts, source units {relations.units}, tolerances in mm: "
-        f"contact {relations.contact_tol:.3g}, penetration {relations.penetration_tol:.3g}"
+        f"contact {relations.contact_tol:.3g}, penetration up to {relations.penetration_tol:.3g} "
+        "per pair"
     )
 
 

@@ -1,54 +1,179 @@
-"""Default tolerances, in millimetres, and how they follow the part size.
+"""Default tolerances, in millimetres, and how they follow the size of each part.
 
-- Contact tolerance: 0.01 mm. Two parts are in contact where their facing surfaces are
-  at most this far apart (or overlap by at most the penetration tolerance).
-- Penetration tolerance: ``max(0.05 mm, 0.001 x median part bounding-box diagonal)``,
-  so 0.05 mm for parts up to 50 mm, 0.1 mm for 100 mm parts, 0.3 mm for 300 mm parts.
-  This absorbs tessellation overlaps of exported CAD (a few hundredths of a millimetre)
-  and the interference of press fits in larger parts. An overlap no deeper than it counts
-  as touching; a deeper one in the assembled pose is an error.
+Contact tolerance
+-----------------
+0.01 mm (:data:`DEFAULT_CONTACT_TOL_MM`). Two parts are in contact where their facing
+surfaces are at most this far apart (or overlap by at most the penetration tolerance).
 
-Both are in millimetres whatever the source unit, because meshes are stored in mm; the same
-parts therefore give the same tables in any unit.
+Penetration tolerance: per-part shrink amounts, summed per pair
+---------------------------------------------------------------
+Every part ``p`` gets a *shrink* ``s_p``: its faces are moved inwards by ``s_p`` before
+the interference check and the sweep test (:mod:`cad.freedom`). Two parts whose surfaces
+overlap by at most ``s_i + s_j`` are then disjoint, so the penetration tolerance of a
+pair is the sum of the shrinks of its two parts::
+
+    s_p = min( max(0.025 mm, 0.003 x D_p),  0.25 mm,  0.1 x T_p )
+    tol(i, j) = s_i + s_j
+
+- ``D_p`` is the diagonal of the part's bounding box: big parts are exported with coarser
+  tessellation and drawn with bigger interferences, so their shrink grows with their size
+  (0.3 % of the diagonal), from a floor of 0.025 mm (a pair of small parts keeps the old
+  0.05 mm) to a cap of 0.25 mm (two big parts accept 0.5 mm, never more).
+- ``T_p`` is the part's thickness: the smallest extent of its bounding box and, for a
+  closed mesh, its mean wall thickness ``2 V / A`` (volume over half the surface area; a
+  sheet of thickness t gives about t, a round bar of radius r gives r). A part is never
+  shrunk by more than a tenth of it, so a thin sheet keeps 80 % of its thickness and
+  still blocks, and a small screw is not eroded away.
+
+What this accepts, with the default rule (pair tolerances of ordinary parts):
+
+==============================================  ==========================
+two 10 mm cubes                                  0.104 mm
+M8 bolt (D ~ 38 mm) in a 100 mm bracket          0.115 + 0.25 = 0.365 mm
+two 150 x 80 x 6 mm finger-jointed panels        0.25 + 0.25 = 0.5 mm
+spur gears of 44 and 64 mm (10 mm thick)         0.189 + 0.25 = 0.44 mm
+0.5 mm sheet against anything                    at most 0.05 mm from the sheet
+==============================================  ==========================
+
+so tessellation overlaps (hundredths), zero-clearance pins drawn at the hole diameter
+with another polygon, finger joints cut with kerf compensation and press fits interfering
+by two to four tenths pass as they come. An overlap no deeper than the pair's tolerance
+counts as touching; a deeper one in the assembled pose is a ValueError naming the pair and
+the depth. Features shallower than the tolerance do not block a slide either (a 0.2 mm
+ridge between two 100 mm parts is ignored), which is the price of accepting real exports.
+
+An explicit ``penetration_tol`` (``--penetration-tol``) replaces the rule: every part then
+shrinks by ``penetration_tol / 2`` and every pair has exactly that tolerance.
+
+Both tolerances are in millimetres whatever the source unit, because meshes are stored in
+mm; the same parts therefore give the same tables in any unit.
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
+import trimesh
 
 DEFAULT_CONTACT_TOL_MM = 0.01
 DEFAULT_PENETRATION_TOL_MM = 0.05
-PENETRATION_TOL_PER_SIZE = 1e-3
+"""Smallest default pair tolerance (two parts at the shrink floor)."""
+SHRINK_FLOOR_MM = 0.025
+"""Smallest default shrink of a part (before the thickness limit)."""
+SHRINK_PER_SIZE = 3e-3
+"""Default shrink per mm of the part's bounding-box diagonal."""
+SHRINK_CAP_MM = 0.25
+"""Largest default shrink of a part."""
+SHRINK_PER_THICKNESS = 0.1
+"""A part is never shrunk by more than this share of its thickness."""
+PENETRATION_TOL_PER_SIZE = SHRINK_PER_SIZE
+"""Kept for callers of the old name; see :data:`SHRINK_PER_SIZE`."""
 CONTACT_NORMAL_MIN = 0.25
 """A surface faces direction ``d`` for contact if its normal's component along ``d`` is at
 least this (normal within about 75.5 degrees of ``d``)."""
 
 
+def part_thickness(mesh: trimesh.Trimesh) -> float:
+    """Thickness of a part in mm: smallest bounding-box extent, and ``2 V / A`` if closed."""
+    extents = np.ptp(np.asarray(mesh.bounds, dtype=float), axis=0)
+    thickness = float(extents.min())
+    if mesh.is_watertight:
+        area = float(mesh.area)
+        volume = abs(float(mesh.volume))
+        if area > 0 and volume > 0:
+            thickness = min(thickness, 2.0 * volume / area)
+    return thickness
+
+
+def part_shrink(diagonal_mm: float, thickness_mm: float) -> float:
+    """Default shrink (mm) of a part with this bounding-box diagonal and thickness (mm)."""
+    by_size = min(max(SHRINK_FLOOR_MM, SHRINK_PER_SIZE * float(diagonal_mm)), SHRINK_CAP_MM)
+    return min(by_size, SHRINK_PER_THICKNESS * float(thickness_mm))
+
+
+def default_shrinks(meshes: list[trimesh.Trimesh]) -> np.ndarray:
+    """Default shrink of each mesh (mm), shape ``(n,)``."""
+    out = np.empty(len(meshes))
+    for k, mesh in enumerate(meshes):
+        diagonal = float(np.linalg.norm(np.ptp(np.asarray(mesh.bounds), axis=0)))
+        out[k] = part_shrink(diagonal, part_thickness(mesh))
+    return out
+
+
 def default_penetration_tol(diagonals_mm: np.ndarray) -> float:
-    """Penetration tolerance (mm) for parts with these bounding-box diagonals (mm)."""
+    """Default tolerance (mm) of a pair of two parts of the median diagonal (thick parts).
+
+    The tolerance actually used is per pair (:class:`Tolerances`); this is a summary.
+    """
     if len(diagonals_mm) == 0:
         return DEFAULT_PENETRATION_TOL_MM
-    return max(
-        DEFAULT_PENETRATION_TOL_MM, PENETRATION_TOL_PER_SIZE * float(np.median(diagonals_mm))
-    )
+    median = float(np.median(diagonals_mm))
+    return 2.0 * part_shrink(median, np.inf)
+
+
+@dataclass(frozen=True, eq=False)
+class Tolerances:
+    """Tolerances of one assembly, in mm.
+
+    Attributes
+    ----------
+    contact : float
+        Largest gap that counts as touching.
+    shrink : np.ndarray
+        Per-part shrink, shape ``(n,)``; the penetration tolerance of pair ``(i, j)`` is
+        ``shrink[i] + shrink[j]``.
+    explicit : bool
+        The penetration tolerance was given (every shrink is half of it).
+    """
+
+    contact: float
+    shrink: np.ndarray
+    explicit: bool = False
+
+    def pair(self, a: int, b: int) -> float:
+        """Penetration tolerance of parts ``a`` and ``b``."""
+        return float(self.shrink[a] + self.shrink[b])
+
+    @property
+    def penetration(self) -> float:
+        """Largest penetration tolerance of any pair (the explicit value if one was given)."""
+        if len(self.shrink) == 0:
+            return DEFAULT_PENETRATION_TOL_MM
+        top = np.sort(self.shrink)[-2:]
+        return float(top.sum() if len(top) == 2 else 2 * top[0])
 
 
 def resolve_tolerances(
-    diagonals_mm: np.ndarray, contact_tol: float | None, penetration_tol: float | None
-) -> tuple[float, float]:
-    """``(contact_tol, penetration_tol)`` in mm, defaults filled in and checked.
+    assembly, contact_tol: float | None = None, penetration_tol: float | None = None
+) -> Tolerances:
+    """Tolerances of ``assembly`` (a :class:`cad.Assembly` or a list of meshes, in mm).
+
+    ``penetration_tol`` None gives the per-part default rule of this module, a number the
+    same tolerance for every pair. A :class:`Tolerances` passed as ``penetration_tol`` is
+    returned as is (with ``contact_tol`` filled in if given).
 
     Raises
     ------
     ValueError
         A negative contact tolerance or a non-positive penetration tolerance.
     """
+    meshes = [p.mesh for p in assembly.parts] if hasattr(assembly, "parts") else list(assembly)
+    if isinstance(penetration_tol, Tolerances):
+        if contact_tol is None:
+            return penetration_tol
+        base = penetration_tol
+        penetration_tol, explicit_shrink = None, base.shrink
+    else:
+        explicit_shrink = None
     ctol = DEFAULT_CONTACT_TOL_MM if contact_tol is None else float(contact_tol)
-    ptol = (
-        default_penetration_tol(diagonals_mm) if penetration_tol is None else float(penetration_tol)
-    )
     if not np.isfinite(ctol) or ctol < 0:
         raise ValueError(f"contact tolerance must be >= 0 mm, got {contact_tol}")
+    if explicit_shrink is not None:
+        return Tolerances(ctol, explicit_shrink, base.explicit)
+    if penetration_tol is None:
+        return Tolerances(ctol, default_shrinks(meshes), False)
+    ptol = float(penetration_tol)
     if not np.isfinite(ptol) or ptol <= 0:
         raise ValueError(f"penetration tolerance must be > 0 mm, got {penetration_tol}")
-    return ctol, ptol
+    return Tolerances(ctol, np.full(len(meshes), ptol / 2.0), True)

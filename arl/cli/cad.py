@@ -21,7 +21,8 @@ def relations_command(
     penetration_tol: float | None = typer.Option(
         None,
         "--penetration-tol",
-        help="Penetration tolerance in mm (default max(0.05, 0.001 x median part diagonal)).",
+        help="Penetration tolerance in mm for every pair (default: per part, scaled with its "
+        "size and thickness, see cad/tolerances.py; a pair gets the sum, at most 0.5 mm).",
     ),
     units: str | None = typer.Option(
         None, "--units", help="Unit of mesh files that declare none (default mm)."

@@ -79,18 +79,25 @@ def test_thin_plate_blocks_at_any_distance(length):
 
 
 @pytest.mark.parametrize(
-    ("bump", "slides"),
-    [(0.03, True), (0.1, False)],
-    ids=["bump within tolerance", "bump deeper than tolerance"],
+    ("bump", "tol", "slides"),
+    [(0.03, None, True), (0.6, None, False), (0.03, 0.05, True), (0.1, 0.05, False)],
+    ids=[
+        "bump within default tolerance",
+        "bump deeper than default tolerance",
+        "bump within explicit tolerance",
+        "bump deeper than explicit tolerance",
+    ],
 )
-def test_slide_over_bump(bump, slides):
+def test_slide_over_bump(bump, tol, slides):
+    """Default pair tolerance here: ground 0.25 + slider 0.052 mm (cad.tolerances)."""
     ground = shapes.box_between((0, 0, 0), (100, 10, 10))
     ridge = shapes.box_between((60, 0, 9), (70, 10, 10 + bump))
     import trimesh
 
     ground = trimesh.boolean.union([ground, ridge], engine="manifold")
     slider = shapes.box_between((0, 0, 10), (10, 10, 20))
-    rel = compute_relations(Assembly.from_meshes({"ground": ground, "slider": slider}))
+    assembly = Assembly.from_meshes({"ground": ground, "slider": slider})
+    rel = compute_relations(assembly, penetration_tol=tol)
     assert bool(rel.tt[rel.index("slider"), rel.index("ground"), 0]) is slides
     assert rel.tt[rel.index("slider"), rel.index("ground"), 1]
 
@@ -186,8 +193,12 @@ def test_pin_drawn_at_hole_diameter_with_other_tessellation(hole_sections, peg_s
 
 
 def test_coarse_tessellation_overlap_beyond_tolerance_is_an_error():
+    """17-gon hole, 23-gon peg: 0.08 mm overlap, beyond an explicit 0.05 mm tolerance
+    (the default pair tolerance here, 0.17 + 0.054 mm, accepts it as a fit)."""
     block = shapes.box_between((-20, -20, 0), (20, 20, 10))
     plate = shapes.difference(block, shapes.cylinder(5, -1, 11, 17))
     peg = shapes.cylinder(5, 0, 15, 23)
+    assembly = Assembly.from_meshes({"plate": plate, "peg": peg})
     with pytest.raises(ValueError, match=r"'plate' and 'peg' interpenetrate by about 0\.08"):
-        compute_relations(Assembly.from_meshes({"plate": plate, "peg": peg}))
+        compute_relations(assembly, penetration_tol=0.05)
+    assert pair(compute_relations(assembly), "peg", "plate") == (SIDE, {"+z", "-z"})

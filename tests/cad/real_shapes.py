@@ -1,0 +1,265 @@
+"""Realistic assemblies built in code, as CAD exports them (sizes in mm).
+
+Each builder returns ``{part id: trimesh.Trimesh}`` in assembled pose and takes ``detail``,
+a multiplier on the number of segments of every curve (1 for the tests, larger for the
+benchmark's heavy parts). They carry what real exports carry:
+
+- :func:`finger_box`: a laser-cut box of 6 mm panels, cut with kerf compensation, so
+  every finger and tab interferes with its neighbour by 0.2 mm;
+- :func:`bearing_stack`: shaft, inner ring, outer ring, housing and a retaining collar,
+  concentric and drawn at the same diameters (zero clearance), each circle with another
+  number of segments;
+- :func:`bolted_bracket`: base plate, L-bracket, two bolts with hex heads, washers and
+  nuts, shafts drawn at the hole diameter;
+- :func:`gear_pair`: two involute spur gears meshing with 0.25 mm of extra tooth thickness
+  (negative backlash), on shafts standing in blind holes of a base plate.
+"""
+
+from __future__ import annotations
+
+import manifold3d
+import numpy as np
+import trimesh
+
+KERF = 0.2
+"""Interference of the finger-jointed box's fingers and tabs (mm)."""
+
+
+def box(lo, hi) -> trimesh.Trimesh:
+    """Axis-aligned box from corner ``lo`` to corner ``hi``."""
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    mesh = trimesh.creation.box(extents=hi - lo)
+    return mesh.apply_translation((lo + hi) / 2)
+
+
+def cylinder(radius, z0, z1, sections, xy=(0.0, 0.0)) -> trimesh.Trimesh:
+    """Cylinder along z from ``z0`` to ``z1`` around ``xy`` (a ``sections``-gon)."""
+    mesh = trimesh.creation.cylinder(radius=radius, height=z1 - z0, sections=int(sections))
+    return mesh.apply_translation((xy[0], xy[1], (z0 + z1) / 2))
+
+
+def union(*meshes: trimesh.Trimesh) -> trimesh.Trimesh:
+    return trimesh.boolean.union(list(meshes), engine="manifold")
+
+
+def difference(a: trimesh.Trimesh, *cutters: trimesh.Trimesh) -> trimesh.Trimesh:
+    return trimesh.boolean.difference([a, *cutters], engine="manifold")
+
+
+def annulus(r_in, r_out, z0, z1, n_in, n_out, xy=(0.0, 0.0)) -> trimesh.Trimesh:
+    """Ring along z; inner and outer circles with their own segment counts."""
+    return difference(cylinder(r_out, z0, z1, n_out, xy), cylinder(r_in, z0 - 1, z1 + 1, n_in, xy))
+
+
+def extrude(contours: list[np.ndarray], z0: float, z1: float) -> trimesh.Trimesh:
+    """Extrude closed 2-D contours (outer CCW, holes CW) from ``z0`` to ``z1``."""
+    section = manifold3d.CrossSection([np.asarray(c, dtype=float) for c in contours])
+    solid = manifold3d.Manifold.extrude(section, z1 - z0).translate((0.0, 0.0, z0))
+    mesh = solid.to_mesh()
+    return trimesh.Trimesh(
+        vertices=np.asarray(mesh.vert_properties)[:, :3], faces=np.asarray(mesh.tri_verts)
+    )
+
+
+def _seg(n: float, detail: float) -> int:
+    return max(3, int(round(n * detail)))
+
+
+# --------------------------------------------------------------------------- finger box
+
+BOX_L, BOX_W, BOX_H, PANEL = 120.0, 80.0, 60.0, 6.0
+FINGERS = 5  # vertical segments per corner, odd: front/back own the even ones
+
+
+def _corner_fingers(x0: float, y0: float, own_even: bool) -> list[trimesh.Trimesh]:
+    """Fingers in the corner column ``[x0, x0+t] x [y0, y0+t]`` between bottom and lid,
+    widened by KERF / 2 at every interior end (so mating fingers overlap by KERF)."""
+    edges = np.linspace(PANEL, BOX_H, FINGERS + 1)
+    out = []
+    for k in range(FINGERS):
+        if (k % 2 == 0) != own_even:
+            continue
+        z0 = edges[k] - (KERF / 2 if k > 0 else 0.0)
+        z1 = edges[k + 1] + (KERF / 2 if k < FINGERS - 1 else 0.0)
+        out.append(box((x0, y0, z0), (x0 + PANEL, y0 + PANEL, z1)))
+    return out
+
+
+def _tab_x(y0: float, z0: float, half: float) -> trimesh.Trimesh:
+    """Tab of a front/back wall (centred on x), KERF wider on each side than its notch."""
+    c = BOX_L / 2
+    return box((c - half - KERF, y0, z0), (c + half + KERF, y0 + PANEL, z0 + PANEL))
+
+
+def _tab_y(x0: float, z0: float, half: float) -> trimesh.Trimesh:
+    c = BOX_W / 2
+    return box((x0, c - half - KERF, z0), (x0 + PANEL, c + half + KERF, z0 + PANEL))
+
+
+def _panel_with_notches(z0: float) -> trimesh.Trimesh:
+    """Bottom (``z0 = 0``) or lid panel with an edge notch for each wall's tab."""
+    plate = box((0, 0, z0), (BOX_L, BOX_W, z0 + PANEL))
+    cx, cy, lo, hi = BOX_L / 2, BOX_W / 2, z0 - 1, z0 + PANEL + 1
+    notches = [
+        box((cx - 20, -1, lo), (cx + 20, PANEL, hi)),
+        box((cx - 20, BOX_W - PANEL, lo), (cx + 20, BOX_W + 1, hi)),
+        box((-1, cy - 15, lo), (PANEL, cy + 15, hi)),
+        box((BOX_L - PANEL, cy - 15, lo), (BOX_L + 1, cy + 15, hi)),
+    ]
+    return difference(plate, *notches)
+
+
+def finger_box(detail: float = 1.0) -> dict[str, trimesh.Trimesh]:
+    """Bottom, four walls and lid; walls finger-jointed at the corners and tabbed into
+    edge notches of bottom and lid; every joint interferes by :data:`KERF`."""
+    del detail  # flat panels: nothing to tessellate
+    t, top = PANEL, BOX_H
+    walls = {}
+    for name, y0 in (("front", 0.0), ("back", BOX_W - t)):
+        body = box((t, y0, t), (BOX_L - t, y0 + t, top))
+        walls[name] = union(
+            body,
+            *_corner_fingers(0.0, y0, True),
+            *_corner_fingers(BOX_L - t, y0, True),
+            _tab_x(y0, 0.0, 20),
+            _tab_x(y0, top, 20),
+        )
+    for name, x0 in (("left", 0.0), ("right", BOX_L - t)):
+        body = box((x0, t, t), (x0 + t, BOX_W - t, top))
+        walls[name] = union(
+            body,
+            *_corner_fingers(x0, 0.0, False),
+            *_corner_fingers(x0, BOX_W - t, False),
+            _tab_y(x0, 0.0, 15),
+            _tab_y(x0, top, 15),
+        )
+    return {"bottom": _panel_with_notches(0.0), **walls, "lid": _panel_with_notches(top)}
+
+
+# ------------------------------------------------------------------------ bearing stack
+
+
+def bearing_stack(detail: float = 1.0) -> dict[str, trimesh.Trimesh]:
+    """Shaft (r 10) through an inner ring (10-15) and outer ring (15-22) seated on the
+    shoulder of a housing bore (22 above z=8, 17 below), a collar (10-14) on the inner
+    ring. Every shared diameter is drawn twice with different segment counts."""
+    s = lambda n: _seg(n, detail)  # noqa: E731
+    housing = difference(
+        box((-40, -40, 0), (40, 40, 30)),
+        cylinder(22, 8, 31, s(72)),
+        cylinder(17, -1, 9, s(48)),
+    )
+    return {
+        "shaft": cylinder(10, -20, 60, s(96)),
+        "inner_ring": annulus(10, 15, 8, 20, s(64), s(80)),
+        "outer_ring": annulus(15, 22, 8, 20, s(128), s(100)),
+        "housing": housing,
+        "collar": annulus(10, 14, 20, 23, s(40), s(60)),
+    }
+
+
+# ---------------------------------------------------------------------- bolted bracket
+
+BOLT_R, HEAD_R, BOLT_XS = 4.0, 7.5, (-25.0, 25.0)
+
+
+def bolted_bracket(detail: float = 1.0) -> dict[str, trimesh.Trimesh]:
+    """Base plate (top at z=0), L-bracket on it (6 mm flanges), two M8 bolts through both
+    with hex heads on washers, washers and hex nuts underneath."""
+    s = lambda n: _seg(n, detail)  # noqa: E731
+    base = difference(
+        box((-50, -30, -10), (50, 30, 0)),
+        *(cylinder(BOLT_R, -11, 1, s(48), (x, 0)) for x in BOLT_XS),
+    )
+    bracket = difference(
+        union(box((-40, -25, 0), (40, 25, 6)), box((-40, 19, 0), (40, 25, 60))),
+        *(cylinder(BOLT_R, -1, 7, s(40), (x, 0)) for x in BOLT_XS),
+        *(
+            cylinder(3, -1, 1, s(36))
+            .apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, (1, 0, 0)))
+            .apply_translation((x, 22, 40))
+            for x in BOLT_XS
+        ),
+    )
+    parts = {"base": base, "bracket": bracket}
+    for k, x in enumerate(BOLT_XS, start=1):
+        parts[f"bolt_{k}"] = union(
+            cylinder(BOLT_R, -20, 7.6, s(32), (x, 0)), cylinder(HEAD_R, 7.6, 12.9, 6, (x, 0))
+        )
+        parts[f"washer_{k}"] = annulus(BOLT_R, 8, 6, 7.6, s(36), s(64), (x, 0))
+        parts[f"washer_{k}b"] = annulus(BOLT_R, 8, -11.6, -10, s(36), s(64), (x, 0))
+        parts[f"nut_{k}"] = annulus(BOLT_R, HEAD_R, -18.1, -11.6, s(24), 6, (x, 0))
+    return parts
+
+
+# ---------------------------------------------------------------------------- gear pair
+
+MODULE, TEETH_A, TEETH_B, PRESSURE = 2.0, 20, 30, np.radians(20.0)
+GEAR_INTERFERENCE = 0.25
+"""Extra tooth thickness at the pitch circle (mm): the teeth overlap by about this."""
+
+
+def _inv(angle):
+    return np.tan(angle) - angle
+
+
+def gear_outline(teeth: int, flank_points: int, phase: float = 0.0) -> np.ndarray:
+    """CCW outline of an involute spur gear (module :data:`MODULE`, 20 degrees, root
+    clearance 0.25 m) with tooth thickness ``pi m / 2 + GEAR_INTERFERENCE`` at the pitch
+    circle; a tooth is centred at angle ``phase``."""
+    r = MODULE * teeth / 2
+    rb, ra, rf = r * np.cos(PRESSURE), r + MODULE, r - 1.25 * MODULE
+    half_pitch = (np.pi * MODULE / 2 + GEAR_INTERFERENCE) / (2 * r)  # half tooth angle at r
+    radii = np.linspace(max(rb, rf), ra, flank_points)
+    half = half_pitch + _inv(PRESSURE) - _inv(np.arccos(np.clip(rb / radii, -1, 1)))
+    if rf < rb:  # radial flank below the base circle
+        radii = np.concatenate([[rf], radii])
+        half = np.concatenate([[half[0]], half])
+    step = 2 * np.pi / teeth
+    tip = max(2, flank_points // 4)
+    points = []
+    for k in range(teeth):
+        c = phase + k * step
+        rising = np.stack([radii, c - half], axis=1)  # root -> tip on the leading flank
+        tip_arc = np.stack([np.full(tip, ra), np.linspace(c - half[-1], c + half[-1], tip)], 1)
+        falling = np.stack([radii[::-1], c + half[::-1]], axis=1)
+        gap_start, gap_end = c + half[0], c + step - half[0]
+        root = np.stack([np.full(tip, rf), np.linspace(gap_start, gap_end, tip + 2)[1:-1]], 1)
+        points.append(np.concatenate([rising, tip_arc[1:-1], falling, root]))
+    polar = np.concatenate(points)
+    return np.stack([polar[:, 0] * np.cos(polar[:, 1]), polar[:, 0] * np.sin(polar[:, 1])], 1)
+
+
+def _gear(teeth, center, phase, flank_points, bore_sections) -> trimesh.Trimesh:
+    outline = gear_outline(teeth, flank_points, phase) + np.asarray(center)
+    angles = np.linspace(0, 2 * np.pi, bore_sections, endpoint=False)[::-1]  # CW hole
+    bore = np.stack([5 * np.cos(angles), 5 * np.sin(angles)], 1) + np.asarray(center)
+    return extrude([outline, bore], 0.0, 10.0)
+
+
+def gear_pair(detail: float = 1.0) -> dict[str, trimesh.Trimesh]:
+    """Gear ``gear_a`` (20 teeth, axis at the origin) meshing with ``gear_b`` (30 teeth,
+    axis at x = 50) in z 0..10, on shafts (r 5, z -6..25) in blind holes of a base plate
+    (top z = -2); a tooth of gear_a points at gear_b."""
+    s = lambda n: _seg(n, detail)  # noqa: E731
+    center_b = (MODULE * (TEETH_A + TEETH_B) / 2, 0.0)
+    plate = difference(
+        box((-30, -40, -12), (85, 40, -2)),
+        cylinder(5, -6, 0, s(40)),
+        cylinder(5, -6, 0, s(40), center_b),
+    )
+    return {
+        "plate": plate,
+        "shaft_a": cylinder(5, -6, 25, s(48)),
+        "shaft_b": cylinder(5, -6, 25, s(56), center_b),
+        "gear_a": _gear(TEETH_A, (0.0, 0.0), 0.0, s(8), s(36)),
+        "gear_b": _gear(TEETH_B, center_b, np.pi + np.pi / TEETH_B, s(8), s(44)),
+    }
+
+
+BUILDERS = {
+    "finger_box": finger_box,
+    "bearing_stack": bearing_stack,
+    "bolted_bracket": bolted_bracket,
+    "gear_pair": gear_pair,
+}
