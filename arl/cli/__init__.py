@@ -13,6 +13,7 @@ from arl.cli import core as _core  # noqa: F401, E402  isort: skip
 from arl.cli import cad as _cad  # noqa: F401, E402  isort: skip
 from arl.cli import assembly as _assembly  # noqa: F401, E402  isort: skip
 from arl.cli import train as _train  # noqa: F401, E402  isort: skip
+from arl.cli import play as _play  # noqa: F401, E402  isort: skip
 from arl.cli import experiment as _experiment  # noqa: F401, E402  isort: skip
 
 __all__ = ["app", "main"]

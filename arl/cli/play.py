@@ -1,0 +1,282 @@
+"""Command ``asmplan play``: a person plays one side of the game, turn by turn.
+
+The game logic is :class:`asp.play.GameSession`; this module only reads and prints. The
+person types a move number (``?`` help, ``q`` quit); end of input quits cleanly (exit 0).
+``--moves 2,1,3`` plays those numbers first (scripted demos and tests), then reads stdin.
+"""
+
+from __future__ import annotations
+
+import sys
+from enum import StrEnum
+from pathlib import Path
+
+import typer
+
+from arl.cli.app import app
+
+GRAPH_SUFFIXES = (".json", ".graphml", ".xml")
+
+HELP_TEXT = """\
+How to play
+  Type the number of a move and press Enter; '?' shows this help, 'q' quits.
+  The robot moves first; then the turns alternate. A side with no move it may do passes
+  at zero cost. The robot minimises the total cost, the human maximises it.
+  'worst' = the guaranteed worst-case total if that move is taken: the most the game can
+  still cost (cost so far included) when the robot plays its policy and the human delays
+  as much as possible. 'coop' = the total if both sides cooperate from there on."""
+
+
+class Side(StrEnum):
+    """The side the person plays."""
+
+    human = "human"
+    robot = "robot"
+
+
+class CostModel(StrEnum):
+    steps = "steps"
+    time = "time"
+
+
+def load_game(source: Path, cost: str | None = None):
+    """The game DAG of ``source`` and its operation descriptions.
+
+    ``source`` is a game DAG file (``.json``/``.graphml``) or an assembly (a folder with
+    ``assembly.yaml``, the YAML, or a ``.IN2``), loaded as ``asmplan solve`` / ``asmplan
+    plan`` load them.
+    """
+    if not source.exists():
+        raise FileNotFoundError(f"{source}: no such file or folder")
+    if source.is_file() and source.suffix.lower() in GRAPH_SUFFIXES:
+        from asp.io import load_dag
+
+        if cost is not None:
+            raise ValueError("--cost applies to assemblies only: a graph file has its costs")
+        return load_dag(source), {}
+    from arl.cli.assembly import _load
+    from asp.game import game_dag
+    from asp.state_graph import build_state_graph
+
+    spec, relations = _load(source, progress=False)
+    graph = build_state_graph(spec, relations)
+    dag = game_dag(graph, cost=cost)
+    return dag, {op.id: op.description for op in spec.operations}
+
+
+def _robot_policy(dag, robot: str):
+    """``robust``/``fast-greedy`` as they are; anything else is a run folder of ``train``."""
+    from asp.play import ROBOT_KINDS
+
+    if robot in ROBOT_KINDS:
+        return robot, robot
+    run = Path(robot)
+    if not run.is_dir():
+        raise ValueError(
+            f"--robot: expected {' or '.join(ROBOT_KINDS)} or a run folder of 'asmplan train', "
+            f"got {robot!r}"
+        )
+    from arl.trainer import load_policies
+
+    policy, _ = load_policies(dag, run)
+    return policy, f"trained ({run.name})"
+
+
+def _parse_moves(text: str | None) -> list[int]:
+    if not text:
+        return []
+    out = []
+    for item in text.split(","):
+        item = item.strip()
+        if not item.isdigit():
+            raise ValueError(f"--moves: expected comma-separated move numbers, got {item!r}")
+        out.append(int(item))
+    return out
+
+
+def _unit(dag) -> str:
+    return "" if dag.cost_model == "steps" else " s"
+
+
+def _state_lines(session, fmt) -> list[str]:
+    u = _unit(session.dag)
+    label = session.node_label
+    state = f"node {session.node_id}" + (f"  [{label}]" if label else "")
+    line = (
+        f"  cost so far {fmt(session.cost)}{u} | worst case remaining "
+        f"{fmt(session.worst_remaining)}{u} (total {fmt(session.cost + session.worst_remaining)})"
+        f" | cooperative best remaining {fmt(session.coop_remaining)}{u}"
+    )
+    out = [f"  state: {state}", line]
+    if abs(session.minimax_remaining - session.worst_remaining) > 1e-9:
+        out.append(f"  (W* from here: {fmt(session.minimax_remaining)}{u} remaining)")
+    return out
+
+
+def _moves_table(session, fmt) -> list[str]:
+    moves = session.moves()
+    width = max(len(m.label) for m in moves)
+    width = min(max(width, 4), 60)
+    head = f"    {'#':>3}  {'move':<{width}}  {'cost':>6}  {'to':>6}  {'worst':>7}  {'coop':>7}"
+    lines = [head]
+    for m in moves:
+        label = m.label if len(m.label) <= width else m.label[: width - 3] + "..."
+        lines.append(
+            f"    {m.number:>3}  {label:<{width}}  {fmt(m.cost):>6}  {str(m.target_id):>6}  "
+            f"{fmt(session.cost + m.worst_remaining):>7}  {fmt(session.cost + m.coop_remaining):>7}"
+        )
+    return lines
+
+
+def _turn_line(turn, fmt, person: int) -> str:
+    from asp.dag import HUMAN, ROBOT
+    from asp.play import side_name
+
+    who = side_name(turn.player)
+    if turn.passed:
+        return f"  {who} passes: {turn.reason}"
+    m = turn.move
+    name = m.label if (m.operation or m.agent) else "moves"
+    what = f"{name} -> node {m.target_id} [cost {fmt(m.cost)}]"
+    if turn.by == "person":
+        note = ""
+        delta = turn.worst_after - turn.worst_before
+        if person == HUMAN and delta < -1e-9:
+            note = f"  (that helps: the worst case drops to {fmt(turn.worst_after)})"
+        elif person == ROBOT and delta > 1e-9:
+            note = f"  (that raises the worst case to {fmt(turn.worst_after)}, +{fmt(delta)})"
+        return f"  you ({who}): {what}{note}"
+    return f"  {who}: {what}: {turn.reason}"
+
+
+def _read_line() -> str | None:
+    line = sys.stdin.readline()
+    return None if line == "" else line.strip()
+
+
+@app.command("play")
+def play_command(
+    source: Path = typer.Argument(
+        ..., help="Game DAG (.json/.graphml) or assembly (folder, assembly.yaml, .IN2)."
+    ),
+    side: Side = typer.Option(Side.human, "--as", help="The side you play: human or robot."),
+    robot: str = typer.Option(
+        "robust",
+        "--robot",
+        help="The computer robot when you play the human: robust, fast-greedy, or a run "
+        "folder of 'asmplan train'.",
+    ),
+    moves: str | None = typer.Option(
+        None, "--moves", help="Scripted move numbers, e.g. 2,1,3 (then reads stdin)."
+    ),
+    seed: int | None = typer.Option(
+        None, "--seed", help="Break the computer human's ties at random with this seed."
+    ),
+    cost: CostModel | None = typer.Option(
+        None, "--cost", help="Cost model of an assembly (default: the spec's)."
+    ),
+) -> None:
+    """Play against the robust plan: you take one side, the computer the other."""
+    from asp.dag import HUMAN, ROBOT
+    from asp.play import GameSession, fmt
+
+    script = _parse_moves(moves)
+    dag, descriptions = load_game(source, None if cost is None else cost.value)
+    person = HUMAN if side is Side.human else ROBOT
+    if person == ROBOT and robot != "robust":
+        raise ValueError("--robot applies when you play the human (--as human)")
+    policy, name = _robot_policy(dag, robot) if person == HUMAN else ("robust", "robust")
+    session = GameSession(
+        dag,
+        person=person,
+        robot=policy,
+        robot_name=name,
+        descriptions=descriptions,
+        seed=seed,
+    )
+    u = _unit(dag)
+    sol = session.solution
+    title = dag.metadata.get("assembly") or source.name
+    typer.echo(f"{title}: game DAG ({dag.cost_model}), {dag.n_nodes} nodes, {dag.n_edges} edges")
+    if person == HUMAN:
+        typer.echo(f"you play the HUMAN side (you maximise the cost) against the {name} robot")
+    else:
+        typer.echo("you play the ROBOT side (you minimise the cost) against a best-response human")
+    typer.echo(
+        f"TCT {fmt(sol.tct)}{u}, W* {fmt(sol.minimax)}{u}. Type a move number, "
+        "? for help, q to quit."
+    )
+    echo_input = not sys.stdin.isatty()
+
+    while not session.finished:
+        for turn in session.advance():
+            who = "robot" if turn.player == ROBOT else "human"
+            if turn.passed:
+                typer.echo(
+                    f"step {turn.step}: {who} at node {turn.node_id} has no move it may "
+                    "do: passes at zero cost"
+                )
+                continue
+            typer.echo(f"step {turn.step}: {who} to move")
+            for line in _state_lines_at(turn, session, fmt):
+                typer.echo(line)
+            typer.echo(_turn_line(turn, fmt, person))
+        if session.finished:
+            break
+        step = len(session.history) + 1
+        typer.echo(f"step {step}: your move ({'human' if person == HUMAN else 'robot'})")
+        for line in _state_lines(session, fmt) + _moves_table(session, fmt):
+            typer.echo(line)
+        n = len(session.moves())
+        while True:
+            prompt = f"your move [1-{n}, ? help, q quit]: "
+            if script:
+                choice = str(script.pop(0))
+                typer.echo(f"{prompt}{choice} (scripted)")
+                if not 1 <= int(choice) <= n:
+                    raise ValueError(f"--moves: move {choice} at step {step}: expected 1 to {n}")
+            else:
+                typer.echo(prompt, nl=False)
+                choice = _read_line()
+                if choice is None:
+                    typer.echo("")
+                    typer.echo("end of input: quitting")
+                    _finish(session)
+                    return
+                if echo_input:
+                    typer.echo(choice)
+            if choice.lower() in ("q", "quit", "exit"):
+                _finish(session)
+                return
+            if choice in ("?", "h", "help"):
+                typer.echo(HELP_TEXT)
+                continue
+            if choice.isdigit() and 1 <= int(choice) <= n:
+                break
+            typer.echo(f"  please type a number from 1 to {n}, ? for help or q to quit")
+        turn = session.play(int(choice))
+        typer.echo(_turn_line(turn, fmt, person))
+    if script:
+        typer.echo(f"({len(script)} scripted moves left unused: the game is over)")
+    _finish(session)
+
+
+def _state_lines_at(turn, session, fmt) -> list[str]:
+    """State lines for a past computer turn (the session has already moved on)."""
+    dag = session.dag
+    u = _unit(dag)
+    label = dag.node_labels[turn.node] if dag.node_labels is not None else ""
+    state = f"node {turn.node_id}" + (f"  [{label}]" if label else "")
+    remaining = turn.worst_before - turn.cost_before
+    coop = float(session.solution.coop[turn.node, turn.player])
+    return [
+        f"  state: {state}",
+        f"  cost so far {fmt(turn.cost_before)}{u} | worst case remaining {fmt(remaining)}{u} "
+        f"(total {fmt(turn.worst_before)}) | cooperative best remaining {fmt(coop)}{u}",
+    ]
+
+
+def _finish(session) -> None:
+    typer.echo("")
+    for line in session.summary().lines():
+        typer.echo(line)
