@@ -32,11 +32,14 @@ class BackendChoice(StrEnum):
     ray = "ray"
 
 
-experiment_app = typer.Typer(
-    help="Reproduce the paper's synthetic experiments (Tables 3-4, Figures 11-13).",
-    no_args_is_help=True,
-)
-app.add_typer(experiment_app, name="experiment")
+class TableChoice(StrEnum):
+    """Which of the paper's experiments to reproduce."""
+
+    table3 = "table3"
+    table4 = "table4"
+
+
+DEFAULT_TRIALS = {TableChoice.table3: 1, TableChoice.table4: 10}
 
 
 def _run(experiment: str, output: Path, trials: int, **options) -> None:
@@ -55,75 +58,48 @@ def _run(experiment: str, output: Path, trials: int, **options) -> None:
     )
 
 
-SOLVER = typer.Option(
-    SolverChoice.both, "--solver", help="exact minimax, ARL, or both (ARL with exact beside it)."
-)
-SEED = typer.Option(0, "--seed", help="Base seed; each task derives its own from it.")
-CONFIG = typer.Option(ConfigChoice.paper, "--config", help="ARL configuration.")
-BACKEND = typer.Option(BackendChoice.local, "--backend", help="local process pool or Ray.")
-ADDRESS = typer.Option(
-    "auto",
-    "--address",
-    help="Ray cluster: auto (started with `ray start`), host:port, or local (private instance).",
-)
-WORKERS = typer.Option(
-    None, "--workers", help="Parallel tasks (default: all cores; 1 runs in this process)."
-)
-GAMES = typer.Option(1000, "--games", help="Games of the random-human simulation.")
-CURVE_TRIAL = typer.Option(1, "--curve-trial", help="Trial whose ARL curves make Figure 11.")
-PROGRESS = typer.Option(True, "--progress/--no-progress", help="Show a progress bar.")
-
-
-@experiment_app.command("table3")
-def table3_command(
-    output: Path = typer.Option(Path("results/t3"), "--output", "-o", help="Output folder."),
-    trials: int = typer.Option(1, "--trials", help="Graphs per configuration."),
-    solver: SolverChoice = SOLVER,
-    seed: int = SEED,
-    config: ConfigChoice = CONFIG,
-    backend: BackendChoice = BACKEND,
-    address: str = ADDRESS,
-    workers: int | None = WORKERS,
-    games: int = GAMES,
-    curve_trial: int = CURVE_TRIAL,
-    progress: bool = PROGRESS,
+@app.command("experiment")
+def experiment_command(
+    table: TableChoice = typer.Argument(
+        ...,
+        help="table3: the six configurations 4/10, 10/4, 10/10, 15/10, 20/10, 20/20 (4 actions); "
+        "table4: the repeated experiment on 20/10 graphs.",
+    ),
+    output: Path | None = typer.Option(
+        None, "--output", "-o", help="Output folder (default results/t3 or results/t4)."
+    ),
+    trials: int | None = typer.Option(
+        None, "--trials", help="Graphs per configuration (default: 1 for table3, 10 for table4)."
+    ),
+    solver: SolverChoice = typer.Option(
+        SolverChoice.both,
+        "--solver",
+        help="exact minimax, ARL, or both (ARL with exact beside it).",
+    ),
+    seed: int = typer.Option(0, "--seed", help="Base seed; each task derives its own from it."),
+    config: ConfigChoice = typer.Option(ConfigChoice.paper, "--config", help="ARL configuration."),
+    backend: BackendChoice = typer.Option(
+        BackendChoice.local, "--backend", help="local process pool or Ray."
+    ),
+    address: str = typer.Option(
+        "auto",
+        "--address",
+        help="Ray cluster: auto (started with `ray start`), host:port, or local (a private one).",
+    ),
+    workers: int | None = typer.Option(
+        None, "--workers", help="Parallel tasks (default: all cores; 1 runs in this process)."
+    ),
+    games: int = typer.Option(1000, "--games", help="Games of the random-human simulation."),
+    curve_trial: int = typer.Option(
+        1, "--curve-trial", help="Trial whose ARL curves make Figure 11."
+    ),
+    progress: bool = typer.Option(True, "--progress/--no-progress", help="Show a progress bar."),
 ) -> None:
-    """Table 3: the six configurations 4/10, 10/4, 10/10, 15/10, 20/10, 20/20 (4 actions)."""
+    """Reproduce the paper's synthetic experiments (Tables 3-4, Figures 11-13)."""
     _run(
-        "table3",
-        output,
-        trials,
-        solver=solver.value,
-        seed=seed,
-        config=config.value,
-        backend=backend.value,
-        address=address,
-        workers=workers,
-        n_games=games,
-        curve_trial=curve_trial,
-        progress=progress,
-    )
-
-
-@experiment_app.command("table4")
-def table4_command(
-    output: Path = typer.Option(Path("results/t4"), "--output", "-o", help="Output folder."),
-    trials: int = typer.Option(10, "--trials", help="Number of 20/10 graphs."),
-    solver: SolverChoice = SOLVER,
-    seed: int = SEED,
-    config: ConfigChoice = CONFIG,
-    backend: BackendChoice = BACKEND,
-    address: str = ADDRESS,
-    workers: int | None = WORKERS,
-    games: int = GAMES,
-    curve_trial: int = CURVE_TRIAL,
-    progress: bool = PROGRESS,
-) -> None:
-    """Table 4: the repeated experiment on 20/10 graphs (ten by default, see --trials)."""
-    _run(
-        "table4",
-        output,
-        trials,
+        table.value,
+        output or Path("results") / ("t3" if table is TableChoice.table3 else "t4"),
+        DEFAULT_TRIALS[table] if trials is None else trials,
         solver=solver.value,
         seed=seed,
         config=config.value,
