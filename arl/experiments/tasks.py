@@ -20,7 +20,6 @@ from __future__ import annotations
 
 import os
 import platform
-import tempfile
 import time
 from contextlib import contextmanager
 from dataclasses import asdict, dataclass, fields
@@ -309,7 +308,7 @@ def run_task(spec: TaskSpec) -> TaskResult:
             rows.append(_row(spec, seeds, "exact", metrics, train_s=solve_s))
             continue
         train = require_trainer()
-        with one_torch_thread(), scratch_sb3_logdir():
+        with one_torch_thread():
             trained = train(dag, config=spec.config, seed=seeds.train)
         policy = np.asarray(trained.robot_policy, dtype=np.int64)
         metrics = plan_metrics(
@@ -357,26 +356,6 @@ def one_torch_thread():
         yield
     finally:
         torch.set_num_threads(previous)
-
-
-@contextmanager
-def scratch_sb3_logdir():
-    """Point SB3's logger at a scratch folder, removed afterwards.
-
-    Without a TensorBoard folder, every ``model.learn`` call makes an (empty)
-    ``$TMPDIR/SB3-<timestamp>`` folder unless ``SB3_LOGDIR`` is set; a sweep would leave
-    hundreds behind.
-    """
-    previous = os.environ.get("SB3_LOGDIR")
-    with tempfile.TemporaryDirectory(prefix="asmplan-sb3-") as scratch:
-        os.environ["SB3_LOGDIR"] = scratch
-        try:
-            yield
-        finally:
-            if previous is None:
-                os.environ.pop("SB3_LOGDIR", None)
-            else:
-                os.environ["SB3_LOGDIR"] = previous
 
 
 def _row(spec, seeds, solver, m, *, train_s, converged=None, cycles=None, timesteps=None):
