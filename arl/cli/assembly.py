@@ -52,6 +52,9 @@ def graph_command(
     fmt: OutputFormat = typer.Option(OutputFormat.json, "--format", help="Output format."),
     cost: CostModel | None = typer.Option(None, "--cost", help="Cost model (default: spec's)."),
     progress: bool = typer.Option(False, "--progress", help="Print progress on stderr."),
+    list_sequences: int = typer.Option(
+        0, "--list", min=0, help="Also list up to N feasible complete sequences (the AST)."
+    ),
 ) -> None:
     """Build the assembly state graph and the game DAG; print the sizes, write the DAG."""
     from asp.game import game_dag
@@ -78,6 +81,8 @@ def graph_command(
         "output": None if output is None else str(output),
         "wall_s": round(time.perf_counter() - t0, 3),
     }
+    if list_sequences:
+        result["sequence_table"] = graph.sequences(limit=list_sequences)
     if spec.credit:
         result["credit"] = spec.credit
     if fmt is OutputFormat.json:
@@ -91,6 +96,8 @@ def graph_command(
         f"game DAG ({dag.cost_model}): {dag.n_nodes:,} nodes, {dag.n_edges:,} edges"
         + ("" if output is None else f" -> {output}")
     )
+    for k, seq in enumerate(result.get("sequence_table", []), start=1):
+        typer.echo(f"  sequence {k}: " + " ".join(seq))
     if spec.credit:
         typer.echo(spec.credit)
 

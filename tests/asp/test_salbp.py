@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import pytest
 
 from asp.game import game_dag
@@ -77,3 +79,19 @@ def test_text_after_end_mark_is_ignored(tmp_path):
     path = tmp_path / "T.IN2"
     path.write_text("2\r\n3\r\n4\r\n1,2\r\n-1,-1\r\n\r\nSome source (1960)\r\n")
     assert read_in2(path).precedences == ((1, 2),)
+
+
+def test_cli_graph_lists_the_sequence_table(shared_data):
+    from typer.testing import CliRunner
+
+    from arl.cli import app
+
+    result = CliRunner().invoke(
+        app, ["graph", str(shared_data / "salbp" / "JACKSON.IN2"), "--list", "5"]
+    )
+    assert result.exit_code == 0, result.output
+    data = json.loads(result.output)
+    table = data["sequence_table"]
+    assert len(table) == 5 and len({tuple(s) for s in table}) == 5
+    assert all(sorted(s, key=int) == [str(i) for i in range(1, 12)] for s in table)
+    assert data["sequences"] == 756
