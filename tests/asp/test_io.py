@@ -90,3 +90,19 @@ def test_save_is_atomic_and_readable_json(tmp_path):
     data = json.loads(path.read_text())
     assert data == dag_to_dict(dag) | {"metadata": data["metadata"]}
     assert [p.name for p in path.parent.iterdir()] == ["g.json"]
+
+
+def test_large_graph_is_written_compactly_and_round_trips(tmp_path):
+    import numpy as np
+
+    from asp.dag import from_arrays
+    from asp.io import READABLE_EDGES
+
+    n = READABLE_EDGES // 2 + 2
+    src = np.concatenate([np.arange(n - 1), np.arange(n - 2)])
+    dst = np.concatenate([np.arange(1, n), np.arange(2, n)])
+    dag = from_arrays(list(range(n)), src, dst, start=0, end=n - 1)
+    assert dag.n_edges > READABLE_EDGES
+    path = save_dag(dag, tmp_path / "big.json")
+    assert path.read_text().count("\n") == 1  # one line: compact
+    _same(dag, load_dag(path))
