@@ -198,3 +198,17 @@ def test_non_watertight_part_warns():
     open_box.update_faces(np.arange(len(open_box.faces)) > 1)
     with pytest.warns(UserWarning, match="'open' .*not watertight"):
         Assembly.from_meshes({"open": open_box, "other": shapes.box((5, 5, 5), (20, 0, 0))})
+
+
+def test_step_scene_loads_in_millimetres_with_the_stacked_relations():
+    pytest.importorskip("cascadio")
+    assembly = load_assembly(Path(__file__).parent / "data" / "two_boxes.step")
+    assert len(assembly.parts) == 2
+    low, high = sorted(assembly.parts, key=lambda p: p.mesh.bounds[0][2])
+    assert np.allclose(low.mesh.extents, 10.0, atol=1e-3)
+    assert np.isclose(high.mesh.bounds[0][2], 10.0, atol=1e-3)
+    rel = compute_relations(assembly)
+    i, j = rel.parts.index(low.id), rel.parts.index(high.id)
+    # DIRECTIONS = +x -x +y -y +z -z: the high cube lies on the +z side of the low one
+    assert rel.tc[i, j].tolist() == [False, False, False, False, True, False]
+    assert rel.tt[j, i].tolist() == [True, True, True, True, True, False]
