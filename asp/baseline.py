@@ -352,6 +352,17 @@ def min_makespan(
     for ivs in by_agent.values():
         if len(ivs) > 1:
             model.add_no_overlap(ivs)
+    # Redundant: at most one task per agent at any time, all agents together, each task
+    # at least its shortest mode long. It gives the solver the pooled-work bound when tasks
+    # may go to several agents.
+    pooled_work = 0
+    if len(by_agent) > 1 and not problem.resources:
+        shortest = [
+            model.new_fixed_size_interval_var(start[i], min(dur[i]), f"min_{t.id}")
+            for i, t in enumerate(tasks)
+        ]
+        model.add_cumulative(shortest, [1] * len(tasks), len(by_agent))
+        pooled_work = -(-sum(min(d) for d in dur) // len(by_agent))
 
     # Constraints: precedence, end <= start.
     for a, b in problem.precedences:
@@ -368,7 +379,7 @@ def min_makespan(
     _tool_constraints(model, problem, start, end)
 
     # Objective: the makespan.
-    makespan = model.new_int_var(0, horizon, "makespan")
+    makespan = model.new_int_var(min(pooled_work, horizon), horizon, "makespan")
     model.add_max_equality(makespan, end)
     model.minimize(makespan)
 
@@ -474,7 +485,9 @@ class AssemblySchedule:
         Longest chain of (minimum) durations through the precedences implied by the state
         graph.
     load_bound : float
-        Largest total duration of the operations only one agent may do.
+        Largest total duration of the operations only one agent may do, or the total
+        work shared evenly over all agents, whichever is larger. An agent open to either
+        side (``side: any``, e.g. every ``.IN2`` task) counts as one worker of each side.
     """
 
     problem: ScheduleProblem
@@ -503,13 +516,19 @@ def assembly_schedule(spec, graph=None) -> AssemblySchedule:
         for b, mask in enumerate(implied_predecessors(graph)):
             pred[b] |= {a for a in range(n) if mask >> a & 1}
     change = {t.name: t.change_time for t in spec.tools}
+    either = {a.name for a in spec.agents if a.side == "any"}
     tasks = []
     for op in ops:
         extra = sum(change[t] for t, _ in op.sets)
+        # An agent open to either side stands for one worker of each side in parallel.
+        modes = []
+        for a, d in op.durations:
+            names = (f"{a}:human", f"{a}:robot") if a in either else (a,)
+            modes += [(name, d + extra) for name in names]
         tasks.append(
             Task(
                 id=op.id,
-                modes=tuple((a, d + extra) for a, d in op.durations),
+                modes=tuple(modes),
                 requires=op.requires,
                 sets=op.sets,
                 description=op.description,
@@ -527,14 +546,18 @@ def assembly_schedule(spec, graph=None) -> AssemblySchedule:
     finish = [0.0] * n
     for b in _topo(pred):
         finish[b] = shortest[b] + max((finish[a] for a in pred[b]), default=0.0)
+    # Load bounds: the work of an agent that alone may do its tasks, and all the work
+    # shared out evenly over every agent.
     load: dict[str, float] = {}
     for t in tasks:
         if len(t.modes) == 1:
             load[t.modes[0][0]] = load.get(t.modes[0][0], 0.0) + t.modes[0][1]
+    agents = {a for t in tasks for a, _ in t.modes}
+    shared = sum(shortest) / len(agents) if agents else 0.0
     return AssemblySchedule(
         problem=problem,
         chain_bound=max(finish, default=0.0),
-        load_bound=max(load.values(), default=0.0),
+        load_bound=max([shared, *load.values()]),
     )
 
 

@@ -158,3 +158,23 @@ def test_bad_solver_arguments():
         min_cost_path(dag, workers=0)
     with pytest.raises(ValueError, match="time_limit"):
         min_cost_path(dag, time_limit=0)
+
+
+@pytest.mark.parametrize(
+    ("times", "pairs", "makespan"),
+    [
+        ([1, 1, 1, 1], [], 2),  # four free tasks, one worker per side: two rounds
+        ([3, 1, 1, 1], [], 3),  # the long task on one side, the rest on the other
+        ([2, 2, 2], [(1, 2), (2, 3)], 6),  # a chain: parallel sides do not help
+        ([4, 1, 1, 2], [(1, 4), (2, 4), (3, 4)], 6),  # fork then join
+    ],
+)
+def test_in2_tasks_open_to_either_side_use_both_sides_in_parallel(tmp_path, times, pairs, makespan):
+    text = "\n".join([str(len(times)), *map(str, times), *(f"{a},{b}" for a, b in pairs)])
+    (tmp_path / "t.IN2").write_text(text + "\n-1,-1\n")
+    spec = load_spec(tmp_path / "t.IN2")
+    sched = assembly_schedule(spec, build_state_graph(spec))
+    result = min_makespan(sched.problem, time_limit=10, workers=1, seed=0)
+    assert result.status == "OPTIMAL" and result.objective == makespan
+    assert sched.lower_bound <= makespan
+    assert sched.load_bound == pytest.approx(sum(times) / 2)
