@@ -6,8 +6,9 @@ optional end mark ``-1,-1``; anything after the end mark is ignored.
 
 Each task becomes an operation open to either side: one agent ``any`` (side ``any``) whose
 duration is the task time. In the game either player may take it; in the CP-SAT schedule
-the ``any`` agent stands for one worker of each side working in parallel. Data: Scholl, A. (1993), *Data of Assembly Line Balancing
-Problems*, TH Darmstadt.
+the ``any`` agent stands for one worker of each side working in parallel.
+
+Data: Scholl, A. (1993), *Data of Assembly Line Balancing Problems*, TH Darmstadt.
 """
 
 from __future__ import annotations
