@@ -124,3 +124,15 @@ def test_trains_on_an_in2_assembly_with_time_costs(shared_data):
     assert len(result.cycles) == TINY.max_cycles
     assert result.certified_wcpl >= result.minimax
     assert evaluate(dag, result.robot_policy)["certified_wcpl"] == result.certified_wcpl
+
+
+def test_policy_stop_rule_waits_for_min_cycles_and_a_stable_window():
+    from arl.trainer import should_stop
+
+    cfg = get_config("fast")
+    stable = [{"policy_hash": "a", "wcpl": 5.0}] * (cfg.min_cycles - 1)
+    assert cfg.min_cycles > cfg.window
+    assert not should_stop(stable, cfg)  # stable for longer than the window, too early
+    assert should_stop([*stable, {"policy_hash": "a", "wcpl": 5.0}], cfg)
+    changed = [*stable, {"policy_hash": "a", "wcpl": 6.0}]
+    assert not should_stop(changed, cfg)  # the greedy-vs-greedy cost moved
