@@ -20,3 +20,17 @@ FIGURE4_EDGES = [
 def figure4() -> GameDAG:
     """The paper's Figure 4: fast path 1-2-9, robust choice 3 (start 1, end 9)."""
     return from_edges(list(range(1, 10)), FIGURE4_EDGES, start=1, end=9)
+
+
+SOLVE_KEYS = (
+    "nodes",
+    "edges",
+    "tct",
+    "minimax",
+    "robust_path",
+    "avg_random",
+    "max_random",
+    "rr",
+    "adversarial_tax",
+)
+"""The keys issue 2 requires of ``asmplan solve --format json``."""

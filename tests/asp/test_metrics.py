@@ -11,7 +11,7 @@ from asp.metrics import (
 )
 from asp.solve import as_policy_array, solve
 from asp.synth import synthetic_dag
-from tests.asp.figures import figure4
+from tests.asp.figures import SOLVE_KEYS, figure4
 
 
 def test_figure4_fast_policy_distribution_is_exact():
@@ -54,17 +54,7 @@ def test_simulation_is_seeded():
 def test_metrics_keys_and_bad_game_count():
     dag = figure4()
     keys = plan_metrics(dag).to_dict().keys()
-    for key in (
-        "nodes",
-        "edges",
-        "tct",
-        "minimax",
-        "robust_path",
-        "avg_random",
-        "max_random",
-        "rr",
-        "adversarial_tax",
-    ):
+    for key in SOLVE_KEYS:
         assert key in keys
     with pytest.raises(ValueError, match="n_games"):
         simulate_random_human(dag, solve(dag).robot_policy, n_games=0)
