@@ -378,8 +378,8 @@ def _row(spec, seeds, solver, m, *, train_s, converged=None, cycles=None, timest
         robust_optimal=m.robust_optimal,
         max_random=m.max_random,
         avg_random=m.avg_random,
-        rr=_fraction(m.rr),
-        rr_certified=_fraction(m.rr_certified),
+        rr=m.rr,
+        rr_certified=m.rr_certified,
         max_random_sampled=m.max_random_sampled,
         avg_random_sampled=m.avg_random_sampled,
         rr_sampled=m.rr_sampled,
@@ -389,8 +389,3 @@ def _row(spec, seeds, solver, m, *, train_s, converged=None, cycles=None, timest
         timesteps=timesteps,
         train_s=float(train_s),
     )
-
-
-def _fraction(x: float) -> float:
-    """Round a probability to 12 digits: an exact share summed in floating point."""
-    return round(float(x), 12)
