@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import networkx as nx
 import numpy as np
@@ -87,10 +88,12 @@ class GameDAG:
     def n_edges(self) -> int:
         return int(self.targets.shape[0])
 
-    @property
+    @cached_property
     def sources(self) -> np.ndarray:
-        """(m,) int64: tail node index of each edge."""
-        return np.repeat(np.arange(self.n_nodes, dtype=np.int64), np.diff(self.indptr))
+        """(m,) int64, read-only: tail node index of each edge (computed once)."""
+        src = np.repeat(np.arange(self.n_nodes, dtype=np.int64), np.diff(self.indptr))
+        src.flags.writeable = False
+        return src
 
     def out_edges(self, v: int) -> range:
         """Edge indices leaving node ``v``."""
@@ -103,7 +106,7 @@ class GameDAG:
 
     def index_of(self, node_id) -> int:
         """Index of the node whose original id is ``node_id`` (also accepts its str form)."""
-        lookup = self._lookup()
+        lookup = self._lookup
         if node_id in lookup:
             return lookup[node_id]
         key = str(node_id)
@@ -111,15 +114,14 @@ class GameDAG:
             return lookup[key]
         raise ValueError(f"unknown node {node_id!r}")
 
+    @cached_property
     def _lookup(self) -> dict:
-        cached = self.__dict__.get("_lookup_cache")
-        if cached is None:
-            cached = {}
-            for i, nid in enumerate(self.node_ids):
-                cached[nid] = i
-                cached.setdefault(str(nid), i)
-            object.__setattr__(self, "_lookup_cache", cached)
-        return cached
+        """Node id (and its str form) -> index, built on first use."""
+        lookup: dict = {}
+        for i, nid in enumerate(self.node_ids):
+            lookup[nid] = i
+            lookup.setdefault(str(nid), i)
+        return lookup
 
     def edge_label(self, e: int) -> str:
         """A short description of edge ``e``: operation and agent where known."""
@@ -315,7 +317,6 @@ def topological_order(dag: GameDAG) -> np.ndarray:
     """
     n = dag.n_nodes
     indeg = np.bincount(dag.targets, minlength=n).astype(np.int64)
-    src = dag.sources
     frontier = np.flatnonzero(indeg == 0)
     out = [frontier]
     seen = frontier.size
@@ -329,7 +330,7 @@ def topological_order(dag: GameDAG) -> np.ndarray:
         seen += frontier.size
         out.append(frontier)
     if seen != n:
-        raise ValueError(f"graph has a cycle: {_cycle_text(dag, src)}")
+        raise ValueError(f"graph has a cycle: {_cycle_text(dag, dag.sources)}")
     return np.concatenate(out).astype(np.int64)
 
 
