@@ -19,7 +19,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # run from a checkout
 
-from arl.experiments.runner import run_experiment  # noqa: E402
+from asmplan.experiments.runner import run_experiment  # noqa: E402
 
 
 def main() -> None:

@@ -7,7 +7,7 @@ import pytest
 import torch
 
 from arl import evaluate, get_config, train
-from arl.cli.app import main
+from asmplan.cli.app import main
 from asp.io import save_dag
 from asp.solve import solve
 from tests.arl.graphs import figure4, sided_time_dag
@@ -94,7 +94,7 @@ def test_paper_config_runs_one_cycle_and_callback_stops():
 
 
 def test_cli_train_and_evaluate(tmp_path, capsys):
-    import arl.cli.train  # noqa: F401  registers the commands
+    import asmplan.cli.train  # noqa: F401  registers the commands
 
     graph = save_dag(figure4(), tmp_path / "g.json")
     run = tmp_path / "run"

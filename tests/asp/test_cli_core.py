@@ -14,7 +14,7 @@ REQUIRED = SOLVE_KEYS
 
 def run(*args):
     return subprocess.run(
-        [sys.executable, "-c", "from arl.cli import main; main()", *args],
+        [sys.executable, "-c", "from asmplan.cli import main; main()", *args],
         capture_output=True,
         text=True,
         timeout=120,

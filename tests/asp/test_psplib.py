@@ -8,8 +8,8 @@ import json
 import pytest
 from typer.testing import CliRunner
 
-import arl.cli.assembly  # noqa: F401  registers the commands
-from arl.cli.app import app
+import asmplan.cli.assembly  # noqa: F401  registers the commands
+from asmplan.cli.app import app
 from asp.baseline import min_makespan
 from asp.psplib import read_sm
 

@@ -84,7 +84,7 @@ def test_text_after_end_mark_is_ignored(tmp_path):
 def test_cli_graph_lists_the_sequence_table(shared_data):
     from typer.testing import CliRunner
 
-    from arl.cli import app
+    from asmplan.cli import app
 
     result = CliRunner().invoke(
         app, ["graph", str(shared_data / "salbp" / "JACKSON.IN2"), "--list", "5"]

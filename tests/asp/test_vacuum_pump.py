@@ -8,8 +8,8 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-import arl.cli.assembly  # noqa: F401  registers the commands
-from arl.cli.app import app, main
+import asmplan.cli.assembly  # noqa: F401  registers the commands
+from asmplan.cli.app import app, main
 from asp.baseline import assembly_schedule, min_cost_path, min_makespan
 from asp.feasibility import load_relations
 from asp.game import game_dag

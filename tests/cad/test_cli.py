@@ -7,8 +7,8 @@ import json
 import pytest
 from typer.testing import CliRunner
 
-import arl.cli.cad  # noqa: F401  registers the command
-from arl.cli.app import app, main
+import asmplan.cli.cad  # noqa: F401  registers the command
+from asmplan.cli.app import app, main
 from tests.cad import shapes
 from tests.cad.test_loading import write_folder
 

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from arl.cli.app import app, fail
+from asmplan.cli.app import app, fail
 
 
 class SolverChoice(StrEnum):
@@ -43,7 +43,7 @@ DEFAULT_TRIALS = {TableChoice.table3: 1, TableChoice.table4: 10}
 
 
 def _run(experiment: str, output: Path, trials: int, **options) -> None:
-    from arl.experiments.runner import TasksFailed, run_experiment
+    from asmplan.experiments.runner import TasksFailed, run_experiment
 
     try:
         report = run_experiment(experiment, output, trials=trials, **options)

@@ -1,6 +1,6 @@
 """``results.csv`` and ``results.md``: the rows of a sweep as tables.
 
-The CSV holds every field of :class:`~arl.experiments.tasks.ResultRow`. The Markdown table
+The CSV holds every field of :class:`~asmplan.experiments.tasks.ResultRow`. The Markdown table
 starts with the paper's columns in the paper's order (Table 3: configuration, TCT, WCPL,
 max and average random length, RR; Table 4: trial, total nodes, TCT, WCPL, average random
 length, RR), then the columns this project adds.
@@ -13,7 +13,7 @@ import io
 from collections.abc import Callable, Sequence
 from dataclasses import asdict
 
-from arl.experiments.tasks import ResultRow
+from asmplan.experiments.tasks import ResultRow
 
 Column = tuple[str, Callable[[ResultRow], str]]
 

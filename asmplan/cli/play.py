@@ -13,7 +13,7 @@ from pathlib import Path
 
 import typer
 
-from arl.cli.app import app
+from asmplan.cli.app import app
 
 GRAPH_SUFFIXES = (".json", ".graphml", ".xml")
 
@@ -54,7 +54,7 @@ def load_game(source: Path, cost: str | None = None):
         if cost is not None:
             raise ValueError("--cost applies to assemblies only: a graph file has its costs")
         return load_dag(source), {}
-    from arl.cli.assembly import _load
+    from asmplan.cli.assembly import _load
     from asp.game import game_dag
     from asp.state_graph import build_state_graph
 

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import typer
 
-from arl.cli.app import OutputFormat, app
+from asmplan.cli.app import OutputFormat, app
 
 EVALUATE_KEYS = (
     "nodes",

@@ -24,15 +24,15 @@ from pathlib import Path
 
 from tqdm import tqdm
 
-from arl.experiments.backends import make_backend
-from arl.experiments.figures import (
+from asmplan.experiments.backends import make_backend
+from asmplan.experiments.figures import (
     figure11_training,
     figure12_resilience,
     figure13_path_lengths,
 )
-from arl.experiments.summary import RunInfo, summary_markdown
-from arl.experiments.tables import results_csv, results_markdown
-from arl.experiments.tasks import (
+from asmplan.experiments.summary import RunInfo, summary_markdown
+from asmplan.experiments.tables import results_csv, results_markdown
+from asmplan.experiments.tasks import (
     ResultRow,
     Solver,
     TaskResult,
@@ -129,7 +129,7 @@ def run_experiment(
     config : str
         ARL configuration, ``"paper"`` or ``"fast"``.
     backend, address, workers
-        Where tasks run (:func:`arl.experiments.backends.make_backend`).
+        Where tasks run (:func:`asmplan.experiments.backends.make_backend`).
     n_games : int
         Games of the paper's random-human simulation.
     curve_trial : int

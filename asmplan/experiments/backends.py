@@ -1,8 +1,8 @@
 """Where tasks run: in this process, in a local process pool, or on a Ray cluster.
 
-Every backend takes a list of :class:`~arl.experiments.tasks.TaskSpec` and yields
+Every backend takes a list of :class:`~asmplan.experiments.tasks.TaskSpec` and yields
 ``(spec, outcome)`` pairs in completion order, the outcome being the
-:class:`~arl.experiments.tasks.TaskResult` or the exception the task raised. A task's
+:class:`~asmplan.experiments.tasks.TaskResult` or the exception the task raised. A task's
 result depends on its spec only, so all backends give the same results for the same seeds.
 
 Ray is optional (``pip install 'asmplan[cluster]'``) and imported only when used.
@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from multiprocessing import get_context
 from pathlib import Path
 
-from arl.experiments.tasks import TaskResult, TaskSpec, run_task
+from asmplan.experiments.tasks import TaskResult, TaskSpec, run_task
 
 Outcome = TaskResult | BaseException
 THREAD_ENV = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS")

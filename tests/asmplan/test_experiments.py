@@ -10,18 +10,18 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from arl.experiments import tasks as tasks_module
-from arl.experiments.figures import moving_average
-from arl.experiments.paper_values import (
+from asmplan.experiments import tasks as tasks_module
+from asmplan.experiments.figures import moving_average
+from asmplan.experiments.paper_values import (
     PAPER_TABLE3,
     PAPER_TABLE4,
     PAPER_TABLE4_QUOTED,
     paper_table3_row,
     paper_table4_row,
 )
-from arl.experiments.runner import FIGURE11, FIGURE12, FIGURE13, run_experiment, task_path
-from arl.experiments.tables import PAPER_COLUMNS
-from arl.experiments.tasks import (
+from asmplan.experiments.runner import FIGURE11, FIGURE12, FIGURE13, run_experiment, task_path
+from asmplan.experiments.tables import PAPER_COLUMNS
+from asmplan.experiments.tasks import (
     TABLE3_CONFIGS,
     GraphConfig,
     ResultRow,
@@ -253,7 +253,7 @@ def fake_train(dag, config="paper", seed=0, **_):
 
 def test_arl_path_with_a_stand_in_trainer(monkeypatch, tmp_path):
     monkeypatch.setattr(tasks_module, "require_trainer", lambda: fake_train)
-    monkeypatch.setattr("arl.experiments.runner.require_trainer", lambda: fake_train)
+    monkeypatch.setattr("asmplan.experiments.runner.require_trainer", lambda: fake_train)
     report = run_experiment(
         "table3",
         tmp_path,
@@ -298,8 +298,8 @@ def test_moving_average():
 
 
 def test_cli_runs_and_reports_bad_input(tmp_path):
-    import arl.cli.experiment  # noqa: F401  registers the commands
-    from arl.cli.app import app
+    import asmplan.cli.experiment  # noqa: F401  registers the commands
+    from asmplan.cli.app import app
 
     runner = CliRunner()
     args = [

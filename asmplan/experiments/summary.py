@@ -9,14 +9,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from arl.experiments.figures import paper_row, primary_rows
-from arl.experiments.paper_values import (
+from asmplan.experiments.figures import paper_row, primary_rows
+from asmplan.experiments.paper_values import (
     PAPER,
     PAPER_TABLE3,
     PAPER_TABLE4,
     PAPER_TABLE4_QUOTED,
 )
-from arl.experiments.tasks import ResultRow
+from asmplan.experiments.tasks import ResultRow
 
 TITLES = {"table3": "Table 3 (six configurations)", "table4": "Table 4 (ten 20/10 graphs)"}
 
@@ -193,7 +193,7 @@ def summary_markdown(info: RunInfo, rows: Sequence[ResultRow]) -> str:
         f"{info.resumed} resumed from `tasks/`), {info.wall_s:.1f} s wall time.",
         "",
         f"Paper values are **the published numbers of {PAPER}**, kept in "
-        "`arl/experiments/paper_values.py`; they are not recomputed. Our graphs are fresh "
+        "`asmplan/experiments/paper_values.py`; they are not recomputed. Our graphs are fresh "
         "draws of the same generator parameters (the paper's graphs and seeds are not "
         "published), so individual rows differ and only the distributions compare.",
         "",

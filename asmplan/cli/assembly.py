@@ -15,7 +15,7 @@ from pathlib import Path
 
 import typer
 
-from arl.cli.app import OutputFormat, app
+from asmplan.cli.app import OutputFormat, app
 
 
 class CostModel(StrEnum):

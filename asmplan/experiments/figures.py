@@ -20,9 +20,9 @@ from collections.abc import Sequence
 import numpy as np
 from matplotlib.figure import Figure
 
-from arl.experiments.paper_values import paper_table3_row, paper_table4_row
-from arl.experiments.tasks import ResultRow
 from arl.plots import moving_average
+from asmplan.experiments.paper_values import paper_table3_row, paper_table4_row
+from asmplan.experiments.tasks import ResultRow
 
 MOVING_AVERAGE = 50
 ROBOT_COLOR, HUMAN_COLOR = "tab:blue", "tab:orange"

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from arl.cli.app import TableFormat, app
+from asmplan.cli.app import TableFormat, app
 
 
 @app.command("relations")

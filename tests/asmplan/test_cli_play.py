@@ -8,8 +8,8 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-import arl.cli.play  # noqa: F401  registers the command
-from arl.cli.app import app, main
+import asmplan.cli.play  # noqa: F401  registers the command
+from asmplan.cli.app import app, main
 from asp.io import save_dag
 from tests.asp.figures import figure4
 

@@ -1,0 +1,5 @@
+"""asmplan: the application layer over ``cad`` <- ``asp`` <- ``arl``.
+
+It holds what people use: the command line (:mod:`asmplan.cli`) and the experiment runner
+that reproduces the paper (:mod:`asmplan.experiments`).
+"""
