@@ -175,7 +175,6 @@ def plan_command(
     seed: int = typer.Option(0, "--seed", help="CP-SAT random seed."),
 ) -> None:
     """Plan an assembly end to end: relations, state graph, game, robust plan, CP-SAT."""
-    from asp.atomic import write_text
     from asp.baseline import assembly_schedule, min_makespan
     from asp.game import game_dag
     from asp.plan import plan_text, relations_summary, relations_text, robust_plan
@@ -221,49 +220,43 @@ def plan_command(
         f"state-graph lower bound {sched.lower_bound:g} s"
     )
 
-    plan = {
-        "format": "asmplan-plan/1",
-        "assembly": spec.name,
-        "source": spec.source,
-        "relations": summary,
-        "states": graph.n_states,
-        "transitions": graph.n_transitions,
-        "sequences": sequences,
-        "game_nodes": dag.n_nodes,
-        "game_edges": dag.n_edges,
-        "cost": dag.cost_model,
-        "tct": solution.tct,
-        "minimax": solution.minimax,
-        "robust_plan": [s.to_dict() for s in steps],
-        "schedule": {
-            **result.to_dict(),
-            "lower_bound": sched.lower_bound,
-            "chain_bound": sched.chain_bound,
-            "load_bound": sched.load_bound,
+    from asmplan.planfile import alternate_states, plan_document
+
+    plan = plan_document(
+        spec=spec,
+        dag=dag,
+        solution=solution,
+        describe=alternate_states(graph, dag),
+        extra={
+            "relations": summary,
+            "states": graph.n_states,
+            "transitions": graph.n_transitions,
+            "sequences": sequences,
+            "schedule": {
+                **result.to_dict(),
+                "lower_bound": sched.lower_bound,
+                "chain_bound": sched.chain_bound,
+                "load_bound": sched.load_bound,
+            },
         },
-    }
-    if spec.credit:
-        plan["credit"] = spec.credit
+    )
     if output is not None:
         _progress("[5/5] writing plan.json and dag.png ...")
-        from asp.plot import MAX_PLOT_NODES, plot_dag
+        from asmplan.planfile import write_plan
+        from asp.plot import plot_dag
         from asp.solve import play
 
-        write_text(output / "plan.json", json.dumps(plan, indent=1) + "\n")
+        write_plan(output / "plan.json", plan)
         written = [output / "plan.json"]
-        if dag.n_nodes <= MAX_PLOT_NODES:
-            path, _ = play(dag, solution.robot_policy, solution.human_policy)
-            edges = _path_edges(dag, path)
-            plot_dag(
-                dag,
-                output / "dag.png",
-                highlight=edges,
-                title=f"{spec.name}: game DAG ({dag.cost_model}), robust plan in red, "
-                f"TCT {solution.tct:g}, W* {solution.minimax:g}",
-            )
-            written.append(output / "dag.png")
-        else:
-            _progress(f"  dag.png skipped: {dag.n_nodes} nodes > {MAX_PLOT_NODES}")
+        path, _ = play(dag, solution.robot_policy, solution.human_policy)
+        plot_dag(
+            dag,
+            output / "dag.png",
+            highlight=_path_edges(dag, path),
+            title=f"{spec.name}: game DAG ({dag.cost_model}), robust plan in red, "
+            f"TCT {solution.tct:g}, W* {solution.minimax:g}",
+        )
+        written.append(output / "dag.png")
         typer.echo("wrote " + " and ".join(str(p) for p in written))
     _progress(f"done in {time.perf_counter() - t0:.1f} s")
 
