@@ -11,7 +11,6 @@ Example
 no/such/folder: no such file or folder
 """
 
-from asp import errors as _family
 from asp.errors import (
     AsmplanError,
     FormatError,
@@ -22,4 +21,12 @@ from asp.errors import (
     SpecError,
 )
 
-__all__ = _family.__all__
+__all__ = [
+    "AsmplanError",
+    "FormatError",
+    "GameError",
+    "GeometryError",
+    "GraphError",
+    "ScheduleError",
+    "SpecError",
+]
