@@ -17,12 +17,13 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
 
+from asmplan.errors import GameError
 from asmplan.planfile import check_plan
 
 EVENT_KINDS = ("started", "finished")
 
 
-class ObservationError(ValueError):
+class ObservationError(GameError):
     """An observation the plan cannot explain; the advisor's state is unchanged."""
 
 

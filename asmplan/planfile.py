@@ -36,6 +36,7 @@ import numpy as np
 
 from asp.atomic import write_text
 from asp.dag import ANY, HUMAN, ROBOT, GameDAG
+from asp.errors import FormatError
 from asp.solve import Solution, node_order
 
 FORMAT = "asmplan-plan/2"
@@ -486,7 +487,7 @@ def read_plan(path: str | os.PathLike[str]) -> dict:
     try:
         doc = json.loads(path.read_text(encoding="utf-8"))
     except json.JSONDecodeError as exc:
-        raise ValueError(f"{path}: not JSON ({exc.msg} at line {exc.lineno})") from None
+        raise FormatError(f"{path}: not JSON ({exc.msg} at line {exc.lineno})") from None
     check_plan(doc, str(path))
     return doc
 
@@ -495,19 +496,19 @@ def check_plan(doc: dict, where: str = "plan") -> None:
     """Check the format and that the policy's columns agree in length."""
     if not isinstance(doc, dict) or doc.get("format") != FORMAT:
         got = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
-        raise ValueError(f"{where}: expected format {FORMAT!r}, got {got!r}")
+        raise FormatError(f"{where}: expected format {FORMAT!r}, got {got!r}")
     policy = doc.get("policy")
     if not isinstance(policy, dict):
-        raise ValueError(f"{where}: no policy (write it again with 'asmplan plan')")
+        raise FormatError(f"{where}: no policy (write it again with 'asmplan plan')")
     n, m = policy["n_states"], policy["n_moves"]
     for key, column in policy["states"].items():
         if len(column) != n:
-            raise ValueError(f"{where}: policy.states.{key}: expected {n} entries")
+            raise FormatError(f"{where}: policy.states.{key}: expected {n} entries")
     if len(policy["moves"]["ptr"]) != n + 1:
-        raise ValueError(f"{where}: policy.moves.ptr: expected {n + 1} entries")
+        raise FormatError(f"{where}: policy.moves.ptr: expected {n + 1} entries")
     for key in ("operation", "agent", "cost", "next"):
         if len(policy["moves"][key]) != m:
-            raise ValueError(f"{where}: policy.moves.{key}: expected {m} entries")
+            raise FormatError(f"{where}: policy.moves.{key}: expected {m} entries")
 
 
 def plan_schema() -> dict:
@@ -524,7 +525,7 @@ def validate_plan(doc: dict) -> None:
     error = next(iter(sorted(validator.iter_errors(doc), key=lambda e: list(e.path))), None)
     if error is not None:
         where = "/".join(str(p) for p in error.absolute_path) or "(root)"
-        raise ValueError(f"plan.json at {where}: {error.message[:200]}")
+        raise FormatError(f"plan.json at {where}: {error.message[:200]}")
 
 
 def timed_write(path: str | os.PathLike[str], doc: dict) -> tuple[Path, float, int]:
@@ -537,19 +538,15 @@ def timed_write(path: str | os.PathLike[str], doc: dict) -> tuple[Path, float, i
 def build_plan(assembly: str | os.PathLike[str], *, cost: str | None = None) -> dict:
     """Plan an assembly (folder, ``assembly.yaml`` or ``.IN2``) without the CP-SAT schedule.
 
-    The relations, state graph, game and exact solution, then :func:`plan_document`.
+    The relations, state graph, game and exact solution (:mod:`asmplan.pipeline`), then
+    :func:`plan_document`.
     """
-    from asp.feasibility import load_relations
-    from asp.game import game_dag
-    from asp.solve import solve
-    from asp.spec import load_spec
-    from asp.state_graph import build_state_graph
+    from asmplan import pipeline
 
-    spec = load_spec(assembly)
-    relations = load_relations(spec) if spec.has_geometry else None
-    graph = build_state_graph(spec, relations)
-    dag = game_dag(graph, cost=cost)
-    solution = solve(dag)
+    loaded = pipeline.load(assembly)
+    graph = pipeline.state_graph(loaded)
+    dag = pipeline.game(graph, cost=cost)
+    solution = pipeline.solve_game(dag)
     return plan_document(
-        spec=spec, dag=dag, solution=solution, describe=alternate_states(graph, dag)
+        spec=loaded.spec, dag=dag, solution=solution, describe=alternate_states(graph, dag)
     )

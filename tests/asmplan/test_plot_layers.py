@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-import asp.plot as plot
+import asmplan.report.plot as plot
 from asp.synth import synthetic_dag
 
 

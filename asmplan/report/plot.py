@@ -2,9 +2,9 @@
 
 Up to :data:`MAX_PLOT_NODES` nodes every node and edge is drawn; above, the graph is drawn
 by layers (longest path from the start) with the number of nodes and edges of each layer,
-and the highlighted path as the layers it crosses, so a large graph is never silently
-left undrawn. matplotlib is imported lazily with the Agg backend; the PNG is written
-atomically.
+and the highlighted path as the layers it crosses, so a large graph is never silently left
+undrawn. matplotlib is imported lazily and used without pyplot (no global backend is set, no figure
+is left open); the PNG is written atomically.
 """
 
 from __future__ import annotations
@@ -55,11 +55,8 @@ def plot_dag(
     """
     if dag.n_nodes > MAX_PLOT_NODES:
         return plot_layers(dag, path, highlight=highlight, title=title)
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     from matplotlib.collections import LineCollection
+    from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
 
     layer = node_layers(dag)
@@ -76,7 +73,8 @@ def plot_dag(
 
     width = max(8.0, 0.45 * (layer.max() + 1))
     height = max(4.0, 0.35 * (np.bincount(layer).max() + 1))
-    fig, ax = plt.subplots(figsize=(min(width, 40), min(height, 30)), dpi=110)
+    fig = Figure(figsize=(min(width, 40), min(height, 30)), dpi=110)
+    ax = fig.subplots()
     segments = np.stack(
         [np.column_stack([x[src], y[src]]), np.column_stack([x[dag.targets], y[dag.targets]])],
         axis=1,
@@ -125,15 +123,13 @@ def plot_layers(
     scale), labelled with its node and out-edge counts; the highlighted edges mark the
     layers the path goes through.
     """
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     layer = node_layers(dag)
     nodes, edges = layer_counts(dag)
     x = np.arange(nodes.size)
-    fig, ax = plt.subplots(figsize=(min(max(8.0, 0.4 * nodes.size), 40), 5), dpi=110)
+    fig = Figure(figsize=(min(max(8.0, 0.4 * nodes.size), 40), 5), dpi=110)
+    ax = fig.subplots()
     ax.bar(x, nodes, color="#9ecae1", edgecolor="#3b6fb6", label="nodes per layer")
     ax.plot(x, np.maximum(edges, 1), "o-", color="#f28c28", ms=3, lw=1, label="edges leaving")
     ax.set_yscale("log")
@@ -166,11 +162,8 @@ def plot_layers(
 
 
 def _save(fig, path: str | os.PathLike[str]) -> Path:
-    """Write ``fig`` as a PNG atomically and close it."""
-    import matplotlib.pyplot as plt
-
+    """Write the matplotlib Figure ``fig`` as a PNG atomically."""
     fig.tight_layout()
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png")
-    plt.close(fig)
     return write_bytes(path, buffer.getvalue())
