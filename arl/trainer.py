@@ -33,9 +33,12 @@ from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv
 from arl.config import TrainConfig, get_config
 from arl.envs import GameVecEnv, Observer, TurnEnv
 from arl.game import AGENTS, NO_MOVE, GameTables
-from arl.tabulate import action_probabilities, greedy_policy
+from arl.tabulate import action_probabilities, greedy_policy, tabulate
+from asp import rules
 from asp.atomic import write_bytes, write_text
 from asp.dag import HUMAN, ROBOT, GameDAG
+from asp.metrics import is_robust_optimal
+from asp.numbers import plain
 from asp.solve import certified_worst_case, play, solve
 
 LOG_VERSION = 1
@@ -94,7 +97,7 @@ class TrainResult:
     @property
     def robust_optimal(self) -> bool:
         """Whether the certified WCPL equals W*."""
-        return abs(self.certified_wcpl - self.minimax) <= 1e-9
+        return is_robust_optimal(self.certified_wcpl, self.minimax)
 
 
 class _EpisodeRecorder(BaseCallback):
@@ -123,16 +126,12 @@ def graph_summary(dag: GameDAG) -> dict:
     return {
         "nodes": dag.n_nodes,
         "edges": dag.n_edges,
-        "start": _plain(dag.node_ids[dag.start]),
-        "end": _plain(dag.node_ids[dag.end]),
+        "start": plain(dag.node_ids[dag.start]),
+        "end": plain(dag.node_ids[dag.end]),
         "cost_model": dag.cost_model,
         "fingerprint": digest.hexdigest()[:16],
         "metadata": json.loads(json.dumps(dag.metadata, default=str)),
     }
-
-
-def _plain(x):
-    return x.item() if hasattr(x, "item") else x
 
 
 def _phase_seed(seed: int, cycle: int, player: int) -> int:
@@ -202,27 +201,9 @@ def _save_model(model, path: Path) -> None:
 
 def robot_reach(tables: GameTables, robot_policy: np.ndarray) -> np.ndarray:
     """(n,) bool: nodes where the robot is on turn, with a move, in some state reachable
-    when it follows ``robot_policy`` against any human."""
-    n, targets = tables.n, tables.dag.targets
-    seen = np.zeros((n, 2), dtype=bool)
-    stack = [(tables.start, ROBOT)]
-    seen[tables.start, ROBOT] = True
-    while stack:
-        v, p = stack.pop()
-        if v == tables.end:
-            continue
-        count = tables.n_moves[p, v]
-        if count == 0:
-            heads = [v]
-        elif p == ROBOT:
-            heads = [int(targets[robot_policy[v]])]
-        else:
-            heads = targets[tables.moves[p, v, :count]].tolist()
-        for t in heads:
-            if not seen[t, 1 - p]:
-                seen[t, 1 - p] = True
-                stack.append((t, 1 - p))
-    return seen[:, ROBOT] & (tables.n_moves[ROBOT] > 0)
+    when it follows ``robot_policy`` against any human (:func:`asp.rules.reachable_states`)."""
+    seen = rules.reachable_states(tables.dag, robot_policy)
+    return seen[:, ROBOT] & tables.can_move[ROBOT]
 
 
 def policy_hash(tables: GameTables, robot_policy: np.ndarray) -> str:
@@ -326,7 +307,7 @@ def train(
     def greedy(p: int) -> np.ndarray:
         if p not in models:
             return np.full(tables.n, NO_MOVE, dtype=np.int64)
-        return greedy_policy(action_probabilities(models[p], tables, p, observer), tables, p)
+        return tabulate(models[p], tables, p, observer)
 
     def freeze_opponent(learner: int) -> None:
         """Set the other side's current policy as the learner's frozen opponent."""
@@ -498,8 +479,7 @@ def load_policies(dag: GameDAG, model_dir: str | Path) -> tuple[np.ndarray, np.n
         if not path.is_file():
             raise ValueError(f"{model_dir}: missing {path.name}")
         model = _algo_class(cfg).load(path, device="cpu")
-        probs = action_probabilities(model, tables, p, observer)
-        policies.append(greedy_policy(probs, tables, p))
+        policies.append(tabulate(model, tables, p, observer))
     return policies[0], policies[1]
 
 
