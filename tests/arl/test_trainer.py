@@ -4,7 +4,6 @@ import json
 
 import numpy as np
 import pytest
-import torch
 
 from arl import evaluate, get_config, train
 from asmplan.cli.app import main
@@ -13,17 +12,9 @@ from asp.solve import solve
 from tests.arl.graphs import figure4, sided_time_dag
 
 # A smaller `fast` so that each cycle takes a few hundredths of a second.
+pytestmark = pytest.mark.usefixtures("deterministic_torch")
+
 TINY = get_config("fast").replace(name="tiny", n_envs=16, n_steps=16, phase_steps=256, max_cycles=3)
-
-
-@pytest.fixture(autouse=True)
-def _deterministic_torch():
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    torch.use_deterministic_algorithms(True)
-    yield
-    torch.use_deterministic_algorithms(False)
-    torch.set_num_threads(threads)
 
 
 def _without_time(cycles):
