@@ -177,7 +177,7 @@ def build_state_graph(
     relations=None,
     *,
     model: OperationModel | None = None,
-    max_states: int = DEFAULT_MAX_STATES,
+    max_states: int | None = None,
     progress: bool = False,
     check: bool = True,
 ) -> StateGraph:
@@ -189,9 +189,10 @@ def build_state_graph(
         Part relations for the geometric checks (none: explicit precedence only).
     model : OperationModel, optional
         A precompiled model (overrides ``relations``).
-    max_states : int
-        Stop with a one-line ``ValueError`` (states reached, layer, what to do) beyond this
-        many states; a layer sure to go over is not built at all.
+    max_states : int, optional
+        Stop with a one-line ``ValueError`` (states reached, the parts that multiply them,
+        how to raise the limit) beyond this many states; a layer sure to go over is not
+        built at all. Default: the spec's ``max_states``, else :data:`DEFAULT_MAX_STATES`.
     progress : bool
         Print the key width and, per layer, the states, transitions and seconds on stderr.
     check : bool
@@ -199,6 +200,8 @@ def build_state_graph(
         sequence exists.
     """
     model = operation_model(spec, relations) if model is None else model
+    if max_states is None:
+        max_states = spec.max_states or DEFAULT_MAX_STATES
     n_ops, n_words = model.n_ops, model.n_words
     index_type = np.int32 if max_states < 2**31 else np.int64
     keys = model.pack([model.start_key])
@@ -227,10 +230,10 @@ def build_state_graph(
         # that is sure to go over the limit (its successor keys alone may not fit in memory).
         at_least = total - (-si.size // (layer + 1))
         if at_least > max_states:
-            raise _too_many(spec, max_states, f"at least {at_least:,}", layer, n_words)
+            raise _too_many(model, keys, max_states, f"at least {at_least:,}", layer)
         uniq, inv = _unique_rows(model.successor_keys(keys[si], oi))
         if total + uniq.shape[0] > max_states:
-            raise _too_many(spec, max_states, f"{total + uniq.shape[0]:,}", layer, n_words)
+            raise _too_many(model, uniq, max_states, f"{total + uniq.shape[0]:,}", layer)
         new_parts = np.empty((uniq.shape[0], parts.shape[1]), dtype=np.uint64)
         new_parts[inv] = parts[si] | model.op_parts[oi]
         del si_l, oi_l
@@ -415,14 +418,32 @@ def _unique_rows(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return ordered[first], inv
 
 
-def _too_many(spec: AssemblySpec, limit: int, reached: str, layer: int, n_words: int):
-    """The one-line error of a state graph over ``max_states``."""
-    n_ops = len(spec.operations)
+def _too_many(model: OperationModel, keys: np.ndarray, limit: int, reached: str, layer: int):
+    """The one-line error of a state graph over ``max_states``.
+
+    ``keys`` is the last layer built (or about to be): the operations done in some but not
+    all of its states are the free choices that multiply the states; the parts they place
+    are named, the most balanced choices (done in about half the states) first.
+    """
+    spec = model.spec
+    n_ops = model.n_ops
+    done = model.done_matrix(keys[:200_000]).mean(axis=0)
+    free = np.flatnonzero((done > 0) & (done < 1))
+    order = free[np.argsort(np.abs(done[free] - 0.5), kind="stable")]
+    names = []
+    for i in order:
+        op = spec.operations[int(i)]
+        names.extend(op.parts or (f"operation {op.id}",))
+    names = list(dict.fromkeys(names))
+    shown = ", ".join(names[:8]) + (f" and {len(names) - 8} more" if len(names) > 8 else "")
+    per_state = 8 * model.n_words + 8 * model.oracle.n_words + 8
     return ValueError(
         f"{spec.source}: the state graph exceeds the limit of {limit:,} states: {reached} "
-        f"states after layer {layer + 1} of {n_ops}; raise max_states if memory allows "
-        f"(the graph takes {8 * n_words + 8} bytes a state plus 10 a transition), or add "
-        f"precedences or split the assembly into subassemblies"
+        f"states after layer {layer + 1} of {n_ops}; the free order of {len(names)} parts or "
+        f"operations multiplies them ({shown or 'none'}); raise max_states (the command line's "
+        f"--max-states N or the spec key max_states: N) if memory allows (about {per_state} "
+        f"bytes a state plus 10 a transition), or fix their order with precedences (after:) "
+        f"or build some of them as subassemblies"
     )
 
 

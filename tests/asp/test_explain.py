@@ -93,3 +93,25 @@ def test_dead_end_is_named_never_an_empty_list():
     assert "every order ends in a dead end" in text
     assert "cannot be inserted (" in text and "no free direction" in text
     assert not text.rstrip().endswith("operations")
+
+
+def test_state_limit_names_the_multiplying_parts_and_the_key():
+    parts = tuple(f"P{k}" for k in range(12))
+    contacts = [(p, "P0", "-z") for p in parts[1:]]
+    rel = relations(parts, contacts, [(p, "P0", "-z") for p in parts[1:]])
+    spec = tower_spec(parts)
+    with pytest.raises(ValueError, match="exceeds the limit of 500 states") as info:
+        build_state_graph(spec, rel, max_states=500)
+    text = str(info.value)
+    assert "the free order of 11 parts or operations multiplies them (P" in text
+    assert "--max-states N" in text and "max_states: N" in text
+    data = {"max_states": 500, "parts": [{"id": p, "file": f"{p}.stl"} for p in parts]}
+    limited = spec_from_dict({**data, **_rest(spec)}, source="tower.yaml")
+    assert limited.max_states == 500
+    with pytest.raises(ValueError, match="exceeds the limit of 500 states"):
+        build_state_graph(limited, rel)
+
+
+def _rest(spec):
+    ops = [{"id": op.id, "agents": {"R": 1}, "part": op.parts[0]} for op in spec.operations]
+    return {"agents": {"R": {"side": "robot"}}, "base_part": "P0", "operations": ops}
