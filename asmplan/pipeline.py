@@ -46,7 +46,7 @@ if TYPE_CHECKING:  # pragma: no cover - types only
 PLAN_FORMAT = "asmplan-plan/2"
 GRAPH_SUFFIXES = (".json", ".graphml", ".xml")
 """Suffixes read as a game DAG file rather than an assembly."""
-PLAN_FILES = ("plan.json", "dag.png")
+PLAN_FILES = ("plan.json", "dag.png", "report.html")
 """The files ``asmplan plan`` writes (besides ``manifest.json``)."""
 
 Progress = Callable[[str], None]
@@ -441,7 +441,7 @@ def plan(
 def write_plan(
     result: AssemblyPlan, output: str | os.PathLike[str], *, on_step: Progress | None = None
 ) -> tuple[Path, ...]:
-    """Write ``plan.json`` and (small enough games) ``dag.png`` into ``output`` as one unit.
+    """Write ``plan.json``, ``dag.png`` and ``report.html`` into ``output`` as one unit.
 
     The files of one run are named by ``manifest.json``, written last; the previous run's
     files are removed first, so the folder never mixes two runs (see
@@ -468,7 +468,25 @@ def write_plan(
             title=f"{result.assembly.spec.name}: game DAG ({dag.cost_model}), robust plan "
             f"in red, TCT {solution.tct:g}, W* {solution.minimax:g}",
         )
+        if on_step is not None:
+            on_step("  writing report.html ...")
+        out.write_text("report.html", plan_report(result, doc, out.path("dag.png").read_bytes()))
     return out.written
+
+
+def plan_report(result: AssemblyPlan, doc: dict, dag_png: bytes | None = None) -> str:
+    """``report.html`` of a plan (:mod:`asmplan.report.html`), with the concurrent game's
+    curve and Gantt charts when the state graph is small enough to solve it here."""
+    from asmplan.report.html import REPORT_MAX_STATES, concurrent_summary, report_html
+
+    if result.graph.n_states <= REPORT_MAX_STATES:
+        concurrent = concurrent_summary(result.assembly.spec, result.graph)
+    else:
+        concurrent = {
+            "error": f"{result.graph.n_states:,} assembly states (the report solves "
+            f"it up to {REPORT_MAX_STATES:,})"
+        }
+    return report_html(doc, dag_png=dag_png, concurrent=concurrent)
 
 
 def path_edges(dag: GameDAG, path: list[int]) -> list[int]:
