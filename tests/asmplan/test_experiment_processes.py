@@ -20,17 +20,21 @@ from tests.conftest import REPO
 pytestmark = pytest.mark.skipif(not Path("/proc").is_dir(), reason="reads /proc")
 
 
-def _children(pid: int) -> set[int]:
-    """Pids of the live processes whose parent is ``pid``."""
-    found = set()
+def _processes() -> list[tuple[int, str, int, int]]:
+    """(pid, state, parent pid, process group) of every process."""
+    found = []
     for stat in Path("/proc").glob("[0-9]*/stat"):
         try:
-            fields = stat.read_text().rsplit(")", 1)[1].split()
-        except (OSError, IndexError):
+            state, ppid, pgid = stat.read_text().rsplit(")", 1)[1].split()[:3]
+        except (OSError, ValueError):
             continue
-        if int(fields[1]) == pid and fields[0] != "Z":
-            found.add(int(stat.parent.name))
+        found.append((int(stat.parent.name), state, int(ppid), int(pgid)))
     return found
+
+
+def _children(pid: int) -> set[int]:
+    """Pids of the live processes whose parent is ``pid``."""
+    return {p for p, state, ppid, _ in _processes() if ppid == pid and state != "Z"}
 
 
 def _alive(pid: int) -> bool:
@@ -100,15 +104,7 @@ def _free_ports(n: int) -> list[int]:
 
 def _group(pgid: int) -> set[int]:
     """Live processes of process group ``pgid``."""
-    found = set()
-    for stat in Path("/proc").glob("[0-9]*/stat"):
-        try:
-            fields = stat.read_text().rsplit(")", 1)[1].split()
-        except (OSError, IndexError):
-            continue
-        if int(fields[2]) == pgid and fields[0] != "Z":
-            found.add(int(stat.parent.name))
-    return found
+    return {p for p, state, _, group in _processes() if group == pgid and state != "Z"}
 
 
 def _ray_start(args: list[str], env: dict, cwd: Path) -> int:
