@@ -13,8 +13,7 @@ import numpy as np
 
 from asp.dag import HUMAN, ROBOT, GameDAG
 from asp.solve import Solution
-
-DIRECTIONS = ("+x", "-x", "+y", "-y", "+z", "-z")
+from cad.directions import DIRECTIONS
 
 
 @dataclass(frozen=True)

@@ -12,6 +12,7 @@ from asmplan.cli.app import app, main
 from asmplan.cli import core as _core  # noqa: F401, E402  isort: skip
 from asmplan.cli import cad as _cad  # noqa: F401, E402  isort: skip
 from asmplan.cli import assembly as _assembly  # noqa: F401, E402  isort: skip
+from asmplan.cli import init as _init  # noqa: F401, E402  isort: skip
 from asmplan.cli import train as _train  # noqa: F401, E402  isort: skip
 from asmplan.cli import play as _play  # noqa: F401, E402  isort: skip
 from asmplan.cli import experiment as _experiment  # noqa: F401, E402  isort: skip

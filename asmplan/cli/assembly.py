@@ -1,8 +1,9 @@
 """Assembly commands: ``asmplan graph``, ``asmplan baseline`` and ``asmplan plan``.
 
-``ASSEMBLY`` is a folder holding ``assembly.yaml``, an ``assembly.yaml`` itself, or a Scholl
-``.IN2`` precedence graph. Heavy libraries (cad, OR-Tools, matplotlib) load inside the
-commands.
+``ASSEMBLY`` is a folder holding ``assembly.yaml``, an ``assembly.yaml`` itself, a Scholl
+``.IN2`` precedence graph, or a CAD file (STEP, glTF/GLB, 3MF, 3DXML) or folder of part
+meshes, for which a spec is generated (``asmplan init`` writes it). Heavy libraries (cad,
+OR-Tools, matplotlib) load inside the commands.
 """
 
 from __future__ import annotations
@@ -35,6 +36,12 @@ def _load(assembly: Path, *, progress: bool):
     from asp.spec import load_spec
 
     spec = load_spec(assembly)
+    if spec.generated:
+        _progress(
+            f"no assembly.yaml: generated a spec from {assembly} ({len(spec.parts)} parts, one "
+            "placement each, agents H and R1, durations from part size); "
+            f"`asmplan init {assembly} -o assembly.yaml` writes it for editing"
+        )
     relations = None
     if spec.has_geometry:
         if progress:
@@ -166,7 +173,11 @@ def baseline_command(
 
 @app.command("plan")
 def plan_command(
-    assembly: Path = typer.Argument(..., help="Folder with assembly.yaml, the YAML, or a .IN2."),
+    assembly: Path = typer.Argument(
+        ...,
+        help="Folder with assembly.yaml, the YAML, a .IN2, or a CAD file (STEP, glTF/GLB, 3MF, "
+        "3DXML) or folder of part meshes (a spec is generated).",
+    ),
     output: Path | None = typer.Option(
         None, "--output", "-o", help="Folder for plan.json, dag.png."
     ),
