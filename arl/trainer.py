@@ -17,7 +17,6 @@ as the uninterrupted run would have.
 from __future__ import annotations
 
 import hashlib
-import io
 import json
 import time
 from collections.abc import Callable
@@ -27,14 +26,14 @@ from typing import Any
 
 import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
-from stable_baselines3.common.logger import Logger
+from stable_baselines3.common.logger import Logger, TensorBoardOutputFormat
 from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv
 
 from arl.config import TrainConfig, get_config
 from arl.envs import GameVecEnv, Observer, TurnEnv
 from arl.game import AGENTS, NO_MOVE, GameTables
-from arl.tabulate import action_probabilities, greedy_policy
-from asp.atomic import write_bytes, write_text
+from arl.runfolder import LOG_FORMAT, RunFolder
+from arl.tabulate import action_probabilities, tabulate
 from asp.dag import HUMAN, ROBOT, GameDAG
 from asp.solve import certified_worst_case, play, solve
 
@@ -174,7 +173,7 @@ def _make_env(dag: GameDAG, player: int, config: TrainConfig, seed: int) -> VecE
     return DummyVecEnv([factory])
 
 
-def _make_model(config: TrainConfig, env: VecEnv, seed: int, tb: Path | None):
+def _make_model(config: TrainConfig, env: VecEnv, seed: int):
     return _algo_class(config)(
         "MlpPolicy",
         env,
@@ -187,17 +186,10 @@ def _make_model(config: TrainConfig, env: VecEnv, seed: int, tb: Path | None):
         clip_range=config.clip_range,
         ent_coef=config.ent_coef,
         policy_kwargs={"net_arch": list(config.net_arch)},
-        tensorboard_log=None if tb is None else str(tb),
         seed=seed,
         device="cpu",
         verbose=0,
     )
-
-
-def _save_model(model, path: Path) -> None:
-    buffer = io.BytesIO()
-    model.save(buffer)
-    write_bytes(path, buffer.getvalue())
 
 
 def robot_reach(tables: GameTables, robot_policy: np.ndarray) -> np.ndarray:
@@ -259,6 +251,54 @@ def _mean(values: list[float]) -> float | None:
 # ---------------------------------------------------------------------------- training
 
 
+@dataclass(eq=False)
+class _Run:
+    """The state of a training run between cycles (what a checkpoint saves)."""
+
+    dag: GameDAG
+    cfg: TrainConfig
+    seed: int
+    tables: GameTables
+    observer: Observer
+    summary: dict
+    minimax: float
+    envs: dict[int, VecEnv]
+    models: dict[int, Any]
+    cycles: list[dict] = field(default_factory=list)
+    rewards: dict[str, list[float]] = field(default_factory=lambda: {"robot": [], "human": []})
+    wall_before: float = 0.0
+    converged: bool = False
+    stopped: bool = False
+    started: float = field(default_factory=time.perf_counter)
+
+    def elapsed(self) -> float:
+        """Training time so far, over all runs of a resumed training."""
+        return self.wall_before + time.perf_counter() - self.started
+
+    def greedy(self, player: int) -> np.ndarray:
+        """(n,) the side's greedy policy as edge indices (``NO_MOVE`` for a side without moves)."""
+        if player not in self.models:
+            return np.full(self.tables.n, NO_MOVE, dtype=np.int64)
+        return tabulate(self.models[player], self.tables, player, self.observer)
+
+    def log(self) -> dict:
+        """The content of ``log.json``."""
+        return {
+            "format": LOG_FORMAT,
+            "version": LOG_VERSION,
+            "seed": self.seed,
+            "config": self.cfg.to_dict(),
+            "graph": self.summary,
+            "minimax": self.minimax,
+            "converged": self.converged,
+            "wall_s": self.cycles[-1]["elapsed_s"] if self.cycles else self.wall_before,
+            "cycles": self.cycles,
+            "robot_policy": self.greedy(ROBOT).tolist(),
+            "human_policy": self.greedy(HUMAN).tolist(),
+            "episode_rewards": self.rewards,
+        }
+
+
 def train(
     dag: GameDAG,
     config: str | TrainConfig = "paper",
@@ -278,13 +318,13 @@ def train(
     seed : int
         Seeds models, environments, numpy and torch.
     output : path, optional
-        Run folder: ``robot.zip``, ``human.zip``, ``log.json``, ``tb/``, ``rewards.png``,
-        rewritten (atomically) after every cycle.
+        Run folder (:mod:`arl.runfolder`): ``robot.zip``, ``human.zip``, ``log.json``
+        committed as one checkpoint after every cycle, ``tb/``, ``rewards.png``.
     progress : bool
         Show a tqdm bar of cycles.
     resume : bool
         Continue the run saved in ``output`` (same graph, seed and config but for
-        ``max_cycles``).
+        ``max_cycles``) from its last committed cycle.
     callback : callable, optional
         ``callback(record) -> bool | None`` after each cycle; ``False`` stops training.
 
@@ -293,181 +333,192 @@ def train(
     TrainResult
     """
     cfg = get_config(config)
-    out = None if output is None else Path(output)
-    if resume and out is None:
+    if resume and output is None:
         raise ValueError("resume: expected an output folder to resume from")
-    tables = GameTables.from_dag(dag)
-    observer = Observer(dag, cfg.obs)
-    summary = graph_summary(dag)
-    minimax = solve(dag).minimax  # for the log only: training never reads it
-    learners = [p for p in (ROBOT, HUMAN) if tables.can_move_somewhere(p)]
-    tb = None if out is None else out / "tb"
+    folder = None if output is None else RunFolder(output)
+    run = _start_run(dag, cfg, seed, folder, resume)
+    try:
+        bar = _progress(range(len(run.cycles), cfg.max_cycles), progress, len(run.cycles), cfg)
+        for cycle in bar:
+            if run.converged or run.stopped:
+                break
+            record = _train_cycle(run, cycle, folder)
+            if callback is not None and callback(record) is False:
+                run.stopped = True
+            if folder is not None:
+                folder.commit(run.log(), {AGENTS[p]: m for p, m in run.models.items()})
+            if progress:
+                bar.set_postfix(wcpl=record["wcpl"], certified=record["certified_wcpl"])
+        result = _result(run, folder)
+        if folder is not None:
+            from arl.plots import rewards_png
 
-    envs = {p: _make_env(dag, p, cfg, seed + p) for p in learners}
-    models: dict[int, Any] = {}
-    cycles: list[dict] = []
-    rewards: dict[str, list[float]] = {"robot": [], "human": []}
-    wall_before = 0.0
-    if resume:
-        log = _load_log(out, summary, seed, cfg)
-        cycles, rewards, wall_before = log["cycles"], log["episode_rewards"], log["wall_s"]
-        for p in learners:
-            models[p] = _algo_class(cfg).load(
-                out / f"{AGENTS[p]}.zip", env=envs[p], device="cpu", tensorboard_log=tb
-            )
-    else:
-        for p in learners:
-            models[p] = _make_model(cfg, envs[p], seed + p, tb)
-    if tb is None:
-        # Without a log folder SB3 would make an empty /tmp/SB3-<time> folder per learn().
-        for model in models.values():
-            model.set_logger(Logger(folder=None, output_formats=[]))
-
-    def greedy(p: int) -> np.ndarray:
-        if p not in models:
-            return np.full(tables.n, NO_MOVE, dtype=np.int64)
-        return greedy_policy(action_probabilities(models[p], tables, p, observer), tables, p)
-
-    def freeze_opponent(learner: int) -> None:
-        """Set the other side's current policy as the learner's frozen opponent."""
-        other = models.get(1 - learner)
-        env = envs[learner]
-        if isinstance(env, GameVecEnv):  # tabulated once: one forward pass over all nodes
-            table = None
-            if other is not None:
-                probs = action_probabilities(other, tables, 1 - learner, observer)
-                table = greedy_policy(probs, tables, 1 - learner)
-                table = table if cfg.opponent_deterministic else probs
-            env.set_opponent(table, cfg.opponent_epsilon)
-        else:  # the paper's: the frozen SB3 model is called at every opponent move
-            env.env_method("set_opponent", other)
-
-    def save_log(elapsed: float) -> None:
-        log = {
-            "format": "asmplan-arl-run",
-            "version": LOG_VERSION,
-            "seed": seed,
-            "config": cfg.to_dict(),
-            "graph": summary,
-            "minimax": minimax,
-            "converged": converged,
-            "wall_s": elapsed,
-            "cycles": cycles,
-            "robot_policy": robot_policy.tolist(),
-            "human_policy": human_policy.tolist(),
-            "episode_rewards": rewards,
-        }
-        write_text(out / "log.json", json.dumps(log, indent=1) + "\n")
-
-    robot_policy, human_policy = greedy(ROBOT), greedy(HUMAN)
-    converged = should_stop(cycles, cfg)
-    stopped = False
-    start = time.perf_counter()
-    bar = _progress(range(len(cycles), cfg.max_cycles), progress, len(cycles), cfg.max_cycles)
-    for cycle in bar:
-        if converged or stopped:
-            break
-        t0 = time.perf_counter()
-        means: dict[int, float | None] = {ROBOT: None, HUMAN: None}
-        counts = {ROBOT: 0, HUMAN: 0}
-        # Phase 1 trains the robot against the frozen human, phase 2 the reverse.
-        for learner in learners:
-            model = models[learner]
-            freeze_opponent(learner)
-            model.set_random_seed(_phase_seed(seed, cycle, learner))
-            model._last_obs = None  # fresh games, so that a resumed run repeats this phase
-            recorder = _EpisodeRecorder()
-            model.learn(
-                cfg.phase_steps,
-                callback=recorder,
-                reset_num_timesteps=False,
-                tb_log_name=AGENTS[learner],
-            )
-            rewards[AGENTS[learner]].extend(recorder.rewards)
-            means[learner], counts[learner] = _mean(recorder.rewards), len(recorder.rewards)
-
-        # Check: tabulate the greedy policies and score them exactly.
-        robot_policy, human_policy = greedy(ROBOT), greedy(HUMAN)
-        _, wcpl = play(dag, robot_policy, human_policy)
-        record = {
-            "cycle": cycle + 1,
-            "robot_mean_reward": means[ROBOT],
-            "human_mean_reward": means[HUMAN],
-            "wcpl": float(wcpl),
-            "certified_wcpl": certified_worst_case(dag, robot_policy),
-            "wall_s": time.perf_counter() - t0,
-            "elapsed_s": wall_before + time.perf_counter() - start,
-            "timesteps": int(sum(m.num_timesteps for m in models.values())),
-            "robot_episodes": counts[ROBOT],
-            "human_episodes": counts[HUMAN],
-            "policy_hash": policy_hash(tables, robot_policy),
-        }
-        cycles.append(record)
-        converged = should_stop(cycles, cfg)
-        if callback is not None and callback(record) is False:
-            stopped = True
-        if out is not None:
-            for p, model in models.items():
-                _save_model(model, out / f"{AGENTS[p]}.zip")
-            save_log(record["elapsed_s"])
-        if progress:
-            bar.set_postfix(wcpl=record["wcpl"], certified=record["certified_wcpl"])
-
-    _, wcpl = play(dag, robot_policy, human_policy)
-    result = TrainResult(
-        robot_policy=robot_policy,
-        human_policy=human_policy,
-        cycles=cycles,
-        episode_rewards=rewards,
-        wall_s=wall_before + time.perf_counter() - start,
-        converged=converged,
-        wcpl=float(wcpl),
-        certified_wcpl=certified_worst_case(dag, robot_policy),
-        minimax=minimax,
-        config=cfg,
-        seed=seed,
-        output=out,
-        models={AGENTS[p]: m for p, m in models.items()},
-    )
-    if out is not None:
-        save_log(result.wall_s)
-        from arl.plots import plot_rewards
-
-        plot_rewards(rewards, out / "rewards.png")
-    for env in envs.values():
-        env.close()
+            folder.write_rewards_png(rewards_png(run.rewards))
+    finally:
+        for env in run.envs.values():
+            env.close()
     return result
 
 
-def _progress(iterable, enabled: bool, initial: int, total: int):
+def _start_run(
+    dag: GameDAG, cfg: TrainConfig, seed: int, folder: RunFolder | None, resume: bool
+) -> _Run:
+    """A new run, or the run saved in ``folder`` restored from its checkpoint in force."""
+    tables = GameTables.from_dag(dag)
+    learners = [p for p in (ROBOT, HUMAN) if tables.can_move_somewhere(p)]
+    run = _Run(
+        dag=dag,
+        cfg=cfg,
+        seed=seed,
+        tables=tables,
+        observer=Observer(dag, cfg.obs),
+        summary=graph_summary(dag),
+        minimax=solve(dag).minimax,  # for the log only: training never reads it
+        envs={p: _make_env(dag, p, cfg, seed + p) for p in learners},
+        models={},
+    )
+    if resume:
+        folder.recover()
+        log = _check_resume(folder, run)
+        run.cycles, run.rewards, run.wall_before = (
+            log["cycles"],
+            log["episode_rewards"],
+            log["wall_s"],
+        )
+        for p in learners:
+            path = folder.model_path(AGENTS[p])
+            run.models[p] = _algo_class(cfg).load(path, env=run.envs[p], device="cpu")
+    else:
+        if folder is not None:
+            folder.start_fresh()
+        run.models = {p: _make_model(cfg, run.envs[p], seed + p) for p in learners}
+    for model in run.models.values():
+        # No logging but the run folder's TensorBoard events (else SB3 writes to stdout or
+        # makes an empty /tmp/SB3-<time> folder per learn()).
+        model.set_logger(Logger(folder=None, output_formats=[]))
+    run.converged = should_stop(run.cycles, cfg)
+    return run
+
+
+def _train_cycle(run: _Run, cycle: int, folder: RunFolder | None) -> dict:
+    """One cycle (phase 1 trains the robot against the frozen human, phase 2 the reverse),
+    then the check: tabulate the greedy policies and score them exactly. Returns the record
+    appended to ``run.cycles``."""
+    t0 = time.perf_counter()
+    means: dict[int, float | None] = {ROBOT: None, HUMAN: None}
+    counts = {ROBOT: 0, HUMAN: 0}
+    for learner in run.models:
+        episodes = _train_phase(run, learner, cycle, folder)
+        run.rewards[AGENTS[learner]].extend(episodes)
+        means[learner], counts[learner] = _mean(episodes), len(episodes)
+    robot_policy = run.greedy(ROBOT)
+    _, wcpl = play(run.dag, robot_policy, run.greedy(HUMAN))
+    record = {
+        "cycle": cycle + 1,
+        "robot_mean_reward": means[ROBOT],
+        "human_mean_reward": means[HUMAN],
+        "wcpl": float(wcpl),
+        "certified_wcpl": certified_worst_case(run.dag, robot_policy),
+        "wall_s": time.perf_counter() - t0,
+        "elapsed_s": run.elapsed(),
+        "timesteps": int(sum(m.num_timesteps for m in run.models.values())),
+        "robot_episodes": counts[ROBOT],
+        "human_episodes": counts[HUMAN],
+        "policy_hash": policy_hash(run.tables, robot_policy),
+    }
+    run.cycles.append(record)
+    run.converged = should_stop(run.cycles, run.cfg)
+    return record
+
+
+def _train_phase(run: _Run, learner: int, cycle: int, folder: RunFolder | None) -> list[float]:
+    """Train ``learner`` for ``phase_steps`` against the other side, frozen; return the
+    rewards of the games it played.
+
+    Every phase starts fresh games from seeds of ``(seed, cycle, learner)``, so that a
+    resumed run repeats it exactly.
+    """
+    model = run.models[learner]
+    _freeze_opponent(run, learner)
+    model.set_env(run.envs[learner], force_reset=True)
+    model.set_random_seed(_phase_seed(run.seed, cycle, learner))
+    logger = None
+    if folder is not None:
+        tb = folder.staging_tb(AGENTS[learner])
+        logger = Logger(folder=str(tb), output_formats=[TensorBoardOutputFormat(str(tb))])
+        model.set_logger(logger)
+    recorder = _EpisodeRecorder()
+    try:
+        model.learn(run.cfg.phase_steps, callback=recorder, reset_num_timesteps=False)
+    finally:
+        if logger is not None:
+            logger.close()
+    return recorder.rewards
+
+
+def _freeze_opponent(run: _Run, learner: int) -> None:
+    """Set the other side's current policy as the learner's frozen opponent."""
+    other, env = run.models.get(1 - learner), run.envs[learner]
+    if not isinstance(env, GameVecEnv):  # the paper's: the frozen model plays every move
+        env.env_method("set_opponent", other)
+        return
+    table = None  # tabulated once: one forward pass over all nodes
+    if other is not None and run.cfg.opponent_deterministic:
+        table = tabulate(other, run.tables, 1 - learner, run.observer)
+    elif other is not None:
+        table = action_probabilities(other, run.tables, 1 - learner, run.observer)
+    env.set_opponent(table, run.cfg.opponent_epsilon)
+
+
+def _result(run: _Run, folder: RunFolder | None) -> TrainResult:
+    robot_policy, human_policy = run.greedy(ROBOT), run.greedy(HUMAN)
+    _, wcpl = play(run.dag, robot_policy, human_policy)
+    return TrainResult(
+        robot_policy=robot_policy,
+        human_policy=human_policy,
+        cycles=run.cycles,
+        episode_rewards=run.rewards,
+        wall_s=run.elapsed(),
+        converged=run.converged,
+        wcpl=float(wcpl),
+        certified_wcpl=certified_worst_case(run.dag, robot_policy),
+        minimax=run.minimax,
+        config=run.cfg,
+        seed=run.seed,
+        output=None if folder is None else folder.path,
+        models={AGENTS[p]: m for p, m in run.models.items()},
+    )
+
+
+def _progress(iterable, enabled: bool, initial: int, cfg: TrainConfig):
     if not enabled:
         return iterable
     from tqdm.auto import tqdm
 
-    return tqdm(iterable, initial=initial, total=total, desc="cycles", unit="cycle")
+    return tqdm(iterable, initial=initial, total=cfg.max_cycles, desc="cycles", unit="cycle")
 
 
 def read_log(output: str | Path) -> dict:
-    """The ``log.json`` of a run folder (``ValueError`` if missing or not a run log)."""
-    path = Path(output) / "log.json"
-    if not path.is_file():
-        raise ValueError(f"{output}: no log.json (not a training run folder)")
+    """The ``log.json`` in force in a run folder (``ValueError`` if missing or malformed)."""
+    return RunFolder(output).read_log()
+
+
+def _saved_config(folder: RunFolder, log: dict) -> TrainConfig:
     try:
-        log = json.loads(path.read_text(encoding="utf-8"))
-    except json.JSONDecodeError as exc:
-        raise ValueError(f"{path}: not valid JSON ({exc})") from None
-    if log.get("format") != "asmplan-arl-run":
-        raise ValueError(f"{path}: expected an asmplan-arl-run log")
-    return log
+        return TrainConfig.from_dict(log["config"])
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{folder.log_path()}: malformed run log (config: {exc})") from None
 
 
-def _load_log(out: Path, summary: dict, seed: int, cfg: TrainConfig) -> dict:
-    log = read_log(out)
-    if log["graph"]["fingerprint"] != summary["fingerprint"]:
+def _check_resume(folder: RunFolder, run: _Run) -> dict:
+    """The saved log, checked to belong to the same graph, seed and config as ``run``."""
+    out, cfg = folder.path, run.cfg
+    log = folder.read_log()
+    if log["graph"]["fingerprint"] != run.summary["fingerprint"]:
         raise ValueError(f"resume: {out} was trained on a different graph")
-    if log["seed"] != seed:
-        raise ValueError(f"resume: {out} was trained with seed {log['seed']}, not {seed}")
-    saved = TrainConfig.from_dict(log["config"])
+    if log["seed"] != run.seed:
+        raise ValueError(f"resume: {out} was trained with seed {log['seed']}, not {run.seed}")
+    saved = _saved_config(folder, log)
     if saved.replace(max_cycles=cfg.max_cycles) != cfg:
         diff = [k for k, v in cfg.to_dict().items() if saved.to_dict()[k] != v]
         raise ValueError(f"resume: config differs from the saved run in {', '.join(diff)}")
@@ -482,24 +533,23 @@ def load_policies(dag: GameDAG, model_dir: str | Path) -> tuple[np.ndarray, np.n
 
     Raises ``ValueError`` if the folder is not a run or was trained on another graph.
     """
-    model_dir = Path(model_dir)
-    log = read_log(model_dir)
+    folder = RunFolder(model_dir)
+    log = folder.read_log()
     if log["graph"]["fingerprint"] != graph_summary(dag)["fingerprint"]:
         raise ValueError(f"{model_dir} was trained on a different graph")
-    cfg = TrainConfig.from_dict(log["config"])
+    cfg = _saved_config(folder, log)
     tables = GameTables.from_dag(dag)
     observer = Observer(dag, cfg.obs)
     policies = []
     for p in (ROBOT, HUMAN):
-        path = model_dir / f"{AGENTS[p]}.zip"
+        path = folder.model_path(AGENTS[p])
         if not tables.can_move_somewhere(p):
             policies.append(np.full(tables.n, NO_MOVE, dtype=np.int64))
             continue
         if not path.is_file():
             raise ValueError(f"{model_dir}: missing {path.name}")
         model = _algo_class(cfg).load(path, device="cpu")
-        probs = action_probabilities(model, tables, p, observer)
-        policies.append(greedy_policy(probs, tables, p))
+        policies.append(tabulate(model, tables, p, observer))
     return policies[0], policies[1]
 
 

@@ -291,8 +291,16 @@ def min_makespan(
     time_limit: float = 60.0,
     workers: int = 1,
     seed: int = 0,
+    replay=None,
 ) -> BaselineResult:
     """Minimum-makespan schedule with CP-SAT.
+
+    ``replay`` (optional) checks a schedule: ``replay(rows)`` returns ``None`` when the
+    schedule is physically feasible, else a cut, a list of ``(y, x)`` task-index pairs of
+    which at least one must become a precedence (``end[y] <= start[x]``) in every feasible
+    schedule. The model is then solved again with the cut (lazy constraints) until a schedule
+    passes; a schedule that does not pass is never reported, and the status is ``OPTIMAL``
+    only for a proven optimum that passed (see :func:`assembly_makespan`).
 
     Tool states as sequence-dependent setups: for a tool ``T``, a *setter* is a task that
     sets ``T`` and a *user* a task that requires a value of ``T``. Every setter is ordered
@@ -383,29 +391,56 @@ def min_makespan(
     model.add_max_equality(makespan, end)
     model.minimize(makespan)
 
-    # Solve.
-    solver = _solver(time_limit, workers, seed)
+    # Solve, replay, cut, until a schedule passes (or time runs out).
     t0 = time.perf_counter()
-    status = solver.solve(model)
-    wall = time.perf_counter() - t0
-    name, found = _status(solver, status)
-    objective = bound = None
     detail: dict = {"tasks": len(tasks), "scale": scale}
-    if found:
-        objective = solver.objective_value / scale
-        bound = solver.best_objective_bound / scale
+    prec: dict[tuple[int, int], object] = {}
+
+    def precedes(y: int, x: int):
+        if (y, x) not in prec:
+            lit = model.new_bool_var(f"prec_{tasks[y].id}_{tasks[x].id}")
+            model.add(end[y] <= start[x]).only_enforce_if(lit)
+            prec[y, x] = lit
+        return prec[y, x]
+
+    cuts = 0
+    while True:
+        left = time_limit - (time.perf_counter() - t0)
+        solver = _solver(max(left, 0.01), workers, seed)
+        status = solver.solve(model)
+        name, found = _status(solver, status)
+        objective = bound = None
         rows = []
-        for i, t in enumerate(tasks):
-            m = next(m for m, lit in enumerate(present[i]) if solver.boolean_value(lit))
-            rows.append(
-                {
-                    "task": t.id,
-                    "agent": t.modes[m][0],
-                    "start": _num(solver.value(start[i]) / scale),
-                    "end": _num(solver.value(end[i]) / scale),
-                }
-            )
-        rows.sort(key=lambda r: (r["start"], r["end"], r["task"]))
+        if found:
+            objective = solver.objective_value / scale
+            bound = solver.best_objective_bound / scale
+            for i, t in enumerate(tasks):
+                m = next(m for m, lit in enumerate(present[i]) if solver.boolean_value(lit))
+                rows.append(
+                    {
+                        "task": t.id,
+                        "agent": t.modes[m][0],
+                        "start": _num(solver.value(start[i]) / scale),
+                        "end": _num(solver.value(end[i]) / scale),
+                    }
+                )
+            rows.sort(key=lambda r: (r["start"], r["end"], r["task"]))
+        cut = replay(rows) if (found and replay is not None) else None
+        if cut is None:
+            break
+        cuts += 1
+        if not cut or time.perf_counter() - t0 >= time_limit:
+            # No cut left to add, or no time: the schedule found is not feasible.
+            name, objective, rows = "UNKNOWN", None, []
+            detail["replay"] = "no physically feasible schedule found within the time limit"
+            break
+        model.add_bool_or([precedes(y, x) for y, x in cut])
+    wall = time.perf_counter() - t0
+    if replay is not None:
+        detail["cuts"] = cuts
+        if rows:
+            detail["replay"] = "passed"
+    if rows:
         detail["schedule"] = rows
     return BaselineResult(
         kind="schedule",
@@ -603,3 +638,113 @@ def _topo(pred: list[set[int]]) -> list[int]:
         if b not in seen:
             visit(b)
     return order
+
+
+# --------------------------------------------------------------------------- physical replay
+
+
+def schedule_violation(model, rows: list[dict]) -> tuple[str, list[tuple[int, int]]] | None:
+    """Replay a schedule through the state graph; ``None`` if it is physically feasible.
+
+    The rule is the concurrent game's (:meth:`asp.concurrent.ConcurrentModel.compatible`):
+    at every start time ``t``, with ``D`` the operations ended by ``t`` and ``A`` those
+    running, every ``D + T`` (``T`` a subset of ``A``) is a state of the state graph from
+    which every other operation of ``A`` is a transition, and no two running operations
+    conflict on a tool. Equivalently: every order of placement consistent with the schedule
+    (``y`` before ``x`` whenever ``y`` ends by the time ``x`` starts) is a path of the state
+    graph, whichever of two overlapping operations finishes first.
+
+    Returns
+    -------
+    (message, cut) or None
+        ``message`` names the operation and the state it cannot follow; ``cut`` is a list of
+        ``(y, x)`` operation-index pairs of which every feasible schedule has at least one as
+        a precedence. With ``I`` the done set and ``b`` the operation that cannot follow it,
+        a feasible schedule never has ``I`` closed under precedence with ``b`` among the
+        first operations after it (the order ``I``, ``b`` would be a placement order), so some
+        operation outside ``I`` precedes one of ``I + {b}``.
+    """
+    ids = model.spec.op_ids
+    index = {oid: i for i, oid in enumerate(ids)}
+    start = {index[r["task"]]: float(r["start"]) for r in rows}
+    end = {index[r["task"]]: float(r["end"]) for r in rows}
+    n = len(ids)
+    if len(start) != n:
+        missing = [ids[i] for i in range(n) if i not in start]
+        return f"operation {missing[0]} is not scheduled", []
+    workers = {w.name for w in model.workers}
+    for r in rows:
+        if r["agent"] not in workers:
+            return f"operation {r['task']}: unknown agent {r['agent']!r}", []
+
+    def cut(done: set[int], b: int) -> list[tuple[int, int]]:
+        first = done | {b}
+        return [(y, x) for x in sorted(first) for y in range(n) if y not in done and y != x]
+
+    def name(done: set[int]) -> str:
+        return "{" + " ".join(ids[i] for i in sorted(done)) + "}" if done else "the start"
+
+    state, done = 0, set()
+    by_end = sorted(range(n), key=lambda i: (end[i], start[i]))
+    for t in sorted(set(start.values())):
+        for i in by_end:
+            if end[i] <= t and i not in done:
+                nxt = model.succ.get((state, i))
+                if nxt is None:
+                    return f"operation {ids[i]} cannot follow {name(done)}", cut(done, i)
+                state = nxt[0]
+                done.add(i)
+        running = sorted(i for i in range(n) if start[i] <= t < end[i])
+        for a in running:
+            for b in running:
+                if a < b and model.conflict[a, b]:
+                    return (
+                        f"operations {ids[a]} and {ids[b]} overlap but share a tool",
+                        [(a, b), (b, a)],
+                    )
+        reached = {0: (state, set(done))}
+        for mask in range(1 << len(running)):
+            cur, cur_done = reached[mask]
+            for k, b in enumerate(running):
+                if mask >> k & 1:
+                    continue
+                nxt = model.succ.get((cur, b))
+                if nxt is None:
+                    return f"operation {ids[b]} cannot follow {name(cur_done)}", cut(cur_done, b)
+                reached[mask | 1 << k] = (nxt[0], cur_done | {b})
+    for i in by_end:
+        if i not in done:
+            nxt = model.succ.get((state, i))
+            if nxt is None:
+                return f"operation {ids[i]} cannot follow {name(done)}", cut(done, i)
+            state = nxt[0]
+            done.add(i)
+    return None
+
+
+def assembly_makespan(
+    spec, graph, *, time_limit: float = 60.0, workers: int = 1, seed: int = 0
+) -> tuple[AssemblySchedule, BaselineResult]:
+    """The minimum-makespan schedule of an assembly that respects the state graph.
+
+    Exact by lazy cuts: CP-SAT solves the schedule with the precedences the state graph
+    implies (:func:`assembly_schedule`); each schedule is replayed through the state graph
+    (:func:`schedule_violation`, the concurrent game's rule); a schedule that fails adds
+    its cut and CP-SAT solves again. Cuts only remove infeasible schedules, so the first
+    proven optimum that passes is the optimum of the physically feasible schedules; the
+    status is ``OPTIMAL`` only then, ``FEASIBLE`` for a passing schedule found within the
+    time limit, else ``UNKNOWN`` with no schedule. ``detail`` holds ``cuts`` and ``replay``.
+    """
+    from asp.concurrent import concurrent_model
+
+    sched = assembly_schedule(spec, graph)
+    model = concurrent_model(spec, graph, step=None)
+
+    def replay(rows):
+        found = schedule_violation(model, rows)
+        return None if found is None else found[1]
+
+    result = min_makespan(
+        sched.problem, time_limit=time_limit, workers=workers, seed=seed, replay=replay
+    )
+    return sched, result

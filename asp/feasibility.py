@@ -3,7 +3,9 @@
 Geometry (``../shared/DESIGN.md``, "Directions and relations"): a part ``p`` placed into the
 assembled set ``S`` (not empty) is feasible iff
 
-- RTC: ``p`` touches some ``j`` in ``S`` (any direction);
+- RTC: ``p`` touches some ``j`` in ``S`` (any direction), or comes to rest on it: a part that
+  a short fall brings onto ``j`` (support, below, e.g. a shaft lying in a bore across its
+  clearance) touches it once settled;
 - RTT: some direction ``d`` is free, ``TT_d(p, j)`` for every ``j`` in ``S`` (``p`` is inserted
   along ``-d``);
 
@@ -11,14 +13,17 @@ and the enabled optimisation constraints hold (switches in the spec):
 
 - topological: the base part is placed first (every other part needs it in ``S``), and
   the explicit ``after`` predecessors are done;
-- stability: ``p`` rests on a part of ``S`` below it, ``TC_g(p, j)`` with ``g`` the gravity
-  direction (skipped for operations marked ``held``: an agent holds the part);
+- stability (support): ``p`` cannot fall, ``SP_g(p, j)`` for some ``j`` in ``S`` with ``g`` the
+  gravity direction: a short move along ``g`` would drive it into ``j``, or it is threaded on
+  ``j`` (:mod:`cad.support`; skipped for operations marked ``held``: an agent holds the part).
+  Relations without a support table (built by hand) fall back to contact along gravity,
+  ``TC_g(p, j)``;
 - functional: the free direction must be one the gripper approaches from
   (``gripper_approach``).
 
 Everything is precomputed as per-part bitmasks over the spec's parts (bit ``j`` = part ``j``):
 ``contact[p]`` (parts ``p`` touches), ``blocked[p, d]`` (parts that block ``p`` along ``d``),
-``support[p]`` (parts ``p`` rests on). With ``S`` a uint64 bitset the checks are
+``support[p]`` (parts that keep ``p`` from falling). With ``S`` a uint64 bitset the checks are
 ``S & contact != 0``, ``OR_d (S & blocked[d] == 0)`` and ``S & support != 0``.
 
 An assembly state packs the done operations (bit ``i`` = operation ``i``) and the tool
@@ -56,7 +61,7 @@ class InsertionOracle:
     blocked : (n, 6) uint64
         Parts that block each part's motion along each direction.
     support : (n,) uint64
-        Parts each part rests on (contact along gravity).
+        Parts that keep each part from falling (support along gravity).
     directions : (6,) bool
         Directions a part may be inserted from (all six unless functional is on).
     base : int
@@ -159,11 +164,13 @@ def insertion_oracle(spec: AssemblySpec, relations=None) -> InsertionOracle:
         rel_ids = tuple(str(x) for x in relations.parts)
         tc = np.asarray(relations.tc, dtype=bool)
         tt = np.asarray(relations.tt, dtype=bool)
+        sp = getattr(relations, "sp", None)
+        sp = tc if sp is None else np.asarray(sp, dtype=bool)
         m = len(rel_ids)
-        if tc.shape != (m, m, 6) or tt.shape != (m, m, 6):
+        if tc.shape != (m, m, 6) or tt.shape != (m, m, 6) or sp.shape != (m, m, 6):
             raise ValueError(
-                f"relations: expected tc and tt of shape ({m}, {m}, 6), got {tc.shape} and "
-                f"{tt.shape}"
+                f"relations: expected tc, tt and sp of shape ({m}, {m}, 6), got {tc.shape}, "
+                f"{tt.shape} and {sp.shape}"
             )
         needed = set(spec.placed_parts) | ({spec.base_part} if spec.base_part else set())
         missing = sorted(needed - set(rel_ids))
@@ -183,8 +190,9 @@ def insertion_oracle(spec: AssemblySpec, relations=None) -> InsertionOracle:
                     continue
                 if tc[ra, rb].any():
                     cmask |= weights[b]
-                if tc[ra, rb, g]:
+                if sp[ra, rb, g]:
                     smask |= weights[b]
+                    cmask |= weights[b]
                 for d in range(6):
                     if not tt[ra, rb, d]:
                         bmask[d] |= weights[b]

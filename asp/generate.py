@@ -28,7 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
-from asp.spec import SPEC_FILE, AssemblySpec, spec_from_dict
+from asp.spec import SPEC_FILE, AssemblySpec, load_spec, spec_from_dict
 
 HUMAN_BASE_S = 3.0
 HUMAN_S_PER_MM = 1.0 / 25.0
@@ -133,6 +133,24 @@ def spec_data(path: str | Path, spec_folder: str | Path | None = None) -> tuple[
         "operations": operations,
     }
     return data, assembly
+
+
+def is_cad_input(path: str | os.PathLike[str]) -> bool:
+    """True for a CAD scene file or a folder of part meshes without an ``assembly.yaml``."""
+    from cad.loading import MESH_SUFFIXES
+
+    path = Path(path)
+    if path.is_dir():
+        return not (path / SPEC_FILE).is_file() and any(
+            f.suffix.lower() in MESH_SUFFIXES for f in path.iterdir() if f.is_file()
+        )
+    return path.is_file() and path.suffix.lower() in MESH_SUFFIXES
+
+
+def load_any(path: str | os.PathLike[str]) -> AssemblySpec:
+    """The spec of ``path``: generated for a CAD file or a folder of part meshes without an
+    ``assembly.yaml`` (:func:`generated_spec`), else read (:func:`asp.spec.load_spec`)."""
+    return generated_spec(path) if is_cad_input(path) else load_spec(path)
 
 
 def generated_spec(path: str | Path) -> AssemblySpec:

@@ -42,8 +42,8 @@ Semantics:
 :func:`load_spec` validates everything and raises a one-line ``ValueError`` naming the
 file, the key and the offending operation or part. An unknown key is refused with the
 nearest known one suggested (``gravty`` -> ``gravity``); YAML aliases that expand past
-a limit are refused (:mod:`cad.yamlfile`). Given a CAD file or a folder of part meshes
-instead, it generates the spec (:mod:`asp.generate`). To add a top-level key, add it to
+a limit are refused (:mod:`cad.yamlfile`). For a CAD file or a folder of part meshes,
+:func:`asp.generate.load_any` generates the spec. To add a top-level key, add it to
 :data:`TOP_KEYS` and read it in ``_Parser.parse``.
 """
 
@@ -230,25 +230,11 @@ def resolve_spec_path(path: str | os.PathLike[str]) -> Path:
     return path
 
 
-def is_cad_input(path: str | os.PathLike[str]) -> bool:
-    """True for a CAD scene file or a folder of part meshes without an ``assembly.yaml``."""
-    from cad.loading import MESH_SUFFIXES
-
-    path = Path(path)
-    if path.is_dir():
-        return not (path / SPEC_FILE).is_file() and any(
-            f.suffix.lower() in MESH_SUFFIXES for f in path.iterdir() if f.is_file()
-        )
-    return path.is_file() and path.suffix.lower() in MESH_SUFFIXES
-
-
 def load_spec(path: str | os.PathLike[str]) -> AssemblySpec:
-    """Load and validate an assembly spec.
+    """Load and validate an assembly spec: a folder with ``assembly.yaml``, the YAML, a ``.IN2``.
 
-    ``path`` is a folder with ``assembly.yaml``, the YAML itself, a Scholl ``.IN2``, or a
-    CAD file (STEP, glTF/GLB, 3MF, 3DXML, a mesh) or folder of part meshes without a spec,
-    for which the spec is generated (:func:`asp.generate.generated_spec`,
-    ``spec.generated`` is True).
+    A CAD file or a folder of part meshes has no spec to load: see
+    :func:`asp.generate.generated_spec` (:func:`asp.generate.load_any` picks).
 
     Raises
     ------
@@ -259,13 +245,9 @@ def load_spec(path: str | os.PathLike[str]) -> AssemblySpec:
     """
     path = Path(path)
     if path.suffix.lower() == ".in2":
-        from asp.salbp import salbp_spec
+        from asp.readers.in2 import in2_assembly
 
-        return salbp_spec(path)
-    if is_cad_input(path):
-        from asp.generate import generated_spec
-
-        return generated_spec(path)
+        return spec_from_dict(in2_assembly(path), source=str(path))
     path = resolve_spec_path(path)
     data = read_yaml(path, what="assembly spec", decimals_as_text=True)
     return spec_from_dict(data, source=str(path))

@@ -76,6 +76,7 @@ def translational_freedom(
     penetration_tol: float | None = None,
     progress: bool = False,
     check: bool = True,
+    eroded: list[trimesh.Trimesh] | None = None,
 ) -> np.ndarray:
     """Translational freedom of every ordered pair of parts in every direction.
 
@@ -90,6 +91,8 @@ def translational_freedom(
         Show a progress bar over the pairs.
     check : bool
         First verify that no pair interpenetrates deeper than the tolerance.
+    eroded : list of trimesh.Trimesh, optional
+        The parts already eroded by their shrinks (:func:`eroded_meshes`).
 
     Returns
     -------
@@ -104,16 +107,42 @@ def translational_freedom(
         Two parts interpenetrate deeper than the tolerance (when ``check``).
     """
     tols = resolve_tolerances(assembly, None, penetration_tol)
-    eroded = eroded_meshes(assembly, tols.shrink)
+    if eroded is None:
+        eroded = eroded_meshes(assembly, tols.shrink)
     if check:
         check_interpenetration(assembly, penetration_tol=tols, eroded=eroded)
     n = len(assembly)
     blocked = np.zeros((n, n, 6), dtype=bool)
-    triangles = [np.asarray(m.triangles, dtype=float) for m in eroded]
+    for axis, a, b, front, back, bounds in facing_pairs(eroded, progress, "freedom"):
+        if bounds[b][1, axis] < bounds[a][0, axis]:
+            continue  # b lies entirely behind a
+        if sweep_blocked(front, back):
+            blocked[a, b, 2 * axis] = True
+            blocked[b, a, 2 * axis + 1] = True
+    tt = ~blocked
+    tt[np.arange(n), np.arange(n), :] = False
+    return tt
+
+
+def facing_pairs(meshes: list[trimesh.Trimesh], progress: bool, label: str):
+    """Ordered pairs of parts whose boxes overlap across an axis, with their facing faces.
+
+    Yields
+    ------
+    axis : int
+    a, b : int
+        Part indices (``a != b``); ``a`` moves along ``+axis`` towards ``b``.
+    front, back : FaceSet
+        Faces of ``a`` facing ``+axis`` and of ``b`` facing ``-axis``.
+    bounds : list of (2, 3) arrays
+        Bounds of every mesh.
+    """
+    n = len(meshes)
+    triangles = [np.asarray(m.triangles, dtype=float) for m in meshes]
     normals = [unit_normals(t) for t in triangles]
-    bounds = [np.asarray(m.bounds, dtype=float) for m in eroded]
+    bounds = [np.asarray(m.bounds, dtype=float) for m in meshes]
     pairs = [(a, b) for a in range(n) for b in range(n) if a != b]
-    bar = progress_bar(progress, 3 * len(pairs), "freedom")
+    bar = progress_bar(progress, 3 * len(pairs), label)
     for axis in range(3):
         sets = [
             axis_face_sets(t, nn, axis, _PARALLEL) for t, nn in zip(triangles, normals, strict=True)
@@ -121,20 +150,12 @@ def translational_freedom(
         others = ((axis + 1) % 3, (axis + 2) % 3)
         for a, b in pairs:
             bar.update(1)
-            if not bounds_overlap(bounds[a], bounds[b], axes=others):
-                continue
-            if bounds[b][1, axis] < bounds[a][0, axis]:
-                continue  # b lies entirely behind a
-            if sweep_blocked(sets[a][0], sets[b][1]):
-                blocked[a, b, 2 * axis] = True
-                blocked[b, a, 2 * axis + 1] = True
+            if bounds_overlap(bounds[a], bounds[b], axes=others):
+                yield axis, a, b, sets[a][0], sets[b][1], bounds
     bar.close()
-    tt = ~blocked
-    tt[np.arange(n), np.arange(n), :] = False
-    return tt
 
 
-def sweep_blocked(front: FaceSet, back: FaceSet) -> bool:
+def sweep_blocked(front: FaceSet, back: FaceSet, travel: float = np.inf) -> bool:
     """Whether faces ``front`` of a part sweeping along ``+axis`` meet faces ``back``.
 
     Parameters
@@ -143,16 +164,20 @@ def sweep_blocked(front: FaceSet, back: FaceSet) -> bool:
         Faces of the moving part that face ``+axis``.
     back : FaceSet
         Faces of the obstacle that face ``-axis``.
+    travel : float
+        Length of the move (default: to infinity). A finite travel ``t`` asks whether the
+        part meets the obstacle within ``t`` (the support test, :mod:`cad.support`).
 
     Returns
     -------
     bool
         True iff some pair has overlapping projections with the obstacle face at or ahead
-        of the moving face somewhere on the overlap.
+        of the moving face, by at most ``travel``, somewhere on the overlap (the height
+        difference is affine on the convex overlap, so its range there is an interval).
     """
-    front, back = crop_pair(front, back, 0.0, np.inf)
+    front, back = crop_pair(front, back, 0.0, travel)
     for ia, ib in box_pair_chunks(front.box, back.box):
-        ahead = back.hmax[ib] >= front.hmin[ia]
+        ahead = (back.hmax[ib] >= front.hmin[ia]) & (back.hmin[ib] - front.hmax[ia] <= travel)
         ia, ib = ia[ahead], ib[ahead]
         # likeliest blockers first: obstacle face wholly ahead of the moving face, and
         # boxes that overlap by a large share (long slivers crossing rarely overlap)
@@ -161,8 +186,8 @@ def sweep_blocked(front: FaceSet, back: FaceSet) -> bool:
         ia, ib = ia[order], ib[order]
         for start in range(0, len(ia), _CHUNK):
             sa, sb = ia[start : start + _CHUNK], ib[start : start + _CHUNK]
-            overlap, _, gap_max = height_gap_range(*front.take(sa), *back.take(sb))
-            if np.any(overlap & (gap_max >= 0.0)):
+            overlap, gap_min, gap_max = height_gap_range(*front.take(sa), *back.take(sb))
+            if np.any(overlap & (gap_max >= 0.0) & (gap_min <= travel)):
                 return True
     return False
 

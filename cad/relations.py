@@ -12,6 +12,7 @@ from cad.contact import contact_relation
 from cad.directions import DIRECTIONS
 from cad.freedom import check_interpenetration, eroded_meshes
 from cad.freedom import translational_freedom as _freedom
+from cad.support import support_relation
 from cad.tolerances import resolve_tolerances
 
 
@@ -38,6 +39,9 @@ class Relations:
         Source length unit of the assembly (tables do not depend on it).
     directions : tuple[str, ...]
         ``("+x", "-x", "+y", "-y", "+z", "-z")``.
+    sp : np.ndarray or None
+        Bool, shape ``(n, n, 6)``: ``sp[i, j, d]`` = part i falling along ``d`` is stopped
+        by part j (:mod:`cad.support`); None when not computed (tables built by hand).
     """
 
     parts: tuple[str, ...]
@@ -48,10 +52,13 @@ class Relations:
     units: str = "mm"
     part_shrink: tuple[float, ...] = ()
     directions: tuple[str, ...] = DIRECTIONS
+    sp: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         n = len(self.parts)
-        for name in ("tc", "tt"):
+        for name in ("tc", "tt", "sp"):
+            if getattr(self, name) is None:
+                continue
             table = np.asarray(getattr(self, name), dtype=bool)
             if table.shape != (n, n, 6):
                 raise ValueError(f"{name} must have shape ({n}, {n}, 6), got {table.shape}")
@@ -82,6 +89,7 @@ class Relations:
             "part_shrink_mm": list(self.part_shrink),
             "tc": self.tc.tolist(),
             "tt": self.tt.tolist(),
+            **({} if self.sp is None else {"sp": self.sp.tolist()}),
         }
 
 
@@ -92,7 +100,7 @@ def compute_relations(
     penetration_tol: float | None = None,
     progress: bool = False,
 ) -> Relations:
-    """Contact and translational freedom of an assembly.
+    """Contact, translational freedom and support of an assembly.
 
     Parameters
     ----------
@@ -110,7 +118,7 @@ def compute_relations(
     Returns
     -------
     Relations
-        ``tc`` and ``tt``, each shape ``(n, n, 6)``.
+        ``tc``, ``tt`` and ``sp`` (:mod:`cad.support`), each shape ``(n, n, 6)``.
 
     Raises
     ------
@@ -118,11 +126,11 @@ def compute_relations(
         Two parts interpenetrate deeper than the penetration tolerance.
     """
     tols = resolve_tolerances(assembly, contact_tol, penetration_tol)
-    check_interpenetration(
-        assembly, penetration_tol=tols, eroded=eroded_meshes(assembly, tols.shrink)
-    )
+    eroded = eroded_meshes(assembly, tols.shrink)
+    check_interpenetration(assembly, penetration_tol=tols, eroded=eroded)
     tc = contact_relation(assembly, penetration_tol=tols, progress=progress)
-    tt = _freedom(assembly, penetration_tol=tols, progress=progress, check=False)
+    tt = _freedom(assembly, penetration_tol=tols, progress=progress, check=False, eroded=eroded)
+    sp = support_relation(assembly, tols, eroded, tc, tt, progress=progress)
     return Relations(
         parts=assembly.ids,
         tc=tc,
@@ -131,6 +139,7 @@ def compute_relations(
         penetration_tol=tols.penetration,
         units=assembly.units,
         part_shrink=tuple(float(x) for x in tols.shrink),
+        sp=sp,
     )
 
 

@@ -45,6 +45,12 @@ ridge between two 100 mm parts is ignored), which is the price of accepting real
 An explicit ``penetration_tol`` (``--penetration-tol``) replaces the rule: every part then
 shrinks by ``penetration_tol / 2`` and every pair has exactly that tolerance.
 
+Support travel
+--------------
+A part is supported if a fall of ``3 x tol(i, j)`` (:data:`cad.support.SUPPORT_TRAVEL_FACTOR`)
+would drive it into a part already there (:mod:`cad.support`): it may stand on that part
+or hang in it across a clearance of up to ``2 x tol(i, j)``.
+
 Both tolerances are in millimetres whatever the source unit, because meshes are stored in
 mm; the same parts therefore give the same tables in any unit.
 """

@@ -20,12 +20,9 @@ from collections.abc import Sequence
 import numpy as np
 from matplotlib.figure import Figure
 
-from arl.plots import moving_average
+from arl.plots import MOVING_AVERAGE, rewards_png
 from asmplan.experiments.paper_values import paper_table3_row, paper_table4_row
 from asmplan.experiments.tasks import ResultRow
-
-MOVING_AVERAGE = 50
-ROBOT_COLOR, HUMAN_COLOR = "tab:blue", "tab:orange"
 
 
 def primary_rows(rows: Sequence[ResultRow]) -> list[ResultRow]:
@@ -62,27 +59,9 @@ def figure11_training(
     episode_rewards: dict[str, Sequence[float]], title: str = "", window: int = MOVING_AVERAGE
 ) -> bytes:
     """Figure 11: per-episode rewards of robot and human with moving averages."""
-    fig = Figure(figsize=(9, 4.8))
-    ax = fig.subplots()
-    for side, color in (("robot", ROBOT_COLOR), ("human", HUMAN_COLOR)):
-        values = np.asarray(episode_rewards.get(side, ()), dtype=np.float64)
-        if values.size == 0:
-            continue
-        episodes = np.arange(1, values.size + 1)
-        ax.plot(episodes, values, color=color, alpha=0.18, linewidth=0.6)
-        ax.plot(
-            episodes,
-            moving_average(values, window),
-            color=color,
-            linewidth=2,
-            label=f"{side.capitalize()} agent (MA {window})",
-        )
-    ax.set_xlabel("Episode")
-    ax.set_ylabel("Episode reward")
-    ax.set_title(title or "Training reward dynamics (ARL, alternating PPO)")
-    ax.grid(alpha=0.3)
-    ax.legend(loc="best")
-    return _png(fig)
+    return rewards_png(
+        episode_rewards, title or "Training reward dynamics (ARL, alternating PPO)", window
+    )
 
 
 def figure12_resilience(experiment: str, rows: Sequence[ResultRow]) -> bytes:

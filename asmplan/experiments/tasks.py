@@ -22,10 +22,12 @@ import os
 import platform
 import time
 from contextlib import contextmanager
-from dataclasses import asdict, dataclass, fields
+from dataclasses import asdict, dataclass, fields, make_dataclass
 from enum import StrEnum
 
 import numpy as np
+
+from asp.metrics import PlanMetrics
 
 EXPERIMENT_KEYS = {"table3": 3, "table4": 4}
 """Spawn-key component of each experiment (its table number in the paper)."""
@@ -171,56 +173,78 @@ def make_specs(
     ]
 
 
-@dataclass(frozen=True)
-class ResultRow:
-    """The metrics of one planner on one graph: a row of ``results.csv``.
+ROW_METRICS = (
+    "nodes",
+    "edges",
+    "tct",
+    "minimax",
+    "wcpl",
+    "certified_wcpl",
+    "robust_optimal",
+    "max_random",
+    "avg_random",
+    "rr",
+    "rr_certified",
+    "max_random_sampled",
+    "avg_random_sampled",
+    "rr_sampled",
+    "adversarial_tax",
+)
+"""The :class:`asp.metrics.PlanMetrics` fields a row carries, in ``results.csv`` order."""
 
+
+def _row_fields() -> list[tuple[str, object]]:
+    metric_types = {f.name: f.type for f in fields(PlanMetrics)}
+    identity = [
+        ("experiment", str),
+        ("config", str),
+        ("layers", int),
+        ("max_nodes", int),
+        ("max_actions", int),
+        ("trial", int),
+        ("graph_seed", int),
+        ("solver", str),
+    ]
+    training = [
+        ("converged", bool | None),
+        ("cycles", int | None),
+        ("timesteps", int | None),
+        ("train_s", float),
+    ]
+    return [*identity, *((name, metric_types[name]) for name in ROW_METRICS), *training]
+
+
+def _comparable(self) -> dict:
+    """The row without its timing fields: equal for equal specs on any backend."""
+    return {k: v for k, v in asdict(self).items() if k not in self.TIMING_FIELDS}
+
+
+def _field_names(cls) -> list[str]:
+    """Column names, in ``results.csv`` order."""
+    return [f.name for f in fields(cls)]
+
+
+ResultRow = make_dataclass(
+    "ResultRow",
+    _row_fields(),
+    frozen=True,
+    namespace={
+        "__module__": __name__,
+        "__doc__": """The metrics of one planner on one graph: a row of ``results.csv``.
+
+    The task's identity, then the :data:`ROW_METRICS` fields of
+    :class:`asp.metrics.PlanMetrics` (declared there once), then the training figures.
     ``wcpl`` is the paper's WCPL: learned robot against learned human for ``arl``, the
     minimax value W* for ``exact``. ``rr`` is the exact share of random-human games with
     cost <= ``wcpl`` (the paper's RR), ``rr_certified`` the share within the certified WCPL
     (1 by construction), ``*_sampled`` the paper's seeded 1,000-game simulation.
     ``train_s`` is the training (``arl``) or solving (``exact``) wall time.
-    """
-
-    experiment: str
-    config: str
-    layers: int
-    max_nodes: int
-    max_actions: int
-    trial: int
-    graph_seed: int
-    solver: str
-    nodes: int
-    edges: int
-    tct: float
-    minimax: float
-    wcpl: float
-    certified_wcpl: float
-    robust_optimal: bool
-    max_random: float
-    avg_random: float
-    rr: float
-    rr_certified: float
-    max_random_sampled: float
-    avg_random_sampled: float
-    rr_sampled: float
-    adversarial_tax: float
-    converged: bool | None
-    cycles: int | None
-    timesteps: int | None
-    train_s: float
-
-    TIMING_FIELDS = ("train_s",)
-    """Fields that vary from run to run; everything else is a function of the spec."""
-
-    def comparable(self) -> dict:
-        """The row without its timing fields: equal for equal specs on any backend."""
-        return {k: v for k, v in asdict(self).items() if k not in self.TIMING_FIELDS}
-
-    @classmethod
-    def field_names(cls) -> list[str]:
-        """Column names, in ``results.csv`` order."""
-        return [f.name for f in fields(cls)]
+    """,
+        "TIMING_FIELDS": ("train_s",),
+        "comparable": _comparable,
+        "field_names": classmethod(_field_names),
+    },
+)
 
 
 @dataclass(frozen=True)
@@ -369,21 +393,7 @@ def _row(spec, seeds, solver, m, *, train_s, converged=None, cycles=None, timest
         trial=spec.trial,
         graph_seed=seeds.graph,
         solver=solver,
-        nodes=m.nodes,
-        edges=m.edges,
-        tct=m.tct,
-        minimax=m.minimax,
-        wcpl=m.wcpl,
-        certified_wcpl=m.certified_wcpl,
-        robust_optimal=m.robust_optimal,
-        max_random=m.max_random,
-        avg_random=m.avg_random,
-        rr=m.rr,
-        rr_certified=m.rr_certified,
-        max_random_sampled=m.max_random_sampled,
-        avg_random_sampled=m.avg_random_sampled,
-        rr_sampled=m.rr_sampled,
-        adversarial_tax=m.adversarial_tax,
+        **{name: getattr(m, name) for name in ROW_METRICS},
         converged=converged,
         cycles=cycles,
         timesteps=timesteps,

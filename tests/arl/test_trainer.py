@@ -4,7 +4,6 @@ import json
 
 import numpy as np
 import pytest
-import torch
 
 from arl import evaluate, get_config, train
 from asmplan.cli.app import main
@@ -13,17 +12,9 @@ from asp.solve import solve
 from tests.arl.graphs import figure4, sided_time_dag
 
 # A smaller `fast` so that each cycle takes a few hundredths of a second.
+pytestmark = pytest.mark.usefixtures("deterministic_torch")
+
 TINY = get_config("fast").replace(name="tiny", n_envs=16, n_steps=16, phase_steps=256, max_cycles=3)
-
-
-@pytest.fixture(autouse=True)
-def _deterministic_torch():
-    threads = torch.get_num_threads()
-    torch.set_num_threads(1)
-    torch.use_deterministic_algorithms(True)
-    yield
-    torch.use_deterministic_algorithms(False)
-    torch.set_num_threads(threads)
 
 
 def _without_time(cycles):
@@ -115,10 +106,10 @@ def test_cli_train_and_evaluate(tmp_path, capsys):
 
 def test_trains_on_an_in2_assembly_with_time_costs(shared_data):
     from asp.game import game_dag
-    from asp.salbp import salbp_spec
+    from asp.spec import load_spec
     from asp.state_graph import build_state_graph
 
-    spec = salbp_spec(shared_data / "salbp" / "BOWMAN8.IN2")  # Bowman (1960), via Scholl
+    spec = load_spec(shared_data / "salbp" / "BOWMAN8.IN2")  # Bowman (1960), via Scholl
     dag = game_dag(build_state_graph(spec), cost="time")
     result = train(dag, TINY, seed=0)
     assert len(result.cycles) == TINY.max_cycles

@@ -72,4 +72,4 @@ def test_init_writes_a_spec_that_plans_the_same(tmp_path):
     for key in ("robust_plan", "tct", "minimax", "relations", "states", "sequences"):
         assert from_file[key] == from_spec[key], key
     again = CliRunner().invoke(app, ["init", str(STEP), "-o", str(spec)])
-    assert again.exit_code != 0 and "--force" in str(again.exception)
+    assert again.exit_code == 2 and "--force" in again.stderr

@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+from arl.plots import moving_average
 from asmplan.experiments import tasks as tasks_module
-from asmplan.experiments.figures import moving_average
 from asmplan.experiments.paper_values import (
     PAPER_TABLE3,
     PAPER_TABLE4,

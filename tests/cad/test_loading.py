@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from asmplan.cli.cad import load_geometry
+from asmplan.pipeline import part_geometry as load_geometry
 from cad import Assembly, compute_relations, load_assembly, read_bom
 from tests.cad import shapes
 

@@ -1,0 +1,65 @@
+"""``asmplan relations``: contact and translational-freedom tables of an assembly."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from asmplan.cli.app import TableFormat, app
+
+TOL_MAX_MM = 1_000.0
+
+
+@app.command("relations")
+def relations_command(
+    assembly: Path = typer.Argument(
+        ..., help="Folder of part meshes, multi-body scene (GLB/glTF/3MF/STEP) or assembly.yaml."
+    ),
+    fmt: TableFormat = typer.Option(TableFormat.text, "--format", help="Output format."),
+    contact_tol: float | None = typer.Option(
+        None,
+        "--contact-tol",
+        min=0.0,
+        max=TOL_MAX_MM,
+        help="Contact tolerance in mm (default 0.01).",
+    ),
+    penetration_tol: float | None = typer.Option(
+        None,
+        "--penetration-tol",
+        min=0.0,
+        max=TOL_MAX_MM,
+        help="Penetration tolerance in mm for every pair (default: per part, scaled with its "
+        "size and thickness, see cad/tolerances.py; a pair gets the sum, at most 0.5 mm).",
+    ),
+    units: str | None = typer.Option(
+        None, "--units", help="Unit of mesh files that declare none (default mm)."
+    ),
+    progress: bool = typer.Option(False, "--progress", help="Show progress on stderr."),
+) -> None:
+    """Compute TC (contact) and TT (translational freedom) for every pair of parts.
+
+    A folder with an assembly.yaml is read through it (its parts, files and units).
+    """
+    from asmplan.pipeline import part_relations
+    from asmplan.report.relations import (
+        relations_csv,
+        relations_json,
+        relations_markdown,
+        relations_text,
+    )
+
+    relations = part_relations(
+        assembly,
+        units=units,
+        contact_tol=contact_tol,
+        penetration_tol=penetration_tol,
+        progress=progress,
+    )
+    render = {
+        TableFormat.text: relations_text,
+        TableFormat.json: relations_json,
+        TableFormat.csv: relations_csv,
+        TableFormat.markdown: relations_markdown,
+    }[fmt]
+    typer.echo(render(relations), nl=False)
