@@ -18,6 +18,7 @@ An ``assembly.yaml`` names everything the planner needs besides the part geometr
     constraints: {topological: true, stability: true, functional: true}
     turn_model: alternate
     cost: steps                        # or time
+    max_states: 20000000               # state graph limit (asmplan plan --max-states)
     operations:
       - id: "1.2"                      # ids are strings (1.10 stays "1.10")
         description: Replace hex bit with cross bit on R1
@@ -66,7 +67,7 @@ CONSTRAINT_KEYS = ("topological", "stability", "functional")
 SPEC_FILE = "assembly.yaml"
 TOP_KEYS = (
     "name", "units", "parts", "agents", "tools", "base_part", "gravity", "gripper_approach",
-    "constraints", "turn_model", "cost", "operations", "credit",
+    "constraints", "turn_model", "cost", "operations", "credit", "max_states",
 )  # fmt: skip
 """The top-level keys of ``assembly.yaml``; any other is refused."""
 OPERATION_KEYS = (
@@ -163,6 +164,7 @@ class AssemblySpec:
     source: str = ""
     units: str | None = None
     credit: str = ""
+    max_states: int | None = None
     generated: bool = False
 
     @property
@@ -345,6 +347,11 @@ class _Parser:
         cost = str(data.get("cost", "steps"))
         if cost not in COST_MODELS:
             raise self.fail("cost", f"expected 'steps' or 'time', got {cost!r}")
+        max_states = data.get("max_states")
+        if max_states is not None and (
+            isinstance(max_states, bool) or not isinstance(max_states, int) or max_states < 1
+        ):
+            raise self.fail("max_states", f"expected a positive integer, got {max_states!r}")
         return AssemblySpec(
             name=str(data.get("name") or Path(self.source).parent.name or "assembly"),
             operations=ops,
@@ -360,6 +367,7 @@ class _Parser:
             source=self.source,
             units=None if units is None else str(units),
             credit=str(data.get("credit", "")),
+            max_states=max_states,
         )
 
     def parts(self, raw) -> tuple[Part, ...]:
