@@ -59,6 +59,9 @@ def plan_command(
         30.0, "--time-limit", min=0.001, max=TIME_LIMIT_MAX, help="CP-SAT time limit, seconds."
     ),
     seed: int = typer.Option(0, "--seed", min=0, max=SEED_MAX, help="CP-SAT random seed."),
+    max_states: int | None = typer.Option(
+        None, "--max-states", min=1, help="State graph limit (default: spec's, else 20,000,000)."
+    ),
 ) -> None:
     """Plan an assembly end to end: relations, state graph, game, robust plan, CP-SAT."""
     from asmplan import pipeline
@@ -71,6 +74,7 @@ def plan_command(
         time_limit=time_limit,
         seed=seed,
         on_step=say,
+        max_states=max_states,
     )
     for line in plan_summary(result):
         typer.echo(line)
