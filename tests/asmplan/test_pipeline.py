@@ -58,7 +58,10 @@ def test_relations_of_a_folder_read_its_assembly_yaml(tmp_path):
     plain = pipeline.part_relations(folder)
     files = sorted(p.name for p in folder.iterdir() if p.suffix == ".stl")
     parts = "\n".join(f"  - {{id: P{k}, file: {name}}}" for k, name in enumerate(files))
-    (folder / "assembly.yaml").write_text(f"units: mm\nparts:\n{parts}\n")
+    ops = "\n".join(f"  - {{id: '{k}', agents: {{H: 1}}, part: P{k}}}" for k in range(len(files)))
+    (folder / "assembly.yaml").write_text(
+        f"units: mm\nparts:\n{parts}\nagents: {{H: {{side: human}}}}\noperations:\n{ops}\n"
+    )
     through_yaml = pipeline.part_relations(folder)
     assert through_yaml.parts == tuple(f"P{k}" for k in range(len(files)))
     assert len(plain.parts) == len(through_yaml.parts)
