@@ -238,9 +238,9 @@ def load_spec(path: str | os.PathLike[str]) -> AssemblySpec:
     """
     path = Path(path)
     if path.suffix.lower() == ".in2":
-        from asp.salbp import salbp_spec
+        from asp.readers.in2 import in2_assembly
 
-        return salbp_spec(path)
+        return spec_from_dict(in2_assembly(path), source=str(path))
     path = resolve_spec_path(path)
     try:
         data = yaml.load(path.read_text(encoding="utf-8"), Loader=_Loader)

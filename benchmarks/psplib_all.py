@@ -13,7 +13,7 @@ import csv
 from pathlib import Path
 
 from asp.baseline import min_makespan
-from asp.psplib import read_sm
+from asp.readers.sm import read_sm
 
 DEFAULT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "psplib_j30"
 

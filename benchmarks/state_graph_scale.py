@@ -21,9 +21,8 @@ import time
 from pathlib import Path
 
 from asp.game import game_dag
-from asp.salbp import salbp_spec
 from asp.solve import solve
-from asp.spec import Agent, AssemblySpec, Constraints, Operation
+from asp.spec import Agent, AssemblySpec, Constraints, Operation, load_spec
 from asp.state_graph import build_state_graph
 from asp.synth import synthetic_dag
 
@@ -75,7 +74,7 @@ def main(folder: Path = DEFAULT) -> None:
     )
     print(header)
     print("-" * len(header))
-    for spec in [*(salbp_spec(path) for path in files), random_spec()]:
+    for spec in [*(load_spec(path) for path in files), random_spec()]:
         t0 = time.perf_counter()
         graph = build_state_graph(spec)
         t1 = time.perf_counter()

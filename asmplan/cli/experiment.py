@@ -8,6 +8,9 @@ from pathlib import Path
 import typer
 
 from asmplan.cli.app import app, fail
+from asmplan.cli.options import GAMES_MAX, SEED_MAX, WORKERS_MAX
+
+TRIALS_MAX = 10_000
 
 
 class SolverChoice(StrEnum):
@@ -69,14 +72,19 @@ def experiment_command(
         None, "--output", "-o", help="Output folder (default results/t3 or results/t4)."
     ),
     trials: int | None = typer.Option(
-        None, "--trials", help="Graphs per configuration (default: 1 for table3, 10 for table4)."
+        None,
+        "--trials",
+        max=TRIALS_MAX,
+        help="Graphs per configuration (default: 1 for table3, 10 for table4).",
     ),
     solver: SolverChoice = typer.Option(
         SolverChoice.both,
         "--solver",
         help="exact minimax, ARL, or both (ARL with exact beside it).",
     ),
-    seed: int = typer.Option(0, "--seed", help="Base seed; each task derives its own from it."),
+    seed: int = typer.Option(
+        0, "--seed", min=0, max=SEED_MAX, help="Base seed; each task derives its own from it."
+    ),
     config: ConfigChoice = typer.Option(ConfigChoice.paper, "--config", help="ARL configuration."),
     backend: BackendChoice = typer.Option(
         BackendChoice.local, "--backend", help="local process pool or Ray."
@@ -87,11 +95,17 @@ def experiment_command(
         help="Ray cluster: auto (started with `ray start`), host:port, or local (a private one).",
     ),
     workers: int | None = typer.Option(
-        None, "--workers", help="Parallel tasks (default: all cores; 1 runs in this process)."
+        None,
+        "--workers",
+        min=1,
+        max=WORKERS_MAX,
+        help="Parallel tasks (default: all cores; 1 runs in this process).",
     ),
-    games: int = typer.Option(1000, "--games", help="Games of the random-human simulation."),
+    games: int = typer.Option(
+        1000, "--games", min=1, max=GAMES_MAX, help="Games of the random-human simulation."
+    ),
     curve_trial: int = typer.Option(
-        1, "--curve-trial", help="Trial whose ARL curves make Figure 11."
+        1, "--curve-trial", min=1, max=TRIALS_MAX, help="Trial whose ARL curves make Figure 11."
     ),
     progress: bool = typer.Option(True, "--progress/--no-progress", help="Show a progress bar."),
 ) -> None:

@@ -8,14 +8,13 @@ person types a move number (``?`` help, ``q`` quit); end of input quits cleanly 
 from __future__ import annotations
 
 import sys
-from enum import StrEnum
 from pathlib import Path
 
 import typer
 
-from asmplan.cli.app import app
-
-GRAPH_SUFFIXES = (".json", ".graphml", ".xml")
+from asmplan.cli.app import app, choices
+from asmplan.cli.options import SEED_MAX, CostModel
+from asp.dag import SIDE_NAMES
 
 HELP_TEXT = """\
 How to play
@@ -27,41 +26,7 @@ How to play
   as much as possible. 'coop' = the total if both sides cooperate from there on."""
 
 
-class Side(StrEnum):
-    """The side the person plays."""
-
-    human = "human"
-    robot = "robot"
-
-
-class CostModel(StrEnum):
-    steps = "steps"
-    time = "time"
-
-
-def load_game(source: Path, cost: str | None = None):
-    """The game DAG of ``source`` and its operation descriptions.
-
-    ``source`` is a game DAG file (``.json``/``.graphml``) or an assembly (a folder with
-    ``assembly.yaml``, the YAML, or a ``.IN2``), loaded as ``asmplan solve`` / ``asmplan
-    plan`` load them.
-    """
-    if not source.exists():
-        raise FileNotFoundError(f"{source}: no such file or folder")
-    if source.is_file() and source.suffix.lower() in GRAPH_SUFFIXES:
-        from asp.io import load_dag
-
-        if cost is not None:
-            raise ValueError("--cost applies to assemblies only: a graph file has its costs")
-        return load_dag(source), {}
-    from asmplan.cli.assembly import _load
-    from asp.game import game_dag
-    from asp.state_graph import build_state_graph
-
-    spec, relations = _load(source, progress=False)
-    graph = build_state_graph(spec, relations)
-    dag = game_dag(graph, cost=cost)
-    return dag, {op.id: op.description for op in spec.operations}
+Side = choices("Side", SIDE_NAMES[:2], "The side the person plays.")
 
 
 def _robot_policy(dag, robot: str):
@@ -170,18 +135,24 @@ def play_command(
         None, "--moves", help="Scripted move numbers, e.g. 2,1,3 (then reads stdin)."
     ),
     seed: int | None = typer.Option(
-        None, "--seed", help="Break the computer human's ties at random with this seed."
+        None,
+        "--seed",
+        min=0,
+        max=SEED_MAX,
+        help="Break the computer human's ties at random with this seed.",
     ),
     cost: CostModel | None = typer.Option(
         None, "--cost", help="Cost model of an assembly (default: the spec's)."
     ),
 ) -> None:
     """Play against the robust plan: you take one side, the computer the other."""
+    from asmplan.pipeline import load_game
     from asp.dag import HUMAN, ROBOT
     from asp.play import GameSession, fmt
 
     script = _parse_moves(moves)
-    dag, descriptions = load_game(source, None if cost is None else cost.value)
+    game = load_game(source, cost=None if cost is None else cost.value)
+    dag, descriptions = game.dag, game.descriptions
     person = HUMAN if side is Side.human else ROBOT
     if person == ROBOT and robot != "robust":
         raise ValueError("--robot applies when you play the human (--as human)")

@@ -106,10 +106,10 @@ def test_cli_train_and_evaluate(tmp_path, capsys):
 
 def test_trains_on_an_in2_assembly_with_time_costs(shared_data):
     from asp.game import game_dag
-    from asp.salbp import salbp_spec
+    from asp.spec import load_spec
     from asp.state_graph import build_state_graph
 
-    spec = salbp_spec(shared_data / "salbp" / "BOWMAN8.IN2")  # Bowman (1960), via Scholl
+    spec = load_spec(shared_data / "salbp" / "BOWMAN8.IN2")  # Bowman (1960), via Scholl
     dag = game_dag(build_state_graph(spec), cost="time")
     result = train(dag, TINY, seed=0)
     assert len(result.cycles) == TINY.max_cycles

@@ -8,10 +8,9 @@ import json
 import pytest
 from typer.testing import CliRunner
 
-import asmplan.cli.assembly  # noqa: F401  registers the commands
-from asmplan.cli.app import app
+from asmplan.cli import app
 from asp.baseline import min_makespan
-from asp.psplib import read_sm
+from asp.readers.sm import read_sm
 
 
 def optimum(shared_data, name):

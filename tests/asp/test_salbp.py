@@ -7,7 +7,7 @@ import json
 import pytest
 
 from asp.game import game_dag
-from asp.salbp import read_in2, salbp_spec
+from asp.readers.in2 import read_in2
 from asp.solve import solve
 from asp.spec import load_spec
 from asp.state_graph import build_state_graph
@@ -42,7 +42,7 @@ def test_state_graph_sizes_and_tct(shared_data, name):
 def test_counts_match_brute_force(shared_data, name):
     inst = read_in2(shared_data / "salbp" / f"{name}.IN2")
     pairs = [(i - 1, j - 1) for i, j in inst.precedences]
-    graph = build_state_graph(salbp_spec(shared_data / "salbp" / f"{name}.IN2"))
+    graph = build_state_graph(load_spec(shared_data / "salbp" / f"{name}.IN2"))
     assert graph.n_states == brute_force_downsets(inst.n_tasks, pairs)
     if inst.n_tasks <= 8:
         assert graph.count_sequences() == brute_force_sequences(inst.n_tasks, pairs)
@@ -52,7 +52,7 @@ def test_reader_details(shared_data):
     inst = read_in2(shared_data / "salbp" / "JACKSON.IN2")
     assert inst.times == (6, 2, 5, 7, 1, 2, 3, 6, 5, 5, 4)
     assert inst.precedences[:3] == ((1, 2), (1, 3), (1, 4))
-    spec = salbp_spec(shared_data / "salbp" / "JACKSON.IN2")
+    spec = load_spec(shared_data / "salbp" / "JACKSON.IN2")
     assert spec.operation("7").after == ("3", "4", "5")
     assert spec.agents[0].side == "any" and "Scholl (1993)" in spec.credit
 
@@ -72,7 +72,7 @@ def test_reader_errors(tmp_path, text, message):
     path = tmp_path / "BAD.IN2"
     path.write_text(text)
     with pytest.raises(ValueError, match=message):
-        salbp_spec(path)
+        load_spec(path)
 
 
 def test_text_after_end_mark_is_ignored(tmp_path):

@@ -8,8 +8,7 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-import asmplan.cli.assembly  # noqa: F401  registers the commands
-from asmplan.cli.app import app, main
+from asmplan.cli import app, main
 from asp.baseline import assembly_schedule, min_cost_path, min_makespan
 from asp.feasibility import load_relations
 from asp.game import game_dag

@@ -1,6 +1,7 @@
 """Drawing a game DAG: nodes laid out by layer, edges coloured by agent, a path highlighted.
 
-matplotlib is imported lazily with the Agg backend; the PNG is written atomically.
+matplotlib is imported lazily and used without pyplot (no global backend is set, no figure
+is left open); the PNG is written atomically.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ import numpy as np
 
 from asp.atomic import write_bytes
 from asp.dag import GameDAG
+from asp.errors import GraphError
 from asp.solve import node_order
 
 AGENT_COLOURS = {"H": "#9e9e9e", "R1": "#2e9d4a", "R2": "#f28c28"}
@@ -47,12 +49,9 @@ def plot_dag(
         More than :data:`MAX_PLOT_NODES` nodes (the drawing would be unreadable).
     """
     if dag.n_nodes > MAX_PLOT_NODES:
-        raise ValueError(f"plot: {dag.n_nodes} nodes, at most {MAX_PLOT_NODES} can be drawn")
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+        raise GraphError(f"plot: {dag.n_nodes} nodes, at most {MAX_PLOT_NODES} can be drawn")
     from matplotlib.collections import LineCollection
+    from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
 
     layer = node_layers(dag)
@@ -69,7 +68,8 @@ def plot_dag(
 
     width = max(8.0, 0.45 * (layer.max() + 1))
     height = max(4.0, 0.35 * (np.bincount(layer).max() + 1))
-    fig, ax = plt.subplots(figsize=(min(width, 40), min(height, 30)), dpi=110)
+    fig = Figure(figsize=(min(width, 40), min(height, 30)), dpi=110)
+    ax = fig.subplots()
     segments = np.stack(
         [np.column_stack([x[src], y[src]]), np.column_stack([x[dag.targets], y[dag.targets]])],
         axis=1,
@@ -96,5 +96,4 @@ def plot_dag(
     fig.tight_layout()
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png")
-    plt.close(fig)
     return write_bytes(path, buffer.getvalue())

@@ -5,7 +5,9 @@ task times, then direct precedence relations ``i,j`` (tasks numbered from 1), an
 optional end mark ``-1,-1``; anything after the end mark is ignored.
 
 Each task becomes an operation open to either side: one agent ``any`` (side ``any``) whose
-duration is the task time. In the game either player may take it; in the CP-SAT schedule
+duration is the task time. :func:`in2_assembly` gives the ``assembly.yaml`` mapping of a
+file, which :func:`asp.spec.load_spec` validates like any other spec (so this reader does not
+depend on the spec model). In the game either player may take it; in the CP-SAT schedule
 the ``any`` agent stands for one worker of each side working in parallel.
 
 Data: Scholl, A. (1993), *Data of Assembly Line Balancing Problems*, TH Darmstadt.
@@ -17,7 +19,7 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-from asp.spec import Agent, AssemblySpec, Constraints, Operation, check_predecessors
+from asp.errors import FormatError
 
 CREDIT = "Precedence graph from Scholl (1993), Data of Assembly Line Balancing Problems"
 
@@ -55,7 +57,7 @@ def read_in2(path: str | os.PathLike[str]) -> SalbpInstance:
         while pos < len(lines) and not lines[pos]:
             pos += 1
         if pos >= len(lines):
-            raise ValueError(f"{path}: unexpected end of file")
+            raise FormatError(f"{path}: unexpected end of file")
         pos += 1
         return pos, lines[pos - 1]
 
@@ -63,20 +65,22 @@ def read_in2(path: str | os.PathLike[str]) -> SalbpInstance:
     try:
         n = int(text)
     except ValueError:
-        raise ValueError(
+        raise FormatError(
             f"{path}: line {lineno}: expected the number of tasks, got {text!r}"
         ) from None
     if n < 1:
-        raise ValueError(f"{path}: line {lineno}: expected a positive number of tasks, got {n}")
+        raise FormatError(f"{path}: line {lineno}: expected a positive number of tasks, got {n}")
     times = []
     for _ in range(n):
         lineno, text = next_line()
         try:
             t = int(text)
         except ValueError:
-            raise ValueError(f"{path}: line {lineno}: expected a task time, got {text!r}") from None
+            raise FormatError(
+                f"{path}: line {lineno}: expected a task time, got {text!r}"
+            ) from None
         if t < 0:
-            raise ValueError(f"{path}: line {lineno}: negative task time {t}")
+            raise FormatError(f"{path}: line {lineno}: negative task time {t}")
         times.append(t)
     pairs = []
     while pos < len(lines):
@@ -88,43 +92,42 @@ def read_in2(path: str | os.PathLike[str]) -> SalbpInstance:
         try:
             i, j = (int(x) for x in fields)
         except ValueError:
-            raise ValueError(f"{path}: line {lineno}: expected 'i,j', got {text!r}") from None
+            raise FormatError(f"{path}: line {lineno}: expected 'i,j', got {text!r}") from None
         if (i, j) == (-1, -1):
             break
         for x in (i, j):
             if not 1 <= x <= n:
-                raise ValueError(f"{path}: line {lineno}: task {x} is not in 1..{n}")
+                raise FormatError(f"{path}: line {lineno}: task {x} is not in 1..{n}")
         if i == j:
-            raise ValueError(f"{path}: line {lineno}: task {i} precedes itself")
+            raise FormatError(f"{path}: line {lineno}: task {i} precedes itself")
         pairs.append((i, j))
     return SalbpInstance(name=path.stem, times=tuple(times), precedences=tuple(pairs))
 
 
-def salbp_spec(path: str | os.PathLike[str]) -> AssemblySpec:
-    """The assembly specification of a ``.IN2`` file: task ``k`` is operation ``"k"``.
+def in2_assembly(path: str | os.PathLike[str]) -> dict:
+    """The ``assembly.yaml`` mapping of a ``.IN2`` file: task ``k`` is operation ``"k"``.
 
-    One agent ``any`` (side ``any``) may do every task, in its task time. No parts, no tools.
+    One agent ``any`` (side ``any``) may do every task, in its task time. No parts, no tools;
+    only the topological constraint applies. Validate it with :func:`asp.spec.spec_from_dict`
+    (``asp.spec.load_spec`` does both).
     """
     inst = read_in2(path)
     preds: dict[int, list[int]] = {k: [] for k in range(1, inst.n_tasks + 1)}
     for i, j in inst.precedences:
         if i not in preds[j]:
             preds[j].append(i)
-    ops = tuple(
-        Operation(
-            id=str(k),
-            description=f"task {k}",
-            durations=(("any", float(inst.times[k - 1])),),
-            after=tuple(str(i) for i in preds[k]),
-        )
-        for k in range(1, inst.n_tasks + 1)
-    )
-    check_predecessors(ops, str(path))
-    return AssemblySpec(
-        name=inst.name,
-        operations=ops,
-        agents=(Agent("any", "any", "either side"),),
-        constraints=Constraints(topological=True, stability=False, functional=False),
-        source=str(path),
-        credit=CREDIT,
-    )
+    return {
+        "name": inst.name,
+        "agents": {"any": {"side": "any", "description": "either side"}},
+        "constraints": {"topological": True, "stability": False, "functional": False},
+        "operations": [
+            {
+                "id": str(k),
+                "description": f"task {k}",
+                "agents": {"any": float(inst.times[k - 1])},
+                "after": [str(i) for i in preds[k]],
+            }
+            for k in range(1, inst.n_tasks + 1)
+        ],
+        "credit": CREDIT,
+    }

@@ -8,6 +8,8 @@ import typer
 
 from asmplan.cli.app import TableFormat, app
 
+TOL_MAX_MM = 1_000.0
+
 
 @app.command("relations")
 def relations_command(
@@ -16,11 +18,17 @@ def relations_command(
     ),
     fmt: TableFormat = typer.Option(TableFormat.text, "--format", help="Output format."),
     contact_tol: float | None = typer.Option(
-        None, "--contact-tol", help="Contact tolerance in mm (default 0.01)."
+        None,
+        "--contact-tol",
+        min=0.0,
+        max=TOL_MAX_MM,
+        help="Contact tolerance in mm (default 0.01).",
     ),
     penetration_tol: float | None = typer.Option(
         None,
         "--penetration-tol",
+        min=0.0,
+        max=TOL_MAX_MM,
         help="Penetration tolerance in mm for every pair (default: per part, scaled with its "
         "size and thickness, see cad/tolerances.py; a pair gets the sum, at most 0.5 mm).",
     ),
@@ -29,13 +37,24 @@ def relations_command(
     ),
     progress: bool = typer.Option(False, "--progress", help="Show progress on stderr."),
 ) -> None:
-    """Compute TC (contact) and TT (translational freedom) for every pair of parts."""
-    from cad import compute_relations, load_assembly
-    from cad.report import relations_csv, relations_json, relations_markdown, relations_text
+    """Compute TC (contact) and TT (translational freedom) for every pair of parts.
 
-    loaded = load_assembly(assembly, units=units)
-    relations = compute_relations(
-        loaded, contact_tol=contact_tol, penetration_tol=penetration_tol, progress=progress
+    A folder with an assembly.yaml is read through it (its parts, files and units).
+    """
+    from asmplan.pipeline import part_relations
+    from asmplan.report.relations import (
+        relations_csv,
+        relations_json,
+        relations_markdown,
+        relations_text,
+    )
+
+    relations = part_relations(
+        assembly,
+        units=units,
+        contact_tol=contact_tol,
+        penetration_tol=penetration_tol,
+        progress=progress,
     )
     render = {
         TableFormat.text: relations_text,

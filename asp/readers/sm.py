@@ -16,6 +16,7 @@ import re
 from pathlib import Path
 
 from asp.baseline import ScheduleProblem, Task
+from asp.errors import FormatError
 
 CREDIT = "PSPLIB instance (Kolisch and Sprecher 1996, European J. Operational Research 96)"
 
@@ -31,7 +32,7 @@ def read_sm(path: str | os.PathLike[str]) -> ScheduleProblem:
         for k, line in enumerate(lines):
             if line.strip().upper().startswith(title):
                 return k
-        raise ValueError(f"{path}: missing section {title!r}: is this a PSPLIB .sm file?")
+        raise FormatError(f"{path}: missing section {title!r}: is this a PSPLIB .sm file?")
 
     def rows_after(start: int, skip: int) -> list[list[int]]:
         out = []
@@ -43,7 +44,7 @@ def read_sm(path: str | os.PathLike[str]) -> ScheduleProblem:
             try:
                 out.append([int(x) for x in line.split()])
             except ValueError:
-                raise ValueError(f"{path}: unexpected line {line.strip()!r}") from None
+                raise FormatError(f"{path}: unexpected line {line.strip()!r}") from None
         return out
 
     n_jobs = None
@@ -59,19 +60,19 @@ def read_sm(path: str | os.PathLike[str]) -> ScheduleProblem:
     capacities = [int(x) for x in lines[k + 2].split()]
     n = len(prec)
     if n_jobs is not None and n != n_jobs:
-        raise ValueError(f"{path}: PRECEDENCE RELATIONS: expected {n_jobs} jobs, found {n}")
+        raise FormatError(f"{path}: PRECEDENCE RELATIONS: expected {n_jobs} jobs, found {n}")
     if len(reqs) != n:
-        raise ValueError(f"{path}: REQUESTS/DURATIONS: expected {n} jobs, found {len(reqs)}")
+        raise FormatError(f"{path}: REQUESTS/DURATIONS: expected {n} jobs, found {len(reqs)}")
     if len(capacities) != len(names):
-        raise ValueError(f"{path}: RESOURCEAVAILABILITIES: expected {len(names)} capacities")
+        raise FormatError(f"{path}: RESOURCEAVAILABILITIES: expected {len(names)} capacities")
     renewable = [i for i, name in enumerate(names) if name.startswith("R")]
     tasks = []
     for row in reqs:
         job, mode, duration, *demand = row
         if mode != 1:
-            raise ValueError(f"{path}: job {job} has mode {mode}: only single-mode is supported")
+            raise FormatError(f"{path}: job {job} has mode {mode}: only single-mode is supported")
         if len(demand) != len(names):
-            raise ValueError(f"{path}: job {job}: expected {len(names)} resource demands")
+            raise FormatError(f"{path}: job {job}: expected {len(names)} resource demands")
         tasks.append(
             Task(
                 id=str(job),
@@ -84,10 +85,10 @@ def read_sm(path: str | os.PathLike[str]) -> ScheduleProblem:
     for row in prec:
         job, _modes, count, *succ = row
         if len(succ) != count:
-            raise ValueError(f"{path}: job {job}: expected {count} successors, got {len(succ)}")
+            raise FormatError(f"{path}: job {job}: expected {count} successors, got {len(succ)}")
         for s in succ:
             if not 1 <= s <= n:
-                raise ValueError(f"{path}: job {job}: unknown successor {s}")
+                raise FormatError(f"{path}: job {job}: unknown successor {s}")
             precedences.append((job - 1, s - 1))
     return ScheduleProblem(
         name=path.name,

@@ -7,8 +7,7 @@ import json
 import pytest
 from typer.testing import CliRunner
 
-import asmplan.cli.cad  # noqa: F401  registers the command
-from asmplan.cli.app import app, main
+from asmplan.cli import app, main
 from tests.cad import shapes
 from tests.cad.test_loading import write_folder
 

@@ -1,0 +1,53 @@
+"""Option ranges and choices shared by the commands (derived from the domain, never copied).
+
+Every numeric option has a range: a value outside it is the one-line usage error
+``asmplan: error: Invalid value for '--seed': ...`` and exit 2.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import typer
+
+from asmplan.cli.app import choices
+from asp.spec import COST_MODELS
+
+SEED_MAX = 2**32 - 1
+"""Seeds are 32-bit: numpy, torch and CP-SAT all accept them."""
+GAMES_MAX = 10_000_000
+"""Simulated random-human games per evaluation (memory grows with the count)."""
+TIME_LIMIT_MAX = 86_400.0
+"""CP-SAT time limit: at most a day."""
+WORKERS_MAX = 1_024
+
+CostModel = choices("CostModel", COST_MODELS, "Cost of a move.")
+
+
+def finite_or_none(value: float | None) -> float | None:
+    """Typer callback: a float option must be a finite number >= 0 (``nan``, ``inf`` fail)."""
+    if value is not None and not (math.isfinite(value) and value >= 0):
+        raise typer.BadParameter(f"expected a finite number >= 0, got {value}")
+    return value
+
+
+def check_output(path: Path | None, *, folder: bool) -> None:
+    """Fail before any work when ``path`` cannot be written (a command's ``--output``).
+
+    Raises ``NotADirectoryError``/``IsADirectoryError`` naming the path: a folder wanted
+    where a file is, a file wanted where a folder is, or a file on the way to either.
+    """
+    if path is None:
+        return
+    if path.exists():
+        if folder and not path.is_dir():
+            raise NotADirectoryError(f"{path}: --output exists and is not a folder")
+        if not folder and path.is_dir():
+            raise IsADirectoryError(f"{path}: --output is a folder, expected a file name")
+        return
+    for parent in path.parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise NotADirectoryError(f"{path}: --output lies under {parent}, a file")
+            return

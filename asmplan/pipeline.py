@@ -1,0 +1,479 @@
+"""The public pipeline: assembly (or CAD file) -> relations -> state graph -> game -> plan.
+
+Every step is a function of its own that takes the previous step's value and returns a
+typed one, so a notebook, a web server or a cell controller can stop at any step, change
+something and go on. The command line (:mod:`asmplan.cli`) is a thin layer over these
+functions; :func:`plan` runs the whole chain as ``asmplan plan`` does.
+
+Example
+-------
+>>> from asmplan import pipeline
+>>> assembly = pipeline.load("examples/vacuum_pump")         # spec + part relations
+>>> graph = pipeline.state_graph(assembly)                    # feasible sequences (AST)
+>>> dag = pipeline.game(graph, cost="time")                   # robot-vs-human game DAG
+>>> solution = pipeline.solve_game(dag)                       # exact minimax
+>>> solution.tct, solution.minimax                            # doctest: +SKIP
+(73.0, 91.0)
+>>> result = pipeline.plan("examples/vacuum_pump")            # everything, plan.json's data
+>>> pipeline.write_plan(result, "results/vacuum_pump")        # doctest: +SKIP
+
+Errors for bad input are :class:`asmplan.errors.AsmplanError` (a ``ValueError``) or an
+``OSError`` for a missing or unreadable file; messages are one line naming the file, part
+or operation at fault.
+
+Heavy libraries (trimesh, OR-Tools, matplotlib) are imported inside the steps that need
+them, so importing this module is cheap.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # pragma: no cover - types only
+    from asp.baseline import BaselineResult
+    from asp.dag import GameDAG
+    from asp.plan import PlanStep
+    from asp.solve import Solution
+    from asp.spec import AssemblySpec
+    from asp.state_graph import StateGraph
+    from cad.relations import Relations
+
+PLAN_FORMAT = "asmplan-plan/1"
+GRAPH_SUFFIXES = (".json", ".graphml", ".xml")
+"""Suffixes read as a game DAG file rather than an assembly."""
+PLAN_FILES = ("plan.json", "dag.png")
+"""The files ``asmplan plan`` writes (besides ``manifest.json``)."""
+
+Progress = Callable[[str], None]
+"""A callback that shows one line of progress (e.g. prints it on stderr)."""
+
+
+# --------------------------------------------------------------------------- values
+
+
+@dataclass(frozen=True, eq=False)
+class Assembly:
+    """An assembly ready for planning: its specification and its part relations.
+
+    Attributes
+    ----------
+    spec : asp.spec.AssemblySpec
+        The validated specification (operations, agents, tools, parts).
+    relations : cad.relations.Relations or None
+        Contact (TC) and translational-freedom (TT) tables, ``(n, n, 6)`` bool each, when
+        the spec has part meshes; ``None`` for a spec without geometry (e.g. ``.IN2``).
+    """
+
+    spec: AssemblySpec
+    relations: Relations | None = None
+
+    @property
+    def descriptions(self) -> dict[str, str]:
+        """Operation id -> description."""
+        return {op.id: op.description for op in self.spec.operations}
+
+
+@dataclass(frozen=True, eq=False)
+class Game:
+    """A game DAG and the descriptions of its operations (empty for a bare graph file).
+
+    Attributes
+    ----------
+    dag : asp.dag.GameDAG
+    descriptions : dict of str to str
+        Operation id -> description, for readable plans.
+    """
+
+    dag: GameDAG
+    descriptions: dict[str, str] = field(default_factory=dict)
+
+
+@dataclass(frozen=True, eq=False)
+class Schedule:
+    """The CP-SAT minimum-makespan schedule of an assembly and its state-graph bounds.
+
+    Attributes
+    ----------
+    result : asp.baseline.BaselineResult
+        Status, objective (makespan), bound and the task rows.
+    lower_bound, chain_bound, load_bound : float
+        State-graph lower bounds of the makespan (see :class:`asp.baseline.AssemblySchedule`).
+    """
+
+    result: BaselineResult
+    lower_bound: float
+    chain_bound: float
+    load_bound: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """``plan.json``'s ``schedule`` object."""
+        return {
+            **self.result.to_dict(),
+            "lower_bound": self.lower_bound,
+            "chain_bound": self.chain_bound,
+            "load_bound": self.load_bound,
+        }
+
+
+@dataclass(frozen=True, eq=False)
+class AssemblyPlan:
+    """Everything ``asmplan plan`` computes for one assembly.
+
+    Attributes
+    ----------
+    assembly : Assembly
+    graph : asp.state_graph.StateGraph
+    sequences : int
+        Number of feasible complete assembly sequences.
+    game : Game
+    solution : asp.solve.Solution
+        Exact solution: TCT, W* and both sides' policies.
+    steps : tuple of asp.plan.PlanStep
+        The robust plan, turn by turn (robust robot against a maximising human).
+    relations_summary : list of dict
+        Per part: contacts (with directions) and free directions.
+    schedule : Schedule
+        CP-SAT minimum makespan with the agents in parallel.
+    """
+
+    assembly: Assembly
+    graph: StateGraph
+    sequences: int
+    game: Game
+    solution: Solution
+    steps: tuple[PlanStep, ...]
+    relations_summary: list[dict]
+    schedule: Schedule
+
+    @property
+    def dag(self) -> GameDAG:
+        return self.game.dag
+
+    def to_dict(self) -> dict[str, Any]:
+        """The ``asmplan-plan/1`` object written as ``plan.json``."""
+        spec, dag = self.assembly.spec, self.game.dag
+        out = {
+            "format": PLAN_FORMAT,
+            "assembly": spec.name,
+            "source": spec.source,
+            "relations": self.relations_summary,
+            "states": self.graph.n_states,
+            "transitions": self.graph.n_transitions,
+            "sequences": self.sequences,
+            "game_nodes": dag.n_nodes,
+            "game_edges": dag.n_edges,
+            "cost": dag.cost_model,
+            "tct": self.solution.tct,
+            "minimax": self.solution.minimax,
+            "robust_plan": [s.to_dict() for s in self.steps],
+            "schedule": self.schedule.to_dict(),
+        }
+        if spec.credit:
+            out["credit"] = spec.credit
+        return out
+
+
+# --------------------------------------------------------------------------- steps
+
+
+def load_assembly(source: str | os.PathLike[str]) -> AssemblySpec:
+    """Read and validate an assembly specification.
+
+    Parameters
+    ----------
+    source : path
+        A folder holding ``assembly.yaml``, the YAML itself, or a Scholl ``.IN2`` graph.
+
+    Returns
+    -------
+    asp.spec.AssemblySpec
+
+    Raises
+    ------
+    asmplan.errors.AsmplanError
+        One line naming the file, the key and the offending operation or part.
+    FileNotFoundError
+        ``source`` does not exist.
+    """
+    from asp.spec import load_spec
+
+    return load_spec(source)
+
+
+def relations(spec: AssemblySpec, *, progress: bool = False) -> Relations | None:
+    """Contact and freedom tables of the parts ``spec`` places (``None``: no geometry).
+
+    Parameters
+    ----------
+    spec : asp.spec.AssemblySpec
+    progress : bool
+        Show a progress bar on stderr.
+
+    Returns
+    -------
+    cad.relations.Relations or None
+        ``tc``, ``tt``: ``(n_parts, n_parts, 6)`` bool.
+    """
+    from asp.feasibility import load_relations
+
+    return load_relations(spec, progress=progress)
+
+
+def load(
+    source: str | os.PathLike[str], *, progress: bool = False, on_step: Progress | None = None
+) -> Assembly:
+    """:func:`load_assembly` and, when the spec has meshes, its :func:`relations`."""
+    spec = load_assembly(source)
+    rel = None
+    if spec.has_geometry:
+        if on_step is not None:
+            on_step(f"computing part relations of {len(spec.parts)} parts ...")
+        rel = relations(spec, progress=progress)
+    return Assembly(spec=spec, relations=rel)
+
+
+def part_relations(
+    source: str | os.PathLike[str],
+    *,
+    units: str | None = None,
+    contact_tol: float | None = None,
+    penetration_tol: float | None = None,
+    progress: bool = False,
+) -> Relations:
+    """Contact and freedom tables of every pair of parts of a folder, scene or spec.
+
+    A folder holding an ``assembly.yaml`` is read through that file (its parts, files and
+    units), as every other command reads it; any other folder is read mesh by mesh.
+
+    Parameters
+    ----------
+    source : path
+        Folder of part meshes, multi-body scene (GLB/glTF/3MF/STEP) or ``assembly.yaml``.
+    units : str, optional
+        Unit of mesh files that declare none (default: the spec's, else mm).
+    contact_tol, penetration_tol : float, optional
+        Tolerances in mm (defaults: :mod:`cad.tolerances`).
+    progress : bool
+        Show a progress bar on stderr.
+
+    Returns
+    -------
+    cad.relations.Relations
+    """
+    import cad
+
+    path = Path(source)
+    if path.is_dir() and (path / "assembly.yaml").is_file():
+        path = path / "assembly.yaml"
+    assembly = cad.load_assembly(path, units=units)
+    return cad.compute_relations(
+        assembly, contact_tol=contact_tol, penetration_tol=penetration_tol, progress=progress
+    )
+
+
+def state_graph(assembly: Assembly, *, progress: bool = False) -> StateGraph:
+    """The assembly state graph: every feasible partial assembly and operation.
+
+    Parameters
+    ----------
+    assembly : Assembly
+    progress : bool
+        Show progress on stderr.
+
+    Returns
+    -------
+    asp.state_graph.StateGraph
+    """
+    from asp.state_graph import build_state_graph
+
+    return build_state_graph(assembly.spec, assembly.relations, progress=progress)
+
+
+def game(graph: StateGraph, *, cost: str | None = None) -> GameDAG:
+    """The robot-vs-human game DAG of a state graph.
+
+    Parameters
+    ----------
+    graph : asp.state_graph.StateGraph
+    cost : {"steps", "time"}, optional
+        Cost of a move (default: the spec's ``cost:``).
+
+    Returns
+    -------
+    asp.dag.GameDAG
+    """
+    from asp.game import game_dag
+
+    return game_dag(graph, cost=cost)
+
+
+def load_game(source: str | os.PathLike[str], *, cost: str | None = None) -> Game:
+    """The game of a game DAG file (``.json``/``.graphml``) or of an assembly.
+
+    Parameters
+    ----------
+    source : path
+        Game DAG file, or an assembly as :func:`load_assembly` reads it.
+    cost : {"steps", "time"}, optional
+        Cost model of an assembly; a graph file has its own costs.
+
+    Returns
+    -------
+    Game
+    """
+    from asp.errors import GraphError
+
+    path = Path(source)
+    if not path.exists():
+        raise FileNotFoundError(f"{path}: no such file or folder")
+    if path.is_file() and path.suffix.lower() in GRAPH_SUFFIXES:
+        from asp.io import load_dag
+
+        if cost is not None:
+            raise GraphError("--cost applies to assemblies only: a graph file has its costs")
+        return Game(load_dag(path))
+    assembly = load(path)
+    return Game(game(state_graph(assembly), cost=cost), assembly.descriptions)
+
+
+def solve_game(dag: GameDAG) -> Solution:
+    """Solve the game exactly (backward induction): TCT, W* and both policies."""
+    from asp.solve import solve
+
+    return solve(dag)
+
+
+def robust_plan(game: Game, solution: Solution) -> tuple[PlanStep, ...]:
+    """The robust robot policy against the maximising human, turn by turn."""
+    from asp.plan import robust_plan as steps
+
+    return tuple(steps(game.dag, solution, game.descriptions))
+
+
+def schedule(
+    assembly: Assembly,
+    graph: StateGraph,
+    *,
+    time_limit: float = 30.0,
+    workers: int = 1,
+    seed: int = 0,
+) -> Schedule:
+    """CP-SAT minimum makespan with the agents working in parallel.
+
+    Parameters
+    ----------
+    assembly : Assembly
+    graph : asp.state_graph.StateGraph
+        Gives the implied precedences and the lower bounds.
+    time_limit : float
+        CP-SAT time limit, seconds.
+    workers : int
+        CP-SAT workers (1: repeatable).
+    seed : int
+        CP-SAT random seed.
+
+    Returns
+    -------
+    Schedule
+    """
+    from asp.baseline import assembly_schedule, min_makespan
+
+    sched = assembly_schedule(assembly.spec, graph)
+    result = min_makespan(sched.problem, time_limit=time_limit, workers=workers, seed=seed)
+    return Schedule(result, sched.lower_bound, sched.chain_bound, sched.load_bound)
+
+
+def plan(
+    source: str | os.PathLike[str] | Assembly,
+    *,
+    cost: str | None = None,
+    time_limit: float = 30.0,
+    seed: int = 0,
+    on_step: Progress | None = None,
+) -> AssemblyPlan:
+    """Plan an assembly end to end, as ``asmplan plan`` does.
+
+    Parameters
+    ----------
+    source : path or Assembly
+        An assembly (see :func:`load_assembly`) or one already loaded.
+    cost : {"steps", "time"}, optional
+        Cost model of the game (default: the spec's).
+    time_limit : float
+        CP-SAT time limit, seconds.
+    seed : int
+        CP-SAT random seed.
+    on_step : callable, optional
+        Called with one line before each step (progress for a person).
+
+    Returns
+    -------
+    AssemblyPlan
+        ``to_dict()`` is the ``plan.json`` object.
+    """
+    from asp.plan import relations_summary
+
+    say = on_step or (lambda _message: None)
+    say("[1/5] reading the assembly and computing part relations ...")
+    assembly = source if isinstance(source, Assembly) else load(source, progress=True, on_step=say)
+    summary = relations_summary(assembly.relations) if assembly.relations is not None else []
+    say("[2/5] building the assembly state graph ...")
+    graph = state_graph(assembly)
+    sequences = graph.count_sequences()
+    say("[3/5] solving the robot-vs-human game ...")
+    the_game = Game(game(graph, cost=cost), assembly.descriptions)
+    solution = solve_game(the_game.dag)
+    steps = robust_plan(the_game, solution)
+    say("[4/5] CP-SAT minimum-makespan schedule ...")
+    sched = schedule(assembly, graph, time_limit=time_limit, seed=seed)
+    return AssemblyPlan(assembly, graph, sequences, the_game, solution, steps, summary, sched)
+
+
+def write_plan(
+    result: AssemblyPlan, output: str | os.PathLike[str], *, on_step: Progress | None = None
+) -> tuple[Path, ...]:
+    """Write ``plan.json`` and (small enough games) ``dag.png`` into ``output`` as one unit.
+
+    The files of one run are named by ``manifest.json``, written last; the previous run's
+    files are removed first, so the folder never mixes two runs (see
+    :class:`asp.atomic.OutputSet`). A failure removes what this run wrote.
+
+    Returns
+    -------
+    tuple of Path
+        The files written (the manifest last).
+    """
+    from asmplan.report.plot import MAX_PLOT_NODES, plot_dag
+    from asp.atomic import OutputSet
+    from asp.solve import play
+
+    dag, solution = result.game.dag, result.solution
+    say = on_step or (lambda _message: None)
+    with OutputSet(output, owns=PLAN_FILES) as out:
+        out.write_text("plan.json", json.dumps(result.to_dict(), indent=1, allow_nan=False) + "\n")
+        if dag.n_nodes <= MAX_PLOT_NODES:
+            path, _ = play(dag, solution.robot_policy, solution.human_policy)
+            plot_dag(
+                dag,
+                out.path("dag.png"),
+                highlight=path_edges(dag, path),
+                title=f"{result.assembly.spec.name}: game DAG ({dag.cost_model}), robust plan "
+                f"in red, TCT {solution.tct:g}, W* {solution.minimax:g}",
+            )
+        else:
+            say(f"  dag.png skipped: {dag.n_nodes} nodes > {MAX_PLOT_NODES}")
+    return out.written
+
+
+def path_edges(dag: GameDAG, path: list[int]) -> list[int]:
+    """Edge indices along a node path (a pass repeats no node, so consecutive nodes differ)."""
+    edges = []
+    for u, v in zip(path, path[1:], strict=False):
+        hits = [e for e in dag.out_edges(u) if dag.targets[e] == v]
+        edges.append(hits[0])
+    return edges

@@ -1,0 +1,20 @@
+"""The project's exception family, rooted in the lowest package so every layer can raise it.
+
+Every error the library raises for bad input is an :class:`AsmplanError`; it subclasses
+``ValueError``, so code that catches ``ValueError`` keeps working. The command line turns
+any of them into ``asmplan: error: <message>`` and exit code 2. Messages are one line and
+name the file, part or operation at fault.
+
+``cad`` defines the root and the geometry errors; :mod:`asp.errors` adds the planning ones
+and :mod:`asmplan.errors` re-exports the whole family for users.
+"""
+
+from __future__ import annotations
+
+
+class AsmplanError(ValueError):
+    """Bad input or an impossible request, explained in one line."""
+
+
+class GeometryError(AsmplanError):
+    """Part geometry that cannot be used: unreadable mesh, deep interpenetration, bad units."""
