@@ -66,6 +66,7 @@ from asp.baseline import (
     schedule_violation,
 )
 from asp.dag import HUMAN, ROBOT, GameDAG, from_arrays
+from asp.errors import GameError, SpecError
 from asp.solve import Solution, evaluate_policy, solve
 from asp.spec import AssemblySpec
 from asp.state_graph import StateGraph
@@ -214,7 +215,7 @@ def concurrent_model(
     """
     where = spec.source or spec.name
     if step is not None and not (math.isfinite(step) and step > 0):
-        raise ValueError(f"{where}: duration step: expected a positive number, got {step}")
+        raise SpecError(f"{where}: duration step: expected a positive number, got {step}")
     workers = []
     for side in (ROBOT, HUMAN):
         for a in spec.agents:
@@ -227,24 +228,24 @@ def concurrent_model(
     ranges = [[None] * len(ops) for _ in workers]
     for i, op in enumerate(ops):
         if not op.durations:
-            raise ValueError(f"{where}: operations[{op.id}]: no agent may do this operation")
+            raise SpecError(f"{where}: operations[{op.id}]: no agent may do this operation")
         for w, x in enumerate(workers):
             if x.agent in op.agents:
                 lo, hi = duration_range(op, x.agent)
                 if not (math.isfinite(lo) and math.isfinite(hi)) or lo < 0 or lo > hi:
-                    raise ValueError(
+                    raise SpecError(
                         f"{where}: operations[{op.id}].agents.{x.agent}: expected a duration "
                         f">= 0 or a range [min, max] with 0 <= min <= max, got [{lo}, {hi}]"
                     )
                 if lo != hi and x.side == ROBOT:
-                    raise ValueError(
+                    raise SpecError(
                         f"{where}: operations[{op.id}].agents.{x.agent}: a duration range is "
                         "for a human; a robot's duration is one number"
                     )
                 ranges[w][i] = (lo, hi)
     for a in spec.agents:
         if not any(a.name in op.agents for op in ops):
-            raise ValueError(f"{where}: agents.{a.name}: this agent may do no operation")
+            raise SpecError(f"{where}: agents.{a.name}: this agent may do no operation")
     numbers = [v for row in ranges for r in row if r is not None for v in r]
     numbers += [t.change_time for t in spec.tools] + ([step] if step is not None else [])
     scale = integer_scale(numbers)
@@ -393,7 +394,7 @@ def build_game(
     else:
         k = int(budgets)
         if k < 0:
-            raise ValueError(f"k: expected a deviation budget >= 0, got {k}")
+            raise GameError(f"k: expected a deviation budget >= 0, got {k}")
         levels = list(range(k + 1))
     nw = len(model.workers)
     idle = tuple((WAIT, 0) for _ in range(nw))
@@ -407,7 +408,7 @@ def build_game(
         if v is None:
             v = len(nodes)
             if v >= max_nodes:
-                raise ValueError(
+                raise GameError(
                     f"{where}: the concurrent game exceeds {max_nodes:,} nodes (budgets "
                     f"{levels[0]}..{levels[-1]}); bound the deviation budget with --max-k, "
                     "coarsen the human duration grid (--duration-step), or add precedences"
@@ -678,7 +679,7 @@ def robustness(
     covers every human decision; ``max_k`` bounds the search (then ``flat`` is False).
     """
     if max_k < 0:
-        raise ValueError(f"max_k: expected a deviation budget >= 0, got {max_k}")
+        raise GameError(f"max_k: expected a deviation budget >= 0, got {max_k}")
     t0 = time.perf_counter()
     adversary = build_game(model, None, max_nodes=max_nodes, progress=progress)
     adv_sol = solve(adversary.dag)
@@ -941,9 +942,10 @@ def assembly_makespan(
     """The minimum-makespan schedule of an assembly that respects the state graph.
 
     Exact by lazy cuts: CP-SAT solves the schedule with the precedences the state graph
-    implies (:func:`asp.baseline.assembly_schedule`); each schedule is replayed through the state graph
-    (:func:`asp.baseline.schedule_violation`, the concurrent game's rule); a schedule that fails adds
-    its cut and CP-SAT solves again. Cuts only remove infeasible schedules, so the first
+    implies (:func:`asp.baseline.assembly_schedule`); each schedule is replayed through the
+    state graph (:func:`asp.baseline.schedule_violation`, the concurrent game's rule); a
+    schedule that fails adds its cut and CP-SAT solves again. Cuts only remove infeasible
+    schedules, so the first
     proven optimum that passes is the optimum of the physically feasible schedules; the
     status is ``OPTIMAL`` only then, ``FEASIBLE`` for a passing schedule found within the
     time limit, else ``UNKNOWN`` with no schedule. ``detail`` holds ``cuts`` and ``replay``.

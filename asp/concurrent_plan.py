@@ -18,6 +18,7 @@
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -79,9 +80,16 @@ def plan_concurrent(
     time_limit: float = 30.0,
     seed: int = 0,
     max_nodes: int = DEFAULT_MAX_NODES,
+    schedule: tuple | None = None,
     progress: bool = False,
 ) -> ConcurrentPlan:
     """Solve the concurrent game of ``spec`` and compare it with CP-SAT (module docstring).
+
+    Parameters
+    ----------
+    schedule : (BaselineResult, float), optional
+        The CP-SAT schedule (from :func:`asp.concurrent.assembly_makespan`) and its lower
+        bound, when already computed.
 
     Raises
     ------
@@ -90,9 +98,14 @@ def plan_concurrent(
         a game over ``max_nodes`` nodes (the message names ``--max-k``).
     """
     if max_k < 0:
-        raise ValueError(f"--max-k: expected a deviation budget >= 0, got {max_k}")
+        from asp.errors import GameError
+
+        raise GameError(f"--max-k: expected a deviation budget >= 0, got {max_k}")
     model = concurrent_model(spec, graph, step=step)
-    sched, result = assembly_makespan(spec, graph, time_limit=time_limit, seed=seed)
+    if schedule is None:
+        sched, result = assembly_makespan(spec, graph, time_limit=time_limit, seed=seed)
+        schedule = (result, sched.lower_bound)
+    result, lower_bound = schedule
     curve = robustness(model, max_k=max_k, max_nodes=max_nodes, progress=progress)
     game, solution = curve.game, curve.solution
     schedule_worst = []
@@ -110,7 +123,7 @@ def plan_concurrent(
         spec=spec,
         curve=curve,
         schedule=result,
-        lower_bound=sched.lower_bound,
+        lower_bound=lower_bound,
         schedule_worst=schedule_worst,
         cooperative=cooperative,
         worst=worst,
@@ -149,6 +162,17 @@ def robustness_table(plan: ConcurrentPlan) -> str:
         f"0..{plan.curve.k}), unbounded {plan.curve.adversary.dag.n_nodes:,} nodes; "
         f"solved in {plan.curve.seconds:.2f} s"
     )
+    return "\n".join(lines)
+
+
+def timeline_text(bars: list[Bar], makespan: float) -> str:
+    """One line per operation: start, end, agent, operation; deviations marked."""
+    lines = [
+        f"  {b.start:>7g} .. {b.end:<7g} {b.agent:<8s} {b.operation}"
+        + ("   <- deviation from the plan" if b.deviation else "")
+        for b in bars
+    ]
+    lines.append(f"  makespan {makespan:g}")
     return "\n".join(lines)
 
 
@@ -250,17 +274,21 @@ def policy_table(game: ConcurrentGame, solution: Solution, *, limit: int = 20_00
     return out
 
 
-def write_figures(plan: ConcurrentPlan, folder: str | os.PathLike[str]) -> list[Path]:
-    """Write ``robustness.png``, ``gantt_cooperative.png`` and ``gantt_worst.png``."""
+def write_figures(plan: ConcurrentPlan, folder: str | os.PathLike[str] | Callable) -> list[Path]:
+    """Write ``robustness.png``, ``gantt_cooperative.png`` and ``gantt_worst.png``.
+
+    ``folder`` is a folder, or a function from a file name to its path (an
+    :class:`asp.atomic.OutputSet`'s ``path``).
+    """
     from asp.gantt import plot_gantt, plot_robustness
 
-    folder = Path(folder)
+    path_of = folder if callable(folder) else Path(folder).joinpath
     name = plan.spec.name
     k = plan.curve.k
     written = [
         plot_robustness(
             plan.curve.to_list(),
-            folder / "robustness.png",
+            path_of("robustness.png"),
             schedule=plan.schedule.objective,
             schedule_rows=plan.schedule_worst,
             title=f"{name}: guaranteed makespan against a person who may deviate k times",
@@ -270,7 +298,7 @@ def write_figures(plan: ConcurrentPlan, folder: str | os.PathLike[str]) -> list[
     written.append(
         plot_gantt(
             bars,
-            folder / "gantt_cooperative.png",
+            path_of("gantt_cooperative.png"),
             makespan=makespan,
             title=f"{name}: robust plan (k = {k}), the person follows it: {makespan:g}",
         )
@@ -279,7 +307,7 @@ def write_figures(plan: ConcurrentPlan, folder: str | os.PathLike[str]) -> list[
     written.append(
         plot_gantt(
             bars,
-            folder / "gantt_worst.png",
+            path_of("gantt_worst.png"),
             makespan=makespan,
             title=f"{name}: robust plan (k = {k}) against the worst person: {makespan:g}",
         )

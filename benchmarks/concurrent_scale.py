@@ -17,9 +17,8 @@ import argparse
 import resource
 import time
 
-from asp.concurrent import build_game, concurrent_model, robustness
-from asp.solve import solve
-from asp.spec import AssemblySpec, Agent, Operation, Tool
+from asp.concurrent import concurrent_model, robustness
+from asp.spec import Agent, AssemblySpec, Operation, Tool
 from asp.state_graph import build_state_graph
 
 
@@ -28,7 +27,7 @@ def job(n_ops: int = 20, robots: int = 2, chains: int = 4, spread: int = 4) -> A
     agents = [Agent("H", "human")] + [Agent(f"R{i + 1}", "robot") for i in range(robots)]
     ops = []
     for i in range(n_ops - 1):
-        chain, pos = i % chains, i // chains
+        pos = i // chains
         after = (f"o{i - chains}",) if pos > 0 else ()
         base = 4 + (7 * i) % 9
         if i % 3 == 0:
