@@ -41,7 +41,8 @@ from arl.game import (
     move_rewards,
     player_of,
 )
-from asp.dag import ROBOT, GameDAG
+from asp import rules
+from asp.dag import GameDAG
 
 OBSERVATIONS = ("node", "features")
 
@@ -357,7 +358,7 @@ class GameVecEnv(VecEnv):
         t, me, opp = self.tables, self.player, 1 - self.player
         active = idx[self.node[idx] != t.end]
         while active.size:
-            movers = active[t.n_moves[opp, self.node[active]] > 0]
+            movers = active[t.can_move[opp, self.node[active]]]
             if movers.size:
                 v = self.node[movers]
                 u = self.rng.random(movers.size)
@@ -366,8 +367,8 @@ class GameVecEnv(VecEnv):
                 cost = t.move_cost[edge]
                 rewards[movers] += move_rewards(opp, cost, self.reward_kind)[me]
                 self.node[movers] = t.dag.targets[edge]
-            v = self.node[active]
-            active = active[(v != t.end) & (t.n_moves[me, v] == 0)]
+            v = self.node[active]  # the learner passes where it has no move
+            active = active[(v != t.end) & ~t.can_move[me, v]]
 
     def _reset_envs(self, idx: np.ndarray) -> None:
         t = self.tables
@@ -376,9 +377,8 @@ class GameVecEnv(VecEnv):
         self.returns[idx] = 0.0
         self.lengths[idx] = 0
         explore = self.rng.random(idx.size) < self.explore_starts
-        robot_starts = t.n_moves[ROBOT, t.start] > 0
-        opponent_first = robot_starts if self.player != ROBOT else not robot_starts
-        if opponent_first:
+        first = rules.settle(t.can_move, t.start, rules.FIRST_PLAYER, t.end)
+        if first != self.player:  # the opponent acts first
             self._opponent_turns(idx[~explore], np.zeros(self.num_envs))
         restart = idx[explore | (self.node[idx] == t.end)]
         self.node[restart] = self.rng.choice(self._learner_nodes, size=restart.size)

@@ -2,7 +2,8 @@
 
 This module knows nothing of Gymnasium, PettingZoo or SB3 (like the board logic of
 PettingZoo's tic-tac-toe): it turns a :class:`asp.dag.GameDAG` into move tables, plays moves
-and passes, and defines the rewards (``../shared/DESIGN.md``, "The game" and "Alternating
+and passes by the rules of :mod:`asp.rules` (the same the exact solver plays by), and
+defines the rewards (``../shared/DESIGN.md``, "The game" and "Alternating
 PPO").
 
 Moves and actions
@@ -20,8 +21,10 @@ Rewards
 -------
 ``reward="paper"`` (DESIGN.md, Table 1 of the paper): the robot gets ``-cost`` for each of
 its own moves and ``+n`` (the number of nodes) when the end is reached, whoever moved last;
-the human gets ``+cost`` for each of its own moves. A move's cost is 1 on a ``steps`` graph
-and the edge cost on a ``time`` graph.
+the human gets ``+cost`` for each of its own moves. A move's cost is
+:func:`asp.rules.move_costs`: the edge's cost, 1 per operation on a ``steps`` graph unless its
+file gives other costs (a GraphML with ``cost`` edges is trained on those costs, the ones it
+is certified on).
 
 ``reward="zero_sum"``: every move (either player's) costs the robot ``cost`` and pays the
 human ``cost``, with no end bonus. With ``gamma = 1`` the robot's return is then exactly
@@ -34,13 +37,15 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from asp.dag import ANY, HUMAN, ROBOT, GameDAG
+from asp import rules
+from asp.dag import GameDAG
+from asp.rules import HUMAN, ROBOT
 
-AGENTS = ("robot", "human")
+AGENTS = rules.PLAYER_NAMES
 """Agent names, indexed by player code (``ROBOT = 0``, ``HUMAN = 1``)."""
 REWARDS = ("paper", "zero_sum")
 INVALID = ("modulo", "raise")
-NO_MOVE = -1
+NO_MOVE = rules.PASS
 
 
 def player_of(agent: str | int) -> int:
@@ -75,7 +80,9 @@ class GameTables:
     n_moves : (2, n) int64
         Number of moves of each player at each node.
     move_cost : (m,) float64
-        Cost of each edge in the game's cost model (1 per move for ``steps``).
+        Cost of each edge (:func:`asp.rules.move_costs`).
+    can_move : (2, n) bool
+        Whether each player has a move at each node (:func:`asp.rules.has_move`).
     """
 
     dag: GameDAG
@@ -84,30 +91,31 @@ class GameTables:
     moves: np.ndarray
     n_moves: np.ndarray
     move_cost: np.ndarray
+    can_move: np.ndarray
 
     @classmethod
     def from_dag(cls, dag: GameDAG) -> GameTables:
         """Build the move tables of ``dag``."""
         n = dag.n_nodes
         src = dag.sources
-        n_moves = np.zeros((2, n), dtype=np.int64)
-        allowed = [(dag.sides == ANY) | (dag.sides == p) for p in (ROBOT, HUMAN)]
-        for p in (ROBOT, HUMAN):
-            n_moves[p] = np.bincount(src[allowed[p]], minlength=n)
+        n_moves = rules.move_counts(dag)
         k = max(1, int(n_moves.max(initial=0)))
         moves = np.full((2, n, k), NO_MOVE, dtype=np.int64)
-        for p in (ROBOT, HUMAN):
-            edges = np.flatnonzero(allowed[p])
+        for p in rules.PLAYERS:
+            first, edges = rules.move_table(dag, p)
             # Rank of each allowed edge among its node's allowed edges (edges are CSR-sorted).
-            first = np.zeros(n + 1, dtype=np.int64)
-            np.cumsum(n_moves[p], out=first[1:])
             rank = np.arange(edges.size) - first[src[edges]]
             moves[p, src[edges], rank] = edges
-        if dag.cost_model == "time":
-            move_cost = dag.costs.astype(np.float64)
-        else:
-            move_cost = np.ones(dag.n_edges, dtype=np.float64)
-        return cls(dag=dag, n=n, max_moves=k, moves=moves, n_moves=n_moves, move_cost=move_cost)
+        move_cost = np.asarray(rules.move_costs(dag), dtype=np.float64)
+        return cls(
+            dag=dag,
+            n=n,
+            max_moves=k,
+            moves=moves,
+            n_moves=n_moves,
+            move_cost=move_cost,
+            can_move=n_moves > 0,
+        )
 
     @property
     def start(self) -> int:
@@ -187,11 +195,11 @@ class Game:
     def __init__(self, tables: GameTables) -> None:
         self.tables = tables
         self.node = tables.start
-        self.player = ROBOT
+        self.player = rules.FIRST_PLAYER
         self.cost = 0.0
         self.settle()
 
-    def reset(self, node: int | None = None, player: int = ROBOT) -> None:
+    def reset(self, node: int | None = None, player: int = rules.FIRST_PLAYER) -> None:
         """Start again at ``node`` (default: the start) with ``player`` on turn."""
         self.node = self.tables.start if node is None else int(node)
         self.player = int(player)
@@ -204,8 +212,7 @@ class Game:
 
     def settle(self) -> None:
         """Pass (at zero cost) while the player on turn has no move."""
-        while not self.done and self.tables.n_moves[self.player, self.node] == 0:
-            self.player = 1 - self.player
+        self.player = rules.settle(self.tables.can_move, self.node, self.player, self.tables.end)
 
     def legal_actions(self) -> np.ndarray:
         """(max_moves,) bool mask of the player on turn (all False once the game is over)."""
@@ -225,10 +232,8 @@ class Game:
 
     def play_edge(self, edge: int) -> float:
         """Play edge ``edge`` (one of the moves of the player on turn); return its cost."""
-        cost = float(self.tables.move_cost[edge])
+        self.node, self.player, cost = rules.step(self.tables.dag, self.node, self.player, edge)
         self.cost += cost
-        self.node = int(self.tables.dag.targets[edge])
-        self.player = 1 - self.player
         self.settle()
         return cost
 

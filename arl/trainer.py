@@ -34,7 +34,10 @@ from arl.envs import GameVecEnv, Observer, TurnEnv
 from arl.game import AGENTS, NO_MOVE, GameTables
 from arl.runfolder import LOG_FORMAT, RunFolder
 from arl.tabulate import action_probabilities, tabulate
+from asp import rules
 from asp.dag import HUMAN, ROBOT, GameDAG
+from asp.metrics import is_robust_optimal
+from asp.numbers import plain
 from asp.solve import certified_worst_case, play, solve
 
 LOG_VERSION = 1
@@ -93,7 +96,7 @@ class TrainResult:
     @property
     def robust_optimal(self) -> bool:
         """Whether the certified WCPL equals W*."""
-        return abs(self.certified_wcpl - self.minimax) <= 1e-9
+        return is_robust_optimal(self.certified_wcpl, self.minimax)
 
 
 class _EpisodeRecorder(BaseCallback):
@@ -122,16 +125,12 @@ def graph_summary(dag: GameDAG) -> dict:
     return {
         "nodes": dag.n_nodes,
         "edges": dag.n_edges,
-        "start": _plain(dag.node_ids[dag.start]),
-        "end": _plain(dag.node_ids[dag.end]),
+        "start": plain(dag.node_ids[dag.start]),
+        "end": plain(dag.node_ids[dag.end]),
         "cost_model": dag.cost_model,
         "fingerprint": digest.hexdigest()[:16],
         "metadata": json.loads(json.dumps(dag.metadata, default=str)),
     }
-
-
-def _plain(x):
-    return x.item() if hasattr(x, "item") else x
 
 
 def _phase_seed(seed: int, cycle: int, player: int) -> int:
@@ -194,27 +193,9 @@ def _make_model(config: TrainConfig, env: VecEnv, seed: int):
 
 def robot_reach(tables: GameTables, robot_policy: np.ndarray) -> np.ndarray:
     """(n,) bool: nodes where the robot is on turn, with a move, in some state reachable
-    when it follows ``robot_policy`` against any human."""
-    n, targets = tables.n, tables.dag.targets
-    seen = np.zeros((n, 2), dtype=bool)
-    stack = [(tables.start, ROBOT)]
-    seen[tables.start, ROBOT] = True
-    while stack:
-        v, p = stack.pop()
-        if v == tables.end:
-            continue
-        count = tables.n_moves[p, v]
-        if count == 0:
-            heads = [v]
-        elif p == ROBOT:
-            heads = [int(targets[robot_policy[v]])]
-        else:
-            heads = targets[tables.moves[p, v, :count]].tolist()
-        for t in heads:
-            if not seen[t, 1 - p]:
-                seen[t, 1 - p] = True
-                stack.append((t, 1 - p))
-    return seen[:, ROBOT] & (tables.n_moves[ROBOT] > 0)
+    when it follows ``robot_policy`` against any human (:func:`asp.rules.reachable_states`)."""
+    seen = rules.reachable_states(tables.dag, robot_policy)
+    return seen[:, ROBOT] & tables.can_move[ROBOT]
 
 
 def policy_hash(tables: GameTables, robot_policy: np.ndarray) -> str:

@@ -26,7 +26,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from asp.dag import ANY, HUMAN, ROBOT, GameDAG
+from asp import rules
+from asp.dag import GameDAG
+from asp.numbers import json_number, plain
+from asp.rules import HUMAN, ROBOT
 
 MAX_SCALE_DIGITS = 6
 
@@ -99,21 +102,14 @@ class BaselineResult:
             "kind": self.kind,
             "name": self.name,
             "status": self.status,
-            "objective": _num(self.objective),
-            "bound": _num(self.bound),
+            "objective": json_number(self.objective, 6),
+            "bound": json_number(self.bound, 6),
             "wall_s": round(self.wall_s, 3),
         }
         out.update(self.detail)
         if self.credit:
             out["credit"] = self.credit
         return out
-
-
-def _num(x):
-    if x is None:
-        return None
-    x = float(x)
-    return int(x) if x.is_integer() else round(x, 6)
 
 
 def integer_scale(values) -> int:
@@ -166,37 +162,37 @@ def path_arcs(dag: GameDAG) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndar
         The end node (or its two game states).
     """
     src = dag.sources
-    if dag.n_edges == 0 or np.all(dag.sides == ANY):
+    move_cost = rules.move_costs(dag)
+    may = rules.move_masks(dag)
+    if dag.n_edges == 0 or np.all(may.all(axis=0)):  # every edge open to both: no turns
         return (
             src,
             dag.targets.copy(),
-            dag.costs.copy(),
+            move_cost.copy(),
             np.arange(dag.n_edges, dtype=np.int64),
             dag.start,
             [dag.end],
         )
     tails, heads, costs, edges = [], [], [], []
-    for p in (ROBOT, HUMAN):
-        allowed = (dag.sides == ANY) | (dag.sides == p)
-        e = np.flatnonzero(allowed)
+    can_move = rules.has_move(dag)
+    for p in rules.PLAYERS:
+        e = np.flatnonzero(may[p])
         tails.append(2 * src[e] + p)
-        heads.append(2 * dag.targets[e] + (1 - p))
-        costs.append(dag.costs[e])
+        heads.append(2 * dag.targets[e] + rules.other(p))
+        costs.append(move_cost[e])
         edges.append(e)
-        has_move = np.zeros(dag.n_nodes, dtype=bool)
-        has_move[src[e]] = True
-        passing = np.flatnonzero(~has_move)
+        passing = np.flatnonzero(~can_move[p])
         passing = passing[passing != dag.end]
         tails.append(2 * passing + p)
-        heads.append(2 * passing + (1 - p))
-        costs.append(np.zeros(passing.size))
-        edges.append(np.full(passing.size, -1, dtype=np.int64))
+        heads.append(2 * passing + rules.other(p))
+        costs.append(np.full(passing.size, rules.PASS_COST))
+        edges.append(np.full(passing.size, rules.PASS, dtype=np.int64))
     return (
         np.concatenate(tails),
         np.concatenate(heads),
         np.concatenate(costs),
         np.concatenate(edges),
-        2 * dag.start + ROBOT,
+        2 * dag.start + rules.FIRST_PLAYER,
         [2 * dag.end + ROBOT, 2 * dag.end + HUMAN],
     )
 
@@ -263,7 +259,7 @@ def min_cost_path(
                 edges.append(int(edge[a]))
             state = int(head[a])
         nodes.append(dag.node_ids[dag.end])
-        detail.update(path=[_plain(x) for x in nodes], edges=edges)
+        detail.update(path=[plain(x) for x in nodes], edges=edges)
         if dag.operations is not None:
             detail["operations"] = [dag.edge_label(e) for e in edges]
     return BaselineResult(
@@ -276,10 +272,6 @@ def min_cost_path(
         detail=detail,
         credit=str(dag.metadata.get("credit", "")),
     )
-
-
-def _plain(x):
-    return x.item() if hasattr(x, "item") else x
 
 
 # --------------------------------------------------------------------------- (b) schedule
@@ -420,8 +412,8 @@ def min_makespan(
                     {
                         "task": t.id,
                         "agent": t.modes[m][0],
-                        "start": _num(solver.value(start[i]) / scale),
-                        "end": _num(solver.value(end[i]) / scale),
+                        "start": json_number(solver.value(start[i]) / scale, 6),
+                        "end": json_number(solver.value(end[i]) / scale, 6),
                     }
                 )
             rows.sort(key=lambda r: (r["start"], r["end"], r["task"]))

@@ -5,10 +5,9 @@ Nodes are indexed ``0 .. n-1``; each keeps its original id (an int or a string) 
 ``indptr[v]:indptr[v+1]``, with their heads in ``targets``, their costs in ``costs`` and the
 side that may take them in ``sides``.
 
-Turn model (``../shared/DESIGN.md``, "The game"): the robot moves first; on its turn a player
-takes one out-edge open to its side (``ROBOT``, ``HUMAN`` or ``ANY``); a player with none
-passes at zero cost; the turn then flips. A game state is ``(node, player on turn)``.
-On a synthetic DAG every edge is ``ANY``.
+The rules of play on it (who may take which edge, passes, the turn, the cost of a move) are
+:mod:`asp.rules`; the side codes ``ROBOT``, ``HUMAN`` and ``ANY`` come from there. On a
+synthetic DAG every edge is ``ANY``.
 """
 
 from __future__ import annotations
@@ -20,21 +19,24 @@ from functools import cached_property
 import networkx as nx
 import numpy as np
 
-ROBOT = 0
-HUMAN = 1
-ANY = 2
-SIDE_NAMES = ("robot", "human", "any")
-PLAYERS = (ROBOT, HUMAN)
+from asp import rules
+from asp.rules import ANY, HUMAN, PLAYERS, ROBOT, SIDE_NAMES, side_from_name
 
-
-def side_from_name(name: str) -> int:
-    """Return the side code of ``"robot"``, ``"human"`` or ``"any"``."""
-    try:
-        return SIDE_NAMES.index(str(name).lower())
-    except ValueError:
-        raise ValueError(
-            f"unknown side {name!r}: expected one of {', '.join(SIDE_NAMES)}"
-        ) from None
+__all__ = [
+    "ANY",
+    "HUMAN",
+    "PLAYERS",
+    "ROBOT",
+    "SIDE_NAMES",
+    "GameDAG",
+    "from_arrays",
+    "from_edges",
+    "from_networkx",
+    "reachable",
+    "side_from_name",
+    "topological_order",
+    "validate_dag",
+]
 
 
 @dataclass(frozen=True, eq=False)
@@ -100,9 +102,8 @@ class GameDAG:
         return range(int(self.indptr[v]), int(self.indptr[v + 1]))
 
     def moves(self, v: int, player: int) -> list[int]:
-        """Edge indices player ``player`` may take from node ``v`` (empty: it passes)."""
-        lo, hi = int(self.indptr[v]), int(self.indptr[v + 1])
-        return [e for e in range(lo, hi) if self.sides[e] == ANY or self.sides[e] == player]
+        """Edge indices player ``player`` may take from node ``v`` (:func:`asp.rules.moves`)."""
+        return rules.moves(self, v, player)
 
     def index_of(self, node_id) -> int:
         """Index of the node whose original id is ``node_id`` (also accepts its str form)."""
@@ -356,8 +357,7 @@ def validate_dag(dag: GameDAG) -> None:
     """Check the invariants the solvers rely on; raise ``ValueError`` naming the fault."""
     if dag.n_nodes == 0:
         raise ValueError("empty graph: expected at least one node")
-    if dag.cost_model not in ("steps", "time"):
-        raise ValueError(f"cost_model: expected 'steps' or 'time', got {dag.cost_model!r}")
+    rules.check_cost_model(dag.cost_model)
     if dag.turn_model != "alternate":
         raise ValueError(f"turn_model: expected 'alternate', got {dag.turn_model!r}")
     if dag.n_edges:

@@ -29,6 +29,7 @@ import networkx as nx
 
 from asp.atomic import write_bytes, write_text
 from asp.dag import SIDE_NAMES, GameDAG, from_edges, from_networkx, side_from_name
+from asp.numbers import json_number, plain
 
 FORMAT = "asmplan-dag/1"
 JSON_SUFFIXES = (".json",)
@@ -41,7 +42,7 @@ def dag_to_dict(dag: GameDAG) -> dict:
     """The ``asmplan-dag/1`` object of ``dag``."""
     nodes = []
     for i, nid in enumerate(dag.node_ids):
-        node = {"id": _plain(nid)}
+        node = {"id": plain(nid)}
         if dag.node_labels is not None:
             node["label"] = dag.node_labels[i]
         nodes.append(node)
@@ -49,9 +50,9 @@ def dag_to_dict(dag: GameDAG) -> dict:
     edges = []
     for e in range(dag.n_edges):
         edge = {
-            "source": _plain(dag.node_ids[src[e]]),
-            "target": _plain(dag.node_ids[int(dag.targets[e])]),
-            "cost": _number(dag.costs[e]),
+            "source": plain(dag.node_ids[src[e]]),
+            "target": plain(dag.node_ids[int(dag.targets[e])]),
+            "cost": json_number(dag.costs[e]),
             "side": SIDE_NAMES[int(dag.sides[e])],
         }
         if dag.operations is not None:
@@ -61,8 +62,8 @@ def dag_to_dict(dag: GameDAG) -> dict:
         edges.append(edge)
     return {
         "format": FORMAT,
-        "start": _plain(dag.node_ids[dag.start]),
-        "end": _plain(dag.node_ids[dag.end]),
+        "start": plain(dag.node_ids[dag.start]),
+        "end": plain(dag.node_ids[dag.end]),
         "cost_model": dag.cost_model,
         "turn_model": dag.turn_model,
         "nodes": nodes,
@@ -159,13 +160,3 @@ def save_dag(dag: GameDAG, path: str | os.PathLike[str]) -> Path:
         nx.write_graphml(g, buffer)
         return write_bytes(path, buffer.getvalue())
     raise ValueError(f"{path}: unknown graph format {suffix!r}: expected .json or .graphml")
-
-
-def _plain(x):
-    """A JSON-friendly node id (numpy ints become ints)."""
-    return x.item() if hasattr(x, "item") else x
-
-
-def _number(x: float):
-    x = float(x)
-    return int(x) if x.is_integer() else x

@@ -4,34 +4,49 @@ For a robot policy (by default the robust one):
 
 - TCT and W* come from :func:`asp.solve.solve`;
 - the certified WCPL is the policy's cost against an exact best-response human;
-- the cost distribution against a uniformly random human is computed exactly by dynamic
-  programming over the states the policy can reach (a probability per cost value), giving
-  the exact mean, maximum and resilience ratio (RR);
+- against a uniformly random human, the exact mean, minimum and maximum come from
+  :func:`asp.solve.evaluate_policy` (the random human plays every line with positive
+  probability, so the maximum is the certified WCPL and the minimum the helpful human's
+  cost): no distribution is needed for them;
+- the resilience ratio RR = P(cost <= b) for a bound b is exact by
+  :func:`probability_within`, a forward dynamic program over "the budget left" that only
+  follows the budgets that can still matter (a budget at least the state's worst case is
+  won, one below its best case lost). Against the certified WCPL it is 1 at once. Where
+  more than :data:`MAX_DISTRIBUTION_ENTRIES` (state, budget) pairs would be needed (long
+  games with fractional costs) RR is taken from the seeded simulation instead and
+  ``exact_distribution`` is false;
 - the paper's seeded simulation of 1,000 games stays beside them, vectorised over games.
+
+The whole exact distribution (:func:`random_cost_distribution`) is kept for small games
+(tests, reports) under the same cap. The rules of play come from :mod:`asp.rules`.
 """
 
 from __future__ import annotations
 
+import heapq
 import math
 from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from asp.dag import ANY, HUMAN, ROBOT, GameDAG
-from asp.solve import Solution, evaluate_policy, node_order, play, solve
+from asp import rules
+from asp.dag import GameDAG
+from asp.numbers import plain
+from asp.rules import HUMAN, ROBOT
+from asp.solve import PolicyEvaluation, Solution, evaluate_policy, node_order, play, solve
 
 DEFAULT_GAMES = 1000
 MAX_DISTRIBUTION_STATES = 200_000
-"""Above this many reachable game states the exact distribution is skipped (RR sampled)."""
+"""Above this many reachable game states the whole distribution is not computed."""
+MAX_DISTRIBUTION_ENTRIES = 1_000_000
+"""Cap on the (game state, cost or budget) pairs an exact dynamic program may hold; past it
+:func:`random_cost_distribution` and :func:`probability_within` answer ``None`` (bounded
+time and memory: about a second and a few hundred MB in the worst case)."""
 
 
 def human_move_table(dag: GameDAG) -> tuple[np.ndarray, np.ndarray]:
     """CSR of the human's moves: ``(indptr (n+1,), edges (k,))`` over edge indices."""
-    allowed = (dag.sides == ANY) | (dag.sides == HUMAN)
-    counts = np.bincount(dag.sources[allowed], minlength=dag.n_nodes)
-    indptr = np.zeros(dag.n_nodes + 1, dtype=np.int64)
-    np.cumsum(counts, out=indptr[1:])
-    return indptr, np.flatnonzero(allowed).astype(np.int64)
+    return rules.move_table(dag, HUMAN)
 
 
 def simulate_random_human(
@@ -53,107 +68,176 @@ def simulate_random_human(
     if n_games < 1:
         raise ValueError(f"n_games: expected a positive integer, got {n_games}")
     rng = np.random.default_rng(seed)
-    h_indptr, h_edges = human_move_table(dag)
-    robot_can = np.zeros(dag.n_nodes, dtype=bool)
-    robot_sides = (dag.sides == ANY) | (dag.sides == ROBOT)
-    robot_can[dag.sources[robot_sides]] = True
+    h_indptr, h_edges = rules.move_table(dag, HUMAN)
+    can_move = rules.has_move(dag)
+    move_cost = rules.move_costs(dag)
     node = np.full(n_games, dag.start, dtype=np.int64)
-    player = np.full(n_games, ROBOT, dtype=np.int64)
+    player = np.full(n_games, rules.FIRST_PLAYER, dtype=np.int64)
     cost = np.zeros(n_games)
     for _ in range(2 * dag.n_nodes + 2):
         active = node != dag.end
         if not active.any():
             return cost
-        edge = np.full(n_games, -1, dtype=np.int64)
-        robots = active & (player == ROBOT) & robot_can[node]
+        edge = np.full(n_games, rules.PASS, dtype=np.int64)
+        robots = active & (player == ROBOT) & can_move[ROBOT, node]
         edge[robots] = robot_policy[node[robots]]
         humans = active & (player == HUMAN)
         count = h_indptr[node[humans] + 1] - h_indptr[node[humans]]
         pick = np.floor(rng.random(humans.sum()) * np.maximum(count, 1)).astype(np.int64)
-        chosen = np.full(count.shape, -1, dtype=np.int64)
+        chosen = np.full(count.shape, rules.PASS, dtype=np.int64)
         has = count > 0  # a human without a move passes
         chosen[has] = h_edges[h_indptr[node[humans]][has] + pick[has]]
         edge[humans] = chosen
-        moving = edge >= 0
-        cost[moving] += dag.costs[edge[moving]]
+        moving = edge != rules.PASS
+        cost[moving] += move_cost[edge[moving]]
         node[moving] = dag.targets[edge[moving]]
-        player[active] = 1 - player[active]
+        player[active] = rules.other(player[active])
     raise ValueError("simulation did not reach the end node: is the graph acyclic?")
 
 
-def random_cost_distribution(dag: GameDAG, robot_policy: np.ndarray) -> dict[float, float] | None:
+def _random_moves(dag: GameDAG, robot_policy, h_indptr, h_edges, v: int, p: int) -> list[int]:
+    """The moves the random game may take in state ``(v, p)`` (each equally likely)."""
+    if p == ROBOT:
+        e = int(robot_policy[v])
+        return [e] if e != rules.PASS else []
+    return h_edges[h_indptr[v] : h_indptr[v + 1]].tolist()
+
+
+def random_cost_distribution(
+    dag: GameDAG, robot_policy: np.ndarray, max_entries: int = MAX_DISTRIBUTION_ENTRIES
+) -> dict[float, float] | None:
     """Exact distribution of the cost of ``robot_policy`` against a uniformly random human.
 
-    Returns a mapping cost -> probability (summing to 1), or ``None`` when the policy
-    reaches more than :data:`MAX_DISTRIBUTION_STATES` game states.
+    Returns a mapping cost -> probability (summing to 1; costs rounded to 9 decimals), or
+    ``None`` when the policy reaches more than :data:`MAX_DISTRIBUTION_STATES` game states
+    or the distributions would hold more than ``max_entries`` (state, cost) pairs (with
+    fractional costs nearly every line has its own total).
     """
-    h_indptr, h_edges = human_move_table(dag)
-    reach = _reachable_states(dag, robot_policy, h_indptr, h_edges)
-    if reach is None:
+    h_indptr, h_edges = rules.move_table(dag, HUMAN)
+    reach = rules.reachable_states(dag, robot_policy)
+    if int(reach.sum()) > MAX_DISTRIBUTION_STATES:
         return None
+    move_cost = rules.move_costs(dag)
+    entries = 0
     dist: dict[tuple[int, int], dict[float, float]] = {}
     for v in node_order(dag)[::-1]:
         v = int(v)
         passes = []
-        for p in (ROBOT, HUMAN):
+        for p in rules.PLAYERS:
             if not reach[v, p]:
                 continue
             if v == dag.end:
                 dist[v, p] = {0.0: 1.0}
                 continue
-            if p == ROBOT:
-                e = int(robot_policy[v])
-                moves = [e] if e >= 0 else []
-            else:
-                moves = h_edges[h_indptr[v] : h_indptr[v + 1]].tolist()
+            moves = _random_moves(dag, robot_policy, h_indptr, h_edges, v, p)
             if not moves:
                 passes.append(p)
                 continue
             out: dict[float, float] = {}
             share = 1.0 / len(moves)
             for e in moves:
-                c, t = float(dag.costs[e]), int(dag.targets[e])
-                for value, prob in dist[t, 1 - p].items():
+                c, t = float(move_cost[e]), int(dag.targets[e])
+                for value, prob in dist[t, rules.other(p)].items():
                     key = round(value + c, 9)
                     out[key] = out.get(key, 0.0) + prob * share
+            entries += len(out)
+            if entries > max_entries:
+                return None
             dist[v, p] = out
         for p in passes:  # a pass costs nothing: same distribution as the other side's turn
-            dist[v, p] = dist[v, 1 - p]
+            dist[v, p] = dist[v, rules.other(p)]
     return dict(sorted(dist[dag.start, ROBOT].items()))
 
 
-def _reachable_states(dag, robot_policy, h_indptr, h_edges) -> np.ndarray | None:
-    seen = np.zeros((dag.n_nodes, 2), dtype=bool)
-    stack = [(dag.start, ROBOT)]
-    seen[dag.start, ROBOT] = True
-    count = 1
-    while stack:
-        v, p = stack.pop()
-        if v == dag.end:
-            continue
-        if p == ROBOT:
-            e = int(robot_policy[v])
-            heads = [int(dag.targets[e])] if e >= 0 else [v]
-        else:
-            moves = h_edges[h_indptr[v] : h_indptr[v + 1]]
-            heads = dag.targets[moves].tolist() if moves.size else [v]
-        for t in heads:
-            if not seen[t, 1 - p]:
-                seen[t, 1 - p] = True
-                count += 1
-                if count > MAX_DISTRIBUTION_STATES:
-                    return None
-                stack.append((t, 1 - p))
-    return seen
+def probability_within(
+    dag: GameDAG,
+    robot_policy: np.ndarray,
+    bound: float,
+    *,
+    evaluation: PolicyEvaluation | None = None,
+    max_entries: int = MAX_DISTRIBUTION_ENTRIES,
+) -> float | None:
+    """Exact P(cost <= ``bound``) of ``robot_policy`` against a uniformly random human.
+
+    A forward dynamic program over game states in topological order, carrying the
+    probability of arriving with each budget (``bound`` minus the cost so far). A budget
+    at least the state's worst case (:attr:`PolicyEvaluation.worst`) is won whatever
+    happens, one below its best case is lost: only budgets in between are followed, so RR
+    against the certified WCPL costs nothing and RR against a lower bound follows only the
+    lines that can still decide it.
+
+    Returns
+    -------
+    float or None
+        The probability rounded to 12 decimals, or ``None`` when more than ``max_entries``
+        (state, budget) pairs would be needed (the caller then samples).
+    """
+    ev = evaluate_policy(dag, robot_policy) if evaluation is None else evaluation
+    worst, best = ev.worst, ev.best
+    h_indptr, h_edges = rules.move_table(dag, HUMAN)
+    can_move = rules.has_move(dag)
+    move_cost = rules.move_costs(dag)
+    order = node_order(dag)
+    position = np.empty(dag.n_nodes, dtype=np.int64)
+    position[order] = np.arange(dag.n_nodes)
+    won: list[float] = []
+    pending: dict[tuple[int, int], dict[float, float]] = {}
+    heap: list[tuple[int, int, int, int]] = []
+    entries = 0
+
+    def send(v: int, p: int, budget: float, prob: float) -> bool:
+        """Move ``prob`` to state ``(v, p)`` with ``budget`` left; False past the cap."""
+        nonlocal entries
+        if rules.cost_at_most(worst[v, p], budget):
+            won.append(prob)
+            return True
+        if budget < best[v, p] and not rules.costs_close(budget, best[v, p]):
+            return True  # lost whatever happens
+        state = pending.get((v, p))
+        if state is None:
+            state = pending[v, p] = {}
+            # At a node the side that passes goes first: its mass flows to the other side.
+            heapq.heappush(heap, (int(position[v]), int(can_move[p, v]), v, p))
+        key = round(budget, 9)
+        if key not in state:
+            entries += 1
+            if entries > max_entries:
+                return False
+        state[key] = state.get(key, 0.0) + prob
+        return True
+
+    if not send(dag.start, rules.FIRST_PLAYER, float(bound), 1.0):
+        return None
+    while heap:
+        _, _, v, p = heapq.heappop(heap)
+        masses = pending.pop((v, p))
+        moves = _random_moves(dag, robot_policy, h_indptr, h_edges, v, p)
+        for budget, prob in masses.items():
+            if not moves:  # a pass: same budget, the other side on turn
+                ok = send(v, rules.other(p), budget, prob)
+            else:
+                share = prob / len(moves)
+                ok = all(
+                    send(int(dag.targets[e]), rules.other(p), budget - float(move_cost[e]), share)
+                    for e in moves
+                )
+            if not ok:
+                return None
+    return round(math.fsum(won), 12)
 
 
 def resilience_ratio(costs: np.ndarray | dict, wcpl: float) -> float:
     """Share (0..1) of games with cost <= ``wcpl``: from sampled costs or an exact distribution."""
     if isinstance(costs, dict):
         # Products of move probabilities carry rounding error: 1.0 must read as 1.0.
-        return round(math.fsum(p for c, p in costs.items() if c <= wcpl + 1e-9), 12)
+        return round(math.fsum(p for c, p in costs.items() if rules.cost_at_most(c, wcpl)), 12)
     costs = np.asarray(costs, dtype=np.float64)
-    return float(np.mean(costs <= wcpl + 1e-9))
+    return float(np.mean(rules.cost_at_most(costs, wcpl)))
+
+
+def is_robust_optimal(certified_wcpl: float, minimax: float) -> bool:
+    """Whether a policy's certified WCPL equals the game value W* (within the tolerance)."""
+    return bool(rules.costs_close(certified_wcpl, minimax))
 
 
 @dataclass(frozen=True)
@@ -162,7 +246,8 @@ class PlanMetrics:
 
     ``rr``: exact share of random-human games within the reference WCPL (the paper's, when
     given, else the certified one); ``rr_certified``: within the certified WCPL (1.0 by
-    construction). ``*_sampled``: the paper's seeded simulation.
+    construction). ``*_sampled``: the paper's seeded simulation. ``exact_distribution``:
+    whether ``rr`` is exact (else it is the simulation's, see :func:`probability_within`).
     """
 
     nodes: int
@@ -217,14 +302,14 @@ def plan_metrics(
     s = (dag.start, ROBOT)
     certified = float(evaluation.worst[s])
     reference = certified if wcpl is None else float(wcpl)
-    dist = random_cost_distribution(dag, policy)
     sampled = simulate_random_human(dag, policy, n_games=n_games, seed=seed)
-    if dist is not None:
-        rr, rr_cert = resilience_ratio(dist, reference), resilience_ratio(dist, certified)
-        min_random = min(dist)
-    else:
-        rr, rr_cert = resilience_ratio(sampled, reference), 1.0
-        min_random = float(evaluation.best[s])
+    rr = probability_within(dag, policy, reference, evaluation=evaluation)
+    rr_cert = probability_within(dag, policy, certified, evaluation=evaluation)
+    exact = rr is not None and rr_cert is not None
+    if rr is None:
+        rr = resilience_ratio(sampled, reference)
+    if rr_cert is None:
+        rr_cert = 1.0  # pragma: no cover - the certified WCPL is always won at the start
     # The path when the policy meets its best-response human (for the robust policy: both
     # sides play minimax).
     path, _ = play(dag, policy, evaluation.human_best_response)
@@ -235,11 +320,11 @@ def plan_metrics(
         minimax=solution.minimax,
         wcpl=reference,
         certified_wcpl=certified,
-        robust_optimal=bool(abs(certified - solution.minimax) <= 1e-9),
-        robust_path=[_plain(dag.node_ids[v]) for v in path],
+        robust_optimal=is_robust_optimal(certified, solution.minimax),
+        robust_path=[plain(dag.node_ids[v]) for v in path],
         avg_random=float(evaluation.expected[s]),
         max_random=certified,
-        min_random=float(min_random),
+        min_random=float(evaluation.best[s]),
         rr=rr,
         rr_certified=rr_cert,
         avg_random_sampled=float(sampled.mean()),
@@ -248,9 +333,5 @@ def plan_metrics(
         games=int(n_games),
         seed=int(seed),
         adversarial_tax=(solution.minimax / solution.tct) if solution.tct > 0 else 1.0,
-        exact_distribution=dist is not None,
+        exact_distribution=exact,
     )
-
-
-def _plain(x):
-    return x.item() if hasattr(x, "item") else x

@@ -11,7 +11,10 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from asp.dag import HUMAN, ROBOT, GameDAG
+from asp import rules
+from asp.dag import GameDAG
+from asp.numbers import cost_text, plain
+from asp.rules import HUMAN, ROBOT
 from asp.solve import Solution
 
 DIRECTIONS = ("+x", "-x", "+y", "-y", "+z", "-z")
@@ -49,7 +52,7 @@ class PlanStep:
     def to_dict(self) -> dict:
         out = asdict(self)
         out["human_options"] = list(self.human_options)
-        out["node"] = self.node.item() if hasattr(self.node, "item") else self.node
+        out["node"] = plain(self.node)
         return out
 
 
@@ -72,18 +75,21 @@ def play_steps(
             return int(policy[v])
 
     steps: list[PlanStep] = []
-    v, player = dag.start, ROBOT
+    v, player = dag.start, rules.FIRST_PLAYER
     for k in range(2 * dag.n_nodes + 2):
         if v == dag.end:
             return steps
-        moves = dag.moves(v, player)
+        moves = rules.moves(dag, v, player)
         options: tuple[str, ...] = ()
         if player == HUMAN:
             options = tuple(dict.fromkeys(dag.edge_label(e) for e in moves))
         if not moves:
             steps.append(
-                PlanStep(k + 1, _side(player), "", "", "pass", 0.0, options, dag.node_ids[v])
+                PlanStep(
+                    k + 1, _side(player), "", "", "pass", rules.PASS_COST, options, dag.node_ids[v]
+                )
             )
+            v, player, _ = rules.step(dag, v, player, rules.PASS)
         else:
             e = int(robot_policy[v]) if player == ROBOT else int(human_choice(v, moves))
             if e not in moves:
@@ -97,13 +103,12 @@ def play_steps(
                     op,
                     agent,
                     descriptions.get(op, ""),
-                    float(dag.costs[e]),
+                    rules.move_cost(dag, e),
                     options,
                     dag.node_ids[v],
                 )
             )
-            v = int(dag.targets[e])
-        player = 1 - player
+            v, player, _ = rules.step(dag, v, player, e)
     raise ValueError("the game did not reach the end node")
 
 
@@ -115,7 +120,7 @@ def robust_plan(
 
 
 def _side(player: int) -> str:
-    return "robot" if player == ROBOT else "human"
+    return rules.player_name(player)
 
 
 def plan_text(steps: list[PlanStep]) -> str:
@@ -125,17 +130,13 @@ def plan_text(steps: list[PlanStep]) -> str:
         if not s.operation:
             what = "passes (nothing it may do)"
         else:
-            what = f"{s.operation:5s} {s.agent:3s} {s.description}  [{_num(s.cost)}]"
+            what = f"{s.operation:5s} {s.agent:3s} {s.description}  [{cost_text(s.cost)}]"
         line = f"{s.step:3d}. {s.player:5s} {what}"
         others = [o for o in s.human_options if not o.startswith(f"{s.operation} ")]
         if s.player == "human" and others:
             line += f"   (human may instead: {', '.join(others)})"
         lines.append(line)
     return "\n".join(lines)
-
-
-def _num(x: float) -> str:
-    return str(int(x)) if float(x).is_integer() else f"{x:g}"
 
 
 def relations_summary(relations) -> list[dict]:

@@ -20,34 +20,34 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from asp.dag import ANY, HUMAN, ROBOT, GameDAG
+from asp import rules
+from asp.dag import GameDAG
+from asp.numbers import cost_text
+from asp.rules import HUMAN, ROBOT, cost_at_most, costs_close
 from asp.solve import NO_MOVE, Solution, as_policy_array, evaluate_policy, solve
 
 ROBOT_KINDS = ("robust", "fast-greedy")
 """Named robot policies; anything else is given as a policy array."""
 
-_TOL = 1e-9
-
 
 def side_name(player: int) -> str:
-    return "robot" if player == ROBOT else "human"
+    return rules.player_name(player)
 
 
 def fmt(x: float) -> str:
     """A cost as text: ``3`` rather than ``3.0``."""
-    x = float(x)
-    return str(int(x)) if x.is_integer() else f"{x:g}"
+    return cost_text(x)
 
 
 def fast_greedy_policy(dag: GameDAG, solution: Solution) -> np.ndarray:
     """The robot that follows the cooperative fastest path: at each node it takes the move
     minimising ``cost + coop`` (ties by lower move index), trusting the human to help."""
     policy = np.full(dag.n_nodes, NO_MOVE, dtype=np.int64)
-    ok = np.flatnonzero((dag.sides == ANY) | (dag.sides == ROBOT))
+    ok = np.flatnonzero(rules.move_mask(dag, ROBOT))
     if ok.size == 0:
         return policy
     src = dag.sources[ok]
-    val = np.round(dag.costs[ok] + solution.coop[dag.targets[ok], HUMAN], 9)
+    val = np.round(rules.move_costs(dag)[ok] + solution.coop[dag.targets[ok], HUMAN], 9)
     order = np.lexsort((ok, val, src))
     first = np.ones(order.size, dtype=bool)
     first[1:] = src[order][1:] != src[order][:-1]
@@ -162,7 +162,7 @@ class Summary:
         else:
             if self.finished:
                 gap = self.cost - self.minimax
-                if gap <= _TOL:
+                if cost_at_most(self.cost, self.minimax):
                     out.append(f"you matched the robust robot: cost {fmt(self.cost)} = W*")
                 else:
                     out.append(
@@ -235,7 +235,7 @@ class GameSession:
             self.evaluation = None
             self.worst_table = self.solution.value
         self.node = dag.start
-        self.player = ROBOT
+        self.player = rules.FIRST_PLAYER
         self.cost = 0.0
         self.history: list[Turn] = []
 
@@ -275,15 +275,15 @@ class GameSession:
         return float(self.solution.coop[self.node, self.player])
 
     def _edges(self) -> list[int]:
-        return [] if self.finished else self.dag.moves(self.node, self.player)
+        return rules.moves(self.dag, self.node, self.player)
 
     def moves(self) -> list[Move]:
         """The moves open to the player on turn (empty: it must pass, or the game is over)."""
-        dag, other = self.dag, 1 - self.player
+        dag, other = self.dag, rules.other(self.player)
         out = []
         for k, e in enumerate(self._edges(), start=1):
             t = int(dag.targets[e])
-            c = float(dag.costs[e])
+            c = rules.move_cost(dag, e)
             op = dag.operations[e] if dag.operations is not None else ""
             out.append(
                 Move(
@@ -347,7 +347,8 @@ class GameSession:
             reason=f"the {side_name(self.player)} has no move it may do: passes at zero cost",
         )
         self.history.append(turn)
-        self.player = 1 - self.player
+        self.node, self.player, cost = rules.step(self.dag, self.node, self.player, rules.PASS)
+        self.cost += cost
         return turn
 
     def _apply(self, move: Move, *, by: str, reason: str) -> Turn:
@@ -364,9 +365,8 @@ class GameSession:
             reason=reason,
         )
         self.history.append(turn)
-        self.cost += move.cost
-        self.node = move.target
-        self.player = 1 - self.player
+        self.node, self.player, cost = rules.step(self.dag, self.node, self.player, move.edge)
+        self.cost += cost
         return turn
 
     def _computer_edge(self, moves: list[Move]) -> int:
@@ -379,7 +379,7 @@ class GameSession:
             return edge
         # The best-response human: maximise the guaranteed worst case.
         best = max(m.worst_remaining for m in moves)
-        ties = [m.edge for m in moves if _close(m.worst_remaining, best)]
+        ties = [m.edge for m in moves if costs_close(m.worst_remaining, best)]
         if self._rng is None or len(ties) == 1:
             return ties[0]
         return int(ties[int(self._rng.integers(len(ties)))])
@@ -391,19 +391,19 @@ class GameSession:
             text = f"delays as much as it can: the worst case becomes {fmt(total)}"
             if others:
                 lowest = min(m.worst_remaining for m in others)
-                if lowest < move.worst_remaining - _TOL:
+                if not cost_at_most(move.worst_remaining, lowest):
                     text += f" (other moves allow as little as {fmt(self.cost + lowest)})"
             return text
         alt = min(others, key=lambda m: m.worst_remaining, default=None)
         if self.robot_name == "robust":
             text = f"keeps the worst case at {fmt(total)}"
-            if alt is not None and alt.worst_remaining > move.worst_remaining + _TOL:
+            if alt is not None and not cost_at_most(alt.worst_remaining, move.worst_remaining):
                 text += f" ({alt.label} would allow up to {fmt(self.cost + alt.worst_remaining)})"
             elif alt is not None:
                 ex = self.solution.expected
-                tied = [m for m in moves if _close(m.worst_remaining, move.worst_remaining)]
+                tied = [m for m in moves if costs_close(m.worst_remaining, move.worst_remaining)]
                 exp = {m.edge: m.cost + float(ex[m.target, HUMAN]) for m in tied}
-                if max(exp.values()) - min(exp.values()) > _TOL:
+                if not costs_close(max(exp.values()), min(exp.values())):
                     best = fmt(round(self.cost + exp[move.edge], 3))
                     text += (
                         f"; of {len(tied)} such moves it has the lowest expected cost "
@@ -433,14 +433,14 @@ class GameSession:
             robot_worst = sol.minimax
         held = None
         if self.finished and self.person == HUMAN:
-            held = self.cost <= robot_worst + _TOL * (1 + abs(robot_worst))
+            held = bool(cost_at_most(self.cost, robot_worst))
         slips = tuple(
             (t.step, t.move.label, t.worst_after - t.worst_before)
             for t in self.history
             if self.person == ROBOT
             and t.by == "person"
             and t.move is not None
-            and t.worst_after > t.worst_before + _TOL
+            and not cost_at_most(t.worst_after, t.worst_before)
         )
         return Summary(
             finished=self.finished,
@@ -458,10 +458,6 @@ class GameSession:
 
 def _turns(k: int) -> str:
     return f"{k} turn" if k == 1 else f"{k} turns"
-
-
-def _close(a: float, b: float) -> bool:
-    return abs(a - b) <= _TOL * (1.0 + abs(a) + abs(b))
 
 
 __all__ = [

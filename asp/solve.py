@@ -10,7 +10,8 @@ nodes in reverse topological order, each state gets:
 
 and the robust robot move (a move achieving the minimax value; ties broken by lower
 ``expected`` cost, then by lower move index) and the human's maximising move (ties by
-lower index). A player with no move passes at zero cost.
+lower index). The rules of play (moves, passes, costs, the cost tolerance) come from
+:mod:`asp.rules` as tables (:func:`asp.rules.kernel_tables`).
 
 The sweeps are compiled with numba (``cache=True``): a 1M-node, 3M-edge game solves in
 well under a second.
@@ -24,9 +25,12 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
-from asp.dag import ANY, HUMAN, ROBOT, GameDAG, topological_order
+from asp import rules
+from asp.dag import GameDAG, topological_order
+from asp.rules import HUMAN, ROBOT
+from asp.rules import close_kernel as _close
 
-NO_MOVE = -1
+NO_MOVE = rules.PASS
 """Policy entry of a state whose player has no move (it passes) or of the end node."""
 
 
@@ -67,9 +71,9 @@ def node_order(dag: GameDAG) -> np.ndarray:
 
 def solve(dag: GameDAG) -> Solution:
     """Solve the game exactly: TCT, W*, the robust robot policy and the human's best reply."""
-    order = node_order(dag)
+    t = rules.kernel_tables(dag)
     value, coop, expected, robot, human = _solve_kernel(
-        dag.indptr, dag.targets, dag.costs, dag.sides, order
+        t.indptr, t.targets, t.cost, t.may, node_order(dag), t.tol
     )
     return Solution(
         tct=float(coop[dag.start, ROBOT]),
@@ -120,16 +124,33 @@ def evaluate_policy(dag: GameDAG, robot_policy: np.ndarray | Mapping) -> PolicyE
         the robot must move.
     """
     policy = as_policy_array(dag, robot_policy)
+    t = rules.kernel_tables(dag)
     worst, expected, best, reply = _evaluate_kernel(
-        dag.indptr, dag.targets, dag.costs, dag.sides, node_order(dag), policy
+        t.indptr, t.targets, t.cost, t.may, node_order(dag), policy, t.tol
     )
-    bad = _first_invalid_state(dag.indptr, dag.targets, dag.sides, policy, worst, dag.start)
+    bad = _first_invalid_state(dag, policy, worst)
     if bad >= 0:
         raise ValueError(
             f"robot policy has no valid move at node {dag.node_ids[bad]!r}: expected one of "
             f"the robot's out-edges {dag.moves(bad, ROBOT)}, got {int(policy[bad])}"
         )
     return PolicyEvaluation(worst=worst, expected=expected, best=best, human_best_response=reply)
+
+
+def _first_invalid_state(dag: GameDAG, policy: np.ndarray, worst: np.ndarray) -> int:
+    """The first node (in play order) the policy reaches where its robot move is invalid, or
+    -1. An invalid entry at a state the game cannot reach does not matter."""
+    if not np.isnan(worst[:, ROBOT]).any():
+        return -1
+    reach = rules.reachable_states(dag, policy)  # stops at an invalid robot move
+    e = policy
+    lo, hi = dag.indptr[:-1], dag.indptr[1:]
+    valid = (e >= lo) & (e < hi)
+    valid[valid] = rules.move_mask(dag, ROBOT)[e[valid]]
+    bad = reach[:, ROBOT] & rules.has_move(dag)[ROBOT] & ~valid
+    order = node_order(dag)
+    hits = order[bad[order]]
+    return int(hits[0]) if hits.size else -1
 
 
 def certified_worst_case(dag: GameDAG, robot_policy: np.ndarray | Mapping) -> float:
@@ -162,21 +183,22 @@ def play(
     dag: GameDAG, robot_policy: np.ndarray, human_policy: np.ndarray
 ) -> tuple[list[int], float]:
     """Play two deterministic policies from the start; return the node path and its cost."""
-    v, player, cost = dag.start, ROBOT, 0.0
+    v, player, cost = dag.start, rules.FIRST_PLAYER, 0.0
     path = [v]
     for _ in range(2 * dag.n_nodes + 2):
         if v == dag.end:
             return path, cost
-        moves = dag.moves(v, player)
+        moves = rules.moves(dag, v, player)
+        e = rules.PASS
         if moves:
             e = int((robot_policy if player == ROBOT else human_policy)[v])
             if e not in moves:
-                who = "robot" if player == ROBOT else "human"
+                who = rules.player_name(player)
                 raise ValueError(f"{who} policy has no valid move at node {dag.node_ids[v]!r}")
-            cost += float(dag.costs[e])
-            v = int(dag.targets[e])
+        v, player, c = rules.step(dag, v, player, e)
+        cost += c
+        if e != rules.PASS:
             path.append(v)
-        player = 1 - player
     raise ValueError("play did not reach the end node: is the graph acyclic?")
 
 
@@ -189,13 +211,8 @@ def robust_path(dag: GameDAG, solution: Solution) -> list:
 # --------------------------------------------------------------------------- kernels
 
 
-@numba.njit(cache=True, inline="always")
-def _close(a: float, b: float) -> bool:
-    return abs(a - b) <= 1e-9 * (1.0 + abs(a) + abs(b))
-
-
 @numba.njit(cache=True)
-def _solve_kernel(indptr, targets, costs, sides, order):  # pragma: no cover - compiled
+def _solve_kernel(indptr, targets, costs, may, order, tol):  # pragma: no cover - compiled
     n = indptr.shape[0] - 1
     value = np.zeros((n, 2))
     coop = np.zeros((n, 2))
@@ -214,18 +231,17 @@ def _solve_kernel(indptr, targets, costs, sides, order):  # pragma: no cover - c
         for e in range(lo, hi):
             t = targets[e]
             c = costs[e]
-            s = sides[e]
-            if s == ANY or s == ROBOT:
+            if may[ROBOT, e]:
                 val = c + value[t, HUMAN]
                 ex = c + expected[t, HUMAN]
-                better = r_arg < 0 or (val < r_val and not _close(val, r_val))
-                tie_better = _close(val, r_val) and ex < r_exp and not _close(ex, r_exp)
+                better = r_arg < 0 or (val < r_val and not _close(val, r_val, tol))
+                tie_better = _close(val, r_val, tol) and ex < r_exp and not _close(ex, r_exp, tol)
                 if better or tie_better:
                     r_val, r_exp, r_arg = val, ex, e
                 r_coop = min(r_coop, c + coop[t, HUMAN])
-            if s == ANY or s == HUMAN:
+            if may[HUMAN, e]:
                 val = c + value[t, ROBOT]
-                if h_arg < 0 or (val > h_val and not _close(val, h_val)):
+                if h_arg < 0 or (val > h_val and not _close(val, h_val, tol)):
                     h_val, h_arg = val, e
                 h_sum += c + expected[t, ROBOT]
                 h_cnt += 1
@@ -253,7 +269,7 @@ def _solve_kernel(indptr, targets, costs, sides, order):  # pragma: no cover - c
 
 
 @numba.njit(cache=True)
-def _evaluate_kernel(indptr, targets, costs, sides, order, policy):  # pragma: no cover
+def _evaluate_kernel(indptr, targets, costs, may, order, policy, tol):  # pragma: no cover
     n = indptr.shape[0] - 1
     worst = np.zeros((n, 2))
     expected = np.zeros((n, 2))
@@ -269,12 +285,11 @@ def _evaluate_kernel(indptr, targets, costs, sides, order, policy):  # pragma: n
         for e in range(lo, hi):
             t = targets[e]
             c = costs[e]
-            s = sides[e]
-            if s == ANY or s == ROBOT:
+            if may[ROBOT, e]:
                 robot_moves = True
-            if s == ANY or s == HUMAN:
+            if may[HUMAN, e]:
                 val = c + worst[t, ROBOT]
-                if h_cnt == 0 or (val > h_worst and not _close(val, h_worst)):
+                if h_cnt == 0 or (val > h_worst and not _close(val, h_worst, tol)):
                     h_worst = val
                     reply[v] = e
                 h_sum += c + expected[t, ROBOT]
@@ -284,7 +299,7 @@ def _evaluate_kernel(indptr, targets, costs, sides, order, policy):  # pragma: n
             worst[v, HUMAN], expected[v, HUMAN], best[v, HUMAN] = h_worst, h_sum / h_cnt, h_best
         if robot_moves:
             e = policy[v]
-            if e < lo or e >= hi or not (sides[e] == ANY or sides[e] == ROBOT):
+            if e < lo or e >= hi or not may[ROBOT, e]:
                 # Only an error if this state can matter: report it, the caller decides.
                 worst[v, ROBOT] = np.nan
                 expected[v, ROBOT] = np.nan
@@ -307,43 +322,3 @@ def _evaluate_kernel(indptr, targets, costs, sides, order, policy):  # pragma: n
                 best[v, ROBOT],
             )
     return worst, expected, best, reply
-
-
-@numba.njit(cache=True)
-def _first_invalid_state(indptr, targets, sides, policy, worst, start):  # pragma: no cover
-    """The first node reachable under the policy where its robot move is invalid, or -1.
-
-    An invalid entry at a state the game cannot reach does not matter.
-    """
-    n = indptr.shape[0] - 1
-    seen = np.zeros((n, 2), np.bool_)
-    stack_v = np.empty(2 * n + 2, np.int64)
-    stack_p = np.empty(2 * n + 2, np.int64)
-    stack_v[0], stack_p[0] = start, ROBOT
-    seen[start, ROBOT] = True
-    top = 1
-    while top > 0:
-        top -= 1
-        v, p = stack_v[top], stack_p[top]
-        lo, hi = indptr[v], indptr[v + 1]
-        if p == ROBOT and np.isnan(worst[v, ROBOT]):
-            e = policy[v]
-            if e < lo or e >= hi or not (sides[e] == ANY or sides[e] == ROBOT):
-                return v
-        moved = False
-        for e in range(lo, hi):
-            s = sides[e]
-            if s == ANY or s == p:
-                moved = True
-                if p == ROBOT and e != policy[v]:
-                    continue
-                t = targets[e]
-                if not seen[t, 1 - p]:
-                    seen[t, 1 - p] = True
-                    stack_v[top], stack_p[top] = t, 1 - p
-                    top += 1
-        if not moved and lo < hi and not seen[v, 1 - p]:
-            seen[v, 1 - p] = True
-            stack_v[top], stack_p[top] = v, 1 - p
-            top += 1
-    return -1

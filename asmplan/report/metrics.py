@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 from asp.metrics import PlanMetrics
+from asp.numbers import cost_text
 
 
 def _num(x: float) -> str:
-    return str(int(x)) if float(x).is_integer() else f"{x:.3f}"
+    return cost_text(x, ".3f")
 
 
 def metrics_text(m: PlanMetrics, title: str = "") -> str:
