@@ -24,6 +24,9 @@ Scalar helpers (:func:`moves`, :func:`step`, :func:`settle`) serve sessions and
 environments; table builders (:func:`move_masks`, :func:`move_counts`, :func:`move_costs`,
 :func:`has_move`, :func:`kernel_tables`) serve the vectorised and compiled consumers.
 
+Every ``dag`` argument is an :class:`asp.dag.GameDAG` (not imported: :mod:`asp.dag` builds on
+this module, and imports flow one way).
+
 Numba caches a compiled kernel per source file and does not notice a change in a function
 it calls from another file: the kernels therefore take the tolerance as an argument, and
 after editing :func:`costs_close` clear the ``__pycache__`` folders (``make clean``).
@@ -32,13 +35,9 @@ after editing :func:`costs_close` clear the ``__pycache__`` folders (``make clea
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
 
 import numba
 import numpy as np
-
-if TYPE_CHECKING:  # pragma: no cover - typing only (asp.dag imports this module)
-    from asp.dag import GameDAG
 
 ROBOT = 0
 HUMAN = 1
@@ -104,7 +103,7 @@ def cost_at_most(a, b, tol: float = COST_TOL):
     return np.less_equal(a, b) | costs_close(a, b, tol)
 
 
-def move_costs(dag: GameDAG) -> np.ndarray:
+def move_costs(dag) -> np.ndarray:
     """(m,) float64: the cost of taking each edge, in the DAG's cost model.
 
     The edge's cost under both ``steps`` and ``time``: a ``steps`` DAG says 1 per move
@@ -113,7 +112,7 @@ def move_costs(dag: GameDAG) -> np.ndarray:
     return dag.costs
 
 
-def move_cost(dag: GameDAG, edge: int) -> float:
+def move_cost(dag, edge: int) -> float:
     """The cost of taking ``edge`` (:data:`PASS_COST` for :data:`PASS`)."""
     return PASS_COST if edge == PASS else float(move_costs(dag)[edge])
 
@@ -131,28 +130,28 @@ def other(player):
     return 1 - player
 
 
-def move_mask(dag: GameDAG, player: int) -> np.ndarray:
+def move_mask(dag, player: int) -> np.ndarray:
     """(m,) bool: the edges ``player`` may take."""
     return may_take(dag.sides, player)
 
 
-def move_masks(dag: GameDAG) -> np.ndarray:
+def move_masks(dag) -> np.ndarray:
     """(2, m) bool: ``[player, edge]``, the edges each player may take."""
     return np.stack([move_mask(dag, p) for p in PLAYERS])
 
 
-def move_counts(dag: GameDAG) -> np.ndarray:
+def move_counts(dag) -> np.ndarray:
     """(2, n) int64: ``[player, node]``, the number of moves of each player at each node."""
     masks = move_masks(dag)
     return np.stack([np.bincount(dag.sources[masks[p]], minlength=dag.n_nodes) for p in PLAYERS])
 
 
-def has_move(dag: GameDAG) -> np.ndarray:
+def has_move(dag) -> np.ndarray:
     """(2, n) bool: ``[player, node]``, whether the player has a move there (else it passes)."""
     return move_counts(dag) > 0
 
 
-def move_table(dag: GameDAG, player: int) -> tuple[np.ndarray, np.ndarray]:
+def move_table(dag, player: int) -> tuple[np.ndarray, np.ndarray]:
     """CSR of ``player``'s moves: ``(indptr (n+1,), edges (k,))``, edges in CSR order."""
     mask = move_mask(dag, player)
     indptr = np.zeros(dag.n_nodes + 1, dtype=np.int64)
@@ -160,7 +159,7 @@ def move_table(dag: GameDAG, player: int) -> tuple[np.ndarray, np.ndarray]:
     return indptr, np.flatnonzero(mask).astype(np.int64)
 
 
-def moves(dag: GameDAG, node: int, player: int) -> list[int]:
+def moves(dag, node: int, player: int) -> list[int]:
     """Edge indices ``player`` may take at ``node``, in edge order (empty: it passes)."""
     if node == dag.end:
         return []
@@ -168,7 +167,7 @@ def moves(dag: GameDAG, node: int, player: int) -> list[int]:
     return [e for e in range(lo, hi) if may_take(int(dag.sides[e]), player)]
 
 
-def step(dag: GameDAG, node: int, player: int, edge: int = PASS) -> tuple[int, int, float]:
+def step(dag, node: int, player: int, edge: int = PASS) -> tuple[int, int, float]:
     """Play ``edge`` (or :data:`PASS`) in state ``(node, player)``.
 
     Returns
@@ -239,7 +238,7 @@ class KernelTables:
     tol: float
 
 
-def kernel_tables(dag: GameDAG) -> KernelTables:
+def kernel_tables(dag) -> KernelTables:
     """The tables the compiled kernels play by."""
     return KernelTables(
         indptr=dag.indptr,
@@ -283,7 +282,7 @@ def _reachable_kernel(indptr, targets, may, policy, start, end):  # pragma: no c
     return seen
 
 
-def reachable_states(dag: GameDAG, robot_policy: np.ndarray) -> np.ndarray:
+def reachable_states(dag, robot_policy: np.ndarray) -> np.ndarray:
     """(n, 2) bool: the game states reachable when the robot follows ``robot_policy``
     against any human (the end node's states included)."""
     t = kernel_tables(dag)
