@@ -37,6 +37,7 @@ format: $(STAMP)
 
 bench: $(STAMP)
 	$(BIN)/python benchmarks/solve_scale.py
+	$(BIN)/python benchmarks/fractional_costs.py
 	$(BIN)/python benchmarks/relations_scale.py
 	$(BIN)/python benchmarks/state_graph_scale.py
 

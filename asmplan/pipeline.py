@@ -44,7 +44,7 @@ if TYPE_CHECKING:  # pragma: no cover - types only
     from asp.state_graph import StateGraph
     from cad.relations import Relations
 
-PLAN_FORMAT = "asmplan-plan/1"
+PLAN_FORMAT = "asmplan-plan/2"
 GRAPH_SUFFIXES = (".json", ".graphml", ".xml")
 """Suffixes read as a game DAG file rather than an assembly."""
 PLAN_FILES = ("plan.json", "dag.png")
@@ -163,34 +163,30 @@ class AssemblyPlan:
         return self.game.dag
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``asmplan-plan/1`` object written as ``plan.json``."""
-        spec, dag = self.assembly.spec, self.game.dag
-        out = {
-            "format": PLAN_FORMAT,
-            "assembly": spec.name,
-            "source": spec.source,
-            "relations": self.relations_summary,
-            "states": self.graph.n_states,
-            "transitions": self.graph.n_transitions,
-            "sequences": self.sequences,
-            "game_nodes": dag.n_nodes,
-            "game_edges": dag.n_edges,
-            "cost": dag.cost_model,
-            "tct": self.solution.tct,
-            "minimax": self.solution.minimax,
-            "robust_plan": [s.to_dict() for s in self.steps],
-            "schedule": self.schedule.to_dict(),
-        }
+        """The ``asmplan-plan/2`` object written as ``plan.json`` (:mod:`asmplan.planfile`)."""
+        from asmplan.planfile import alternate_states, plan_document
+
+        doc = plan_document(
+            spec=self.assembly.spec,
+            dag=self.game.dag,
+            solution=self.solution,
+            describe=alternate_states(self.graph, self.game.dag),
+            extra={
+                "relations": self.relations_summary,
+                "states": self.graph.n_states,
+                "transitions": self.graph.n_transitions,
+                "sequences": self.sequences,
+                "schedule": self.schedule.to_dict(),
+            },
+        )
         if self.concurrent is not None:
             from asp.concurrent_plan import plan_entries
 
-            out.update(plan_entries(self.concurrent))
-            out["schedule"].update(
+            doc.update(plan_entries(self.concurrent))
+            doc["schedule"].update(
                 chain_bound=self.schedule.chain_bound, load_bound=self.schedule.load_bound
             )
-        if spec.credit:
-            out["credit"] = spec.credit
-        return out
+        return doc
 
 
 # --------------------------------------------------------------------------- steps
@@ -499,25 +495,22 @@ def write_plan(
     tuple of Path
         The files written (the manifest last).
     """
-    from asmplan.report.plot import MAX_PLOT_NODES, plot_dag
+    from asmplan.report.plot import plot_dag
     from asp.atomic import OutputSet
     from asp.solve import play
 
     dag, solution = result.game.dag, result.solution
-    say = on_step or (lambda _message: None)
     with OutputSet(output, owns=PLAN_FILES + CONCURRENT_FILES) as out:
-        out.write_text("plan.json", json.dumps(result.to_dict(), indent=1, allow_nan=False) + "\n")
-        if dag.n_nodes <= MAX_PLOT_NODES:
-            path, _ = play(dag, solution.robot_policy, solution.human_policy)
-            plot_dag(
-                dag,
-                out.path("dag.png"),
-                highlight=path_edges(dag, path),
-                title=f"{result.assembly.spec.name}: game DAG ({dag.cost_model}), robust plan "
-                f"in red, TCT {solution.tct:g}, W* {solution.minimax:g}",
-            )
-        else:
-            say(f"  dag.png skipped: {dag.n_nodes} nodes > {MAX_PLOT_NODES}")
+        doc = result.to_dict()
+        out.write_text("plan.json", json.dumps(doc, separators=(",", ":"), allow_nan=False) + "\n")
+        path, _ = play(dag, solution.robot_policy, solution.human_policy)
+        plot_dag(
+            dag,
+            out.path("dag.png"),
+            highlight=path_edges(dag, path),
+            title=f"{result.assembly.spec.name}: game DAG ({dag.cost_model}), robust plan "
+            f"in red, TCT {solution.tct:g}, W* {solution.minimax:g}",
+        )
         if result.concurrent is not None:
             from asp.concurrent_plan import write_figures
 

@@ -38,10 +38,11 @@ from asp.solve import PolicyEvaluation, Solution, evaluate_policy, node_order, p
 DEFAULT_GAMES = 1000
 MAX_DISTRIBUTION_STATES = 200_000
 """Above this many reachable game states the whole distribution is not computed."""
-MAX_DISTRIBUTION_ENTRIES = 1_000_000
+MAX_DISTRIBUTION_ENTRIES = 250_000
 """Cap on the (game state, cost or budget) pairs an exact dynamic program may hold; past it
-:func:`random_cost_distribution` and :func:`probability_within` answer ``None`` (bounded
-time and memory: about a second and a few hundred MB in the worst case)."""
+:func:`random_cost_distribution` and :func:`probability_within` answer ``None``, which bounds
+their time and memory (about 2 s and 100 MB in the worst case on one core;
+``benchmarks/fractional_costs.py``)."""
 
 
 def human_move_table(dag: GameDAG) -> tuple[np.ndarray, np.ndarray]:

@@ -1,0 +1,552 @@
+"""The plan file ``plan.json`` (format ``asmplan-plan/2``): the robust policy a cell runs.
+
+A robust plan is a policy, not a line (``../shared/DESIGN.md``, "The plan a robot runs").
+The file holds, for every state the robust robot can reach against any human, the robots'
+next operations, the instruction to the person and the remaining guaranteed bound
+(``policy``); the principal line (``robust_plan``: both sides follow the plan); the worst
+line (``worst_line``: the robust robot against a delaying human); the metrics and the CP-SAT
+schedule. The JSON Schema is ``asmplan/schemas/plan-2.schema.json`` (shipped in the package).
+
+The policy table is columnar so that large policies stay fast to write and read: state
+``i`` is entry ``i`` of every array of ``policy.states``; its moves are
+``policy.moves.*[ptr[i]:ptr[i + 1]]``. A state's done operations are a hexadecimal bit mask
+over ``policy.operations`` (bit ``k`` set: ``operations[k]`` done); its tools are value
+indices into ``policy.tools``. A move's operation and agent are indices into
+``policy.operations`` and ``policy.agents`` (``-1``: the side passes at zero cost).
+:class:`asmplan.advisor.Advisor` reads it and answers in operation ids.
+
+Turn model ``alternate``: a state is (assembly state, side on turn). At a robot state the
+table keeps the robots' one planned move; at a human state every move the person may make.
+The instruction to the person is the move that keeps the guaranteed bound lowest (ties: the
+cooperative cost, then the move order).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+import numba
+import numpy as np
+
+from asp.atomic import write_text
+from asp.dag import ANY, HUMAN, ROBOT, GameDAG
+from asp.errors import FormatError
+from asp.solve import Solution, node_order
+
+FORMAT = "asmplan-plan/2"
+SCHEMA_FILE = "plan-2.schema.json"
+TURN_NAMES = ("robot", "human")
+
+StateDescriber = Callable[[int], dict]
+"""Node index -> ``{"done": [op ids], "tools": {name: value}, "running": [...]}``."""
+
+
+# --------------------------------------------------------------------------- state names
+
+
+def alternate_states(graph, dag: GameDAG) -> StateDescriber:
+    """The structured state of each node of ``game_dag(graph)`` (turn model ``alternate``).
+
+    Node ``i < n - 1`` is the ``i``-th state that can still be completed and is not
+    complete (the numbering of :func:`asp.game.game_dag`); the last node is the complete
+    assembly. No operation runs between turns, so ``running`` is always empty.
+    """
+    alive = graph.coreachable()
+    complete = graph.complete
+    inner = np.flatnonzero(alive & ~complete)
+    ends = np.flatnonzero(alive & complete)
+    if inner.size + 1 != dag.n_nodes:
+        raise ValueError(
+            f"state names: the game has {dag.n_nodes} nodes, the state graph "
+            f"{inner.size + 1} (was the game built from this graph?)"
+        )
+    model = graph.model
+    state_of = np.append(inner, ends[:1])
+
+    def describe(v: int) -> dict:
+        key = graph.keys[int(state_of[v])]
+        return {"done": model.done_ops(key), "tools": model.tool_state(key), "running": []}
+
+    return describe
+
+
+# --------------------------------------------------------------------------- policy table
+
+
+@numba.njit(cache=True)
+def _reach_kernel(indptr, targets, sides, robot_policy, order, start, end):  # pragma: no cover
+    """(n, 2) bool: game states the robust robot reaches against any human."""
+    n = indptr.shape[0] - 1
+    reach = np.zeros((n, 2), np.bool_)
+    reach[start, ROBOT] = True
+    for k in range(n):
+        v = order[k]
+        if v == end:
+            continue
+        for _ in range(2):  # a pass flips the turn at the same node
+            if reach[v, ROBOT]:
+                e = robot_policy[v]
+                if e >= 0:
+                    reach[targets[e], HUMAN] = True
+                else:
+                    reach[v, HUMAN] = True
+            if reach[v, HUMAN]:
+                moved = False
+                for e in range(indptr[v], indptr[v + 1]):
+                    if sides[e] == ANY or sides[e] == HUMAN:
+                        reach[targets[e], ROBOT] = True
+                        moved = True
+                if not moved:
+                    reach[v, ROBOT] = True
+    return reach
+
+
+@dataclass(frozen=True, eq=False)
+class PolicyTable:
+    """The reachable game states of the robust policy and their moves (arrays).
+
+    Attributes
+    ----------
+    node : (S,) int64
+        Game DAG node of each state (states in topological order, robot before human).
+    turn : (S,) int8
+        Side on turn (``ROBOT`` / ``HUMAN``).
+    bound : (S,) float64
+        Remaining guaranteed cost (the minimax value of the state).
+    ptr : (S + 1,) int64
+        Moves of state ``i`` are ``ptr[i]:ptr[i + 1]``.
+    edge : (M,) int64
+        Game DAG edge of each move (``-1``: a pass).
+    next : (M,) int64
+        State reached by each move.
+    instruction : (S,) int64
+        At a human state, the move (index into the move arrays) the person is asked to
+        make; ``-1`` elsewhere or when the person can only pass.
+    """
+
+    node: np.ndarray
+    turn: np.ndarray
+    bound: np.ndarray
+    ptr: np.ndarray
+    edge: np.ndarray
+    next: np.ndarray
+    instruction: np.ndarray
+
+
+def policy_table(dag: GameDAG, solution: Solution) -> PolicyTable:
+    """Every state the robust robot reaches against any human, with its moves."""
+    order = node_order(dag)
+    policy = np.asarray(solution.robot_policy, dtype=np.int64)
+    reach = _reach_kernel(dag.indptr, dag.targets, dag.sides, policy, order, dag.start, dag.end)
+    rank = np.empty(dag.n_nodes, dtype=np.int64)
+    rank[order] = np.arange(dag.n_nodes)
+    flat = np.flatnonzero(reach.ravel())  # index v * 2 + p
+    nodes, turns = flat // 2, flat % 2
+    sort = np.lexsort((turns, rank[nodes]))
+    nodes, turns = nodes[sort], turns[sort]
+    index = np.full((dag.n_nodes, 2), -1, dtype=np.int64)
+    index[nodes, turns] = np.arange(nodes.size)
+    ptr, edge, nxt, instruction = _moves_kernel(
+        dag.indptr,
+        dag.targets,
+        dag.costs,
+        dag.sides,
+        policy,
+        nodes,
+        turns.astype(np.int64),
+        index,
+        solution.value,
+        solution.coop,
+        dag.end,
+    )
+    return PolicyTable(
+        node=nodes,
+        turn=turns.astype(np.int8),
+        bound=solution.value[nodes, turns],
+        ptr=ptr,
+        edge=edge,
+        next=nxt,
+        instruction=instruction,
+    )
+
+
+@numba.njit(cache=True)
+def _moves_kernel(
+    indptr, targets, costs, sides, policy, nodes, turns, index, value, coop, end
+):  # pragma: no cover - compiled
+    s_count = nodes.shape[0]
+    ptr = np.zeros(s_count + 1, np.int64)
+    for i in range(s_count):
+        v, p = nodes[i], turns[i]
+        k = 0
+        if v != end:
+            if p == ROBOT:
+                k = 1
+            else:
+                for e in range(indptr[v], indptr[v + 1]):
+                    if sides[e] == ANY or sides[e] == HUMAN:
+                        k += 1
+                k = max(k, 1)
+        ptr[i + 1] = ptr[i] + k
+    edge = np.full(ptr[s_count], -1, np.int64)
+    nxt = np.full(ptr[s_count], -1, np.int64)
+    instruction = np.full(s_count, -1, np.int64)
+    for i in range(s_count):
+        v, p = nodes[i], turns[i]
+        if v == end:
+            continue
+        j = ptr[i]
+        if p == ROBOT:
+            e = policy[v]
+            edge[j] = e
+            nxt[j] = index[targets[e], HUMAN] if e >= 0 else index[v, HUMAN]
+            continue
+        best, best_coop = np.inf, np.inf
+        for e in range(indptr[v], indptr[v + 1]):
+            if sides[e] == ANY or sides[e] == HUMAN:
+                t = targets[e]
+                edge[j] = e
+                nxt[j] = index[t, ROBOT]
+                val = costs[e] + value[t, ROBOT]
+                cv = costs[e] + coop[t, ROBOT]
+                tol = 1e-9 * (1.0 + abs(val) + abs(best))
+                if val < best - tol or (abs(val - best) <= tol and cv < best_coop - 1e-9):
+                    best, best_coop, instruction[i] = val, cv, j
+                j += 1
+        if j == ptr[i]:  # the person has no move: a pass
+            nxt[j] = index[v, ROBOT]
+    return ptr, edge, nxt, instruction
+
+
+def policy_document(
+    dag: GameDAG, solution: Solution, describe: StateDescriber | None, table: PolicyTable
+) -> dict:
+    """The ``policy`` object of the plan file (columnar, see the module docstring)."""
+    op_names = _operation_names(dag, describe)
+    op_index = {op: k for k, op in enumerate(op_names)}
+    agent_names = sorted(set(dag.agents or ()))
+    agent_index = {a: k for k, a in enumerate(agent_names)}
+    edge_op = np.array([op_index.get(op, -1) for op in (dag.operations or ())], dtype=np.int64)
+    edge_agent = np.array([agent_index.get(a, -1) for a in (dag.agents or ())], dtype=np.int64)
+    moves = table.edge >= 0
+    move_op = np.full(table.edge.shape, -1, dtype=np.int64)
+    move_agent = np.full(table.edge.shape, -1, dtype=np.int64)
+    move_cost = np.zeros(table.edge.shape)
+    if edge_op.size:
+        move_op[moves] = edge_op[table.edge[moves]]
+        move_agent[moves] = edge_agent[table.edge[moves]]
+    move_cost[moves] = dag.costs[table.edge[moves]]
+
+    tools: dict[str, list[str]] = {}
+    done_col, tools_col, running_col = [], [], []
+    cache: dict[int, tuple] = {}
+    for v in table.node.tolist():
+        if v not in cache:
+            state = describe(v) if describe is not None else _anonymous(v)
+            mask = 0
+            for op in state["done"]:
+                mask |= 1 << op_index[op]
+            values = []
+            for name, value in state["tools"].items():
+                known = tools.setdefault(name, [])
+                if value not in known:
+                    known.append(value)
+                values.append(known.index(value))
+            running = [[r["agent"], r["operation"], r["remaining"]] for r in state["running"]]
+            cache[v] = (format(mask, "x"), values, running)
+        mask_hex, values, running = cache[v]
+        done_col.append(mask_hex)
+        tools_col.append(values)
+        running_col.append(running)
+
+    turn_names = np.array(TURN_NAMES, dtype=object)[table.turn].tolist()
+    robots: list[list] = []
+    instruction: list = []
+    for i, t in enumerate(table.turn.tolist()):
+        lo = int(table.ptr[i])
+        if t == ROBOT and table.ptr[i + 1] > lo and move_op[lo] >= 0:
+            robots.append([[int(move_op[lo]), int(move_agent[lo])]])
+        else:
+            robots.append([])
+        j = int(table.instruction[i])
+        instruction.append(None if j < 0 else [int(move_op[j]), int(move_agent[j])])
+    return {
+        "turn_model": dag.turn_model,
+        "cost": dag.cost_model,
+        "operations": op_names,
+        "agents": agent_names,
+        "tools": tools,
+        "start": 0,
+        "n_states": int(table.node.size),
+        "n_moves": int(table.edge.size),
+        "states": {
+            "node": [_plain(dag.node_ids[v]) for v in table.node.tolist()],
+            "turn": turn_names,
+            "done": done_col,
+            "tools": tools_col,
+            "running": running_col,
+            "bound": _numbers(table.bound),
+            "robots": robots,
+            "instruction": instruction,
+        },
+        "moves": {
+            "ptr": table.ptr.tolist(),
+            "operation": move_op.tolist(),
+            "agent": move_agent.tolist(),
+            "cost": _numbers(move_cost),
+            "next": table.next.tolist(),
+        },
+    }
+
+
+def _operation_names(dag: GameDAG, describe: StateDescriber | None) -> list[str]:
+    names = dict.fromkeys(op for op in (dag.operations or ()) if op)
+    if describe is not None:
+        names.update(dict.fromkeys(describe(dag.end)["done"]))
+    return list(names)
+
+
+def _anonymous(v: int) -> dict:
+    return {"done": [], "tools": {}, "running": []}
+
+
+def _numbers(arr: np.ndarray) -> list:
+    """Floats that are whole as ints (shorter JSON), others as floats."""
+    arr = np.asarray(arr, dtype=np.float64)
+    if np.all(np.isfinite(arr)) and np.all(arr == np.round(arr)):
+        return arr.astype(np.int64).tolist()
+    return arr.tolist()
+
+
+def _plain(x):
+    return x.item() if hasattr(x, "item") else x
+
+
+# --------------------------------------------------------------------------- lines
+
+
+def line_steps(policy: dict, follow: str, operations: dict[str, dict]) -> list[dict]:
+    """A line through the policy from the start, as readable steps.
+
+    ``follow="plan"``: the person follows the instruction (the principal line);
+    ``follow="worst"``: the person takes a move that keeps the bound highest (the worst line).
+    """
+    states, moves = policy["states"], policy["moves"]
+    op_names, agent_names = policy["operations"], policy["agents"]
+    steps: list[dict] = []
+    i, total = policy["start"], 0.0
+    while True:
+        lo, hi = moves["ptr"][i], moves["ptr"][i + 1]
+        if lo == hi:
+            return steps
+        turn = states["turn"][i]
+        if turn == "robot" or hi - lo == 1:
+            j = lo
+        elif follow == "plan":
+            j = _instruction_move(policy, i)
+        else:
+            j = max(
+                range(lo, hi),
+                key=lambda m: (moves["cost"][m] + states["bound"][moves["next"][m]], -m),
+            )
+        op = op_names[moves["operation"][j]] if moves["operation"][j] >= 0 else ""
+        agent = agent_names[moves["agent"][j]] if moves["agent"][j] >= 0 else ""
+        options = []
+        if turn == "human":
+            options = [
+                f"{op_names[moves['operation'][m]]} {agent_names[moves['agent'][m]]}"
+                for m in range(lo, hi)
+                if moves["operation"][m] >= 0
+            ]
+        cost = moves["cost"][j]
+        total += cost
+        info = operations.get(op, {})
+        steps.append(
+            {
+                "step": len(steps) + 1,
+                "player": turn,
+                "operation": op,
+                "agent": agent,
+                "description": info.get("description", "") if op else "pass",
+                "parts": list(info.get("parts", [])) if op else [],
+                "cost": cost,
+                "elapsed": total,
+                "bound": states["bound"][moves["next"][j]],
+                "human_options": options,
+                "node": states["node"][i],
+            }
+        )
+        i = moves["next"][j]
+
+
+def _instruction_move(policy: dict, i: int) -> int:
+    """The move index of the instruction at state ``i`` (its first move if none)."""
+    states, moves = policy["states"], policy["moves"]
+    lo, hi = moves["ptr"][i], moves["ptr"][i + 1]
+    want = states["instruction"][i]
+    if want is not None:
+        for m in range(lo, hi):
+            if [moves["operation"][m], moves["agent"][m]] == want:
+                return m
+    return lo
+
+
+# --------------------------------------------------------------------------- the document
+
+
+def plan_document(
+    *,
+    spec,
+    dag: GameDAG,
+    solution: Solution,
+    describe: StateDescriber | None = None,
+    extra: dict | None = None,
+) -> dict:
+    """The whole plan file: policy, lines, metrics, operations and parts, plus ``extra``.
+
+    ``extra`` holds the keys computed elsewhere (relations, state graph sizes, ``schedule``);
+    they are kept as given.
+    """
+    table = policy_table(dag, solution)
+    policy = policy_document(dag, solution, describe, table)
+    operations = {
+        op.id: {
+            "description": op.description,
+            "agents": dict(op.durations),
+            "parts": list(op.parts),
+        }
+        for op in spec.operations
+    }
+    principal = line_steps(policy, "plan", operations)
+    worst = line_steps(policy, "worst", operations)
+    w0 = principal[-1]["elapsed"] if principal else 0.0
+    doc = {
+        "format": FORMAT,
+        "assembly": spec.name,
+        "source": spec.source,
+        "turn_model": dag.turn_model,
+        "cost": dag.cost_model,
+        "game_nodes": dag.n_nodes,
+        "game_edges": dag.n_edges,
+        "tct": solution.tct,
+        "minimax": solution.minimax,
+        "metrics": {
+            "tct": solution.tct,
+            "minimax": solution.minimax,
+            "w0": w0,
+            "worst_line": worst[-1]["elapsed"] if worst else 0.0,
+            "adversarial_tax": solution.minimax / solution.tct if solution.tct > 0 else 1.0,
+            "avg_random": float(solution.expected[dag.start, ROBOT]),
+            "policy_states": policy["n_states"],
+            "policy_moves": policy["n_moves"],
+        },
+        "agents": {a.name: a.side for a in spec.agents},
+        "parts": [
+            {"id": p.id, "name": p.name, "file": p.file, "quantity": p.quantity} for p in spec.parts
+        ],
+        "operations": operations,
+        "robust_plan": principal,
+        "worst_line": worst,
+        "policy": policy,
+    }
+    if extra:
+        for key, value in extra.items():
+            doc.setdefault(key, value)
+    if spec.credit:
+        doc["credit"] = spec.credit
+    return doc
+
+
+# --------------------------------------------------------------------------- read / write
+
+
+def write_plan(path: str | os.PathLike[str], doc: dict) -> Path:
+    """Write a plan file atomically (compact JSON: large policies stay small)."""
+    return write_text(path, json.dumps(doc, separators=(",", ":")) + "\n")
+
+
+def read_plan(path: str | os.PathLike[str]) -> dict:
+    """Read a plan file (or the ``plan.json`` in a folder); check its format and shape.
+
+    Raises
+    ------
+    ValueError
+        Not JSON, another format, or arrays of inconsistent lengths (naming the key).
+    """
+    path = Path(path)
+    if path.is_dir():
+        path = path / "plan.json"
+    if not path.is_file():
+        raise FileNotFoundError(f"{path}: no such plan file")
+    try:
+        doc = json.loads(path.read_text(encoding="utf-8"))
+    except json.JSONDecodeError as exc:
+        raise FormatError(f"{path}: not JSON ({exc.msg} at line {exc.lineno})") from None
+    check_plan(doc, str(path))
+    return doc
+
+
+def check_plan(doc: dict, where: str = "plan") -> None:
+    """Check the format and that the policy's columns agree in length."""
+    if not isinstance(doc, dict) or doc.get("format") != FORMAT:
+        got = doc.get("format") if isinstance(doc, dict) else type(doc).__name__
+        raise FormatError(f"{where}: expected format {FORMAT!r}, got {got!r}")
+    policy = doc.get("policy")
+    if not isinstance(policy, dict):
+        raise FormatError(f"{where}: no policy (write it again with 'asmplan plan')")
+    n, m = policy["n_states"], policy["n_moves"]
+    for key, column in policy["states"].items():
+        if len(column) != n:
+            raise FormatError(f"{where}: policy.states.{key}: expected {n} entries")
+    if len(policy["moves"]["ptr"]) != n + 1:
+        raise FormatError(f"{where}: policy.moves.ptr: expected {n + 1} entries")
+    for key in ("operation", "agent", "cost", "next"):
+        if len(policy["moves"][key]) != m:
+            raise FormatError(f"{where}: policy.moves.{key}: expected {m} entries")
+
+
+def plan_schema() -> dict:
+    """The JSON Schema of ``asmplan-plan/2`` (shipped in the package)."""
+    text = resources.files("asmplan.schemas").joinpath(SCHEMA_FILE).read_text(encoding="utf-8")
+    return json.loads(text)
+
+
+def validate_plan(doc: dict) -> None:
+    """Validate ``doc`` against the JSON Schema; raise ``ValueError`` naming the first fault."""
+    import jsonschema
+
+    validator = jsonschema.Draft202012Validator(plan_schema())
+    error = next(iter(sorted(validator.iter_errors(doc), key=lambda e: list(e.path))), None)
+    if error is not None:
+        where = "/".join(str(p) for p in error.absolute_path) or "(root)"
+        raise FormatError(f"plan.json at {where}: {error.message[:200]}")
+
+
+def timed_write(path: str | os.PathLike[str], doc: dict) -> tuple[Path, float, int]:
+    """Write ``doc``; return the path, the seconds taken and the file size in bytes."""
+    t0 = time.perf_counter()
+    out = write_plan(path, doc)
+    return out, time.perf_counter() - t0, out.stat().st_size
+
+
+def build_plan(assembly: str | os.PathLike[str], *, cost: str | None = None) -> dict:
+    """Plan an assembly (folder, ``assembly.yaml`` or ``.IN2``) without the CP-SAT schedule.
+
+    The relations, state graph, game and exact solution (:mod:`asmplan.pipeline`), then
+    :func:`plan_document`.
+    """
+    from asmplan import pipeline
+
+    loaded = pipeline.load(assembly)
+    graph = pipeline.state_graph(loaded)
+    dag = pipeline.game(graph, cost=cost)
+    solution = pipeline.solve_game(dag)
+    return plan_document(
+        spec=loaded.spec, dag=dag, solution=solution, describe=alternate_states(graph, dag)
+    )

@@ -1,0 +1,51 @@
+"""Small plans for the application-layer tests (no meshes, built in milliseconds)."""
+
+from __future__ import annotations
+
+from asmplan.planfile import alternate_states, plan_document
+from asp.game import game_dag
+from asp.solve import solve
+from asp.spec import spec_from_dict
+from asp.state_graph import build_state_graph
+
+CELL = {
+    "name": "cell",
+    "agents": {"H": {"side": "human"}, "R1": {"side": "robot"}, "R2": {"side": "robot"}},
+    "tools": {"R1.bit": {"initial": "hex", "change_time": 3}},
+    "cost": "time",
+    "operations": [
+        {"id": "a", "description": "prepare", "agents": {"H": 2, "R2": 4}},
+        {"id": "b", "description": "place base", "agents": {"H": 5, "R1": 3}, "after": ["a"]},
+        {"id": "c", "description": "fit cover", "agents": {"H": 4}, "after": ["a"]},
+        {
+            "id": "d",
+            "description": "change bit",
+            "agents": {"H": 6},
+            "requires": {"R1.bit": "hex"},
+            "sets": {"R1.bit": "cross"},
+        },
+        {
+            "id": "e",
+            "description": "screw",
+            "agents": {"R1": 2, "H": 9},
+            "requires": {"R1.bit": "cross"},
+            "after": ["b", "c"],
+        },
+        {"id": "f", "description": "inspect", "agents": {"R2": 1, "H": 1}, "after": ["e"]},
+    ],
+}
+
+
+def cell_game(cost: str | None = None):
+    """(spec, graph, dag, solution) of the small cell."""
+    spec = spec_from_dict(CELL, source="cell.yaml")
+    graph = build_state_graph(spec)
+    dag = game_dag(graph, cost=cost)
+    return spec, graph, dag, solve(dag)
+
+
+def cell_plan(cost: str | None = None) -> dict:
+    spec, graph, dag, solution = cell_game(cost)
+    return plan_document(
+        spec=spec, dag=dag, solution=solution, describe=alternate_states(graph, dag)
+    )

@@ -1,0 +1,142 @@
+"""The plan file ``asmplan-plan/2``: schema, policy table, lines, read/write round trip."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from asmplan.planfile import (
+    FORMAT,
+    build_plan,
+    policy_table,
+    read_plan,
+    validate_plan,
+    write_plan,
+)
+from asp.dag import HUMAN, ROBOT
+from asp.solve import evaluate_policy
+from tests.asmplan.plans import cell_game, cell_plan
+
+
+@pytest.mark.parametrize("cost", ["time", "steps"])
+def test_cell_plan_validates_and_round_trips(tmp_path, cost):
+    doc = cell_plan(cost)
+    validate_plan(doc)
+    path = write_plan(tmp_path / "plan.json", doc)
+    back = read_plan(tmp_path)
+    assert back == json.loads(path.read_text())
+    assert back["format"] == FORMAT
+    assert back["cost"] == cost
+
+
+def test_schema_rejects_a_broken_plan():
+    doc = cell_plan()
+    doc["policy"]["states"]["turn"][0] = "nobody"
+    with pytest.raises(ValueError, match="policy/states/turn/0"):
+        validate_plan(doc)
+    doc = cell_plan()
+    del doc["worst_line"]
+    with pytest.raises(ValueError, match="worst_line"):
+        validate_plan(doc)
+
+
+def test_read_plan_names_the_fault(tmp_path):
+    (tmp_path / "plan.json").write_text('{"format": "asmplan-plan/1"}')
+    with pytest.raises(ValueError, match="expected format 'asmplan-plan/2'"):
+        read_plan(tmp_path)
+    doc = cell_plan()
+    doc["policy"]["states"]["bound"].pop()
+    write_plan(tmp_path / "plan.json", doc)
+    with pytest.raises(ValueError, match=r"policy.states.bound"):
+        read_plan(tmp_path)
+
+
+def test_policy_table_is_closed_and_bounds_are_the_solver_values():
+    spec, graph, dag, sol = cell_game()
+    table = policy_table(dag, sol)
+    n = table.node.size
+    # Every move leads to a state of the table; the start is state 0.
+    assert table.node[0] == dag.start and table.turn[0] == ROBOT
+    assert np.all((table.next >= 0) & (table.next < n))
+    np.testing.assert_allclose(table.bound, sol.value[table.node, table.turn])
+    # Robot states hold the policy's move only; human states every human move.
+    for i in range(n):
+        v, p = int(table.node[i]), int(table.turn[i])
+        moves = table.edge[table.ptr[i] : table.ptr[i + 1]]
+        if v == dag.end:
+            assert moves.size == 0
+        elif p == ROBOT:
+            assert moves.tolist() == [int(sol.robot_policy[v])]
+        else:
+            want = dag.moves(v, HUMAN) or [-1]
+            assert moves.tolist() == want
+    # The bound is the robust policy's certified worst case.
+    worst = evaluate_policy(dag, sol.robot_policy).worst
+    np.testing.assert_allclose(table.bound, worst[table.node, table.turn])
+
+
+def test_policy_covers_every_state_reachable_against_any_human():
+    spec, graph, dag, sol = cell_game()
+    table = policy_table(dag, sol)
+    have = set(zip(table.node.tolist(), table.turn.tolist(), strict=True))
+    seen, stack = set(), [(dag.start, ROBOT)]
+    while stack:
+        v, p = stack.pop()
+        if (v, p) in seen:
+            continue
+        seen.add((v, p))
+        if v == dag.end:
+            continue
+        moves = dag.moves(v, p)
+        if p == ROBOT and moves:
+            moves = [int(sol.robot_policy[v])]
+        stack += [(int(dag.targets[e]), 1 - p) for e in moves] or [(v, 1 - p)]
+    assert have == seen
+
+
+def test_lines_principal_and_worst():
+    doc = cell_plan()
+    principal, worst = doc["robust_plan"], doc["worst_line"]
+    assert worst[-1]["elapsed"] == pytest.approx(doc["minimax"])
+    assert principal[-1]["elapsed"] == pytest.approx(doc["metrics"]["w0"])
+    assert doc["metrics"]["w0"] <= doc["minimax"] + 1e-9
+    assert doc["metrics"]["w0"] < doc["minimax"]  # this cell: following the plan pays
+    # Each line does every operation once, with its parts and a non-increasing bound.
+    for line in (principal, worst):
+        ops = [s["operation"] for s in line if s["operation"]]
+        assert sorted(ops) == sorted(doc["operations"])
+        assert all(s["elapsed"] + s["bound"] <= doc["minimax"] + 1e-9 for s in line)
+        assert line[-1]["bound"] == 0
+
+
+def test_states_are_named_by_done_operations_and_tools():
+    doc = cell_plan()
+    pol = doc["policy"]
+    assert pol["tools"] == {"R1.bit": ["hex", "cross"]} or set(pol["tools"]["R1.bit"]) == {
+        "hex",
+        "cross",
+    }
+    assert pol["states"]["done"][0] == "0"
+    assert pol["states"]["running"][0] == []
+    # The end state has every operation done.
+    last = max(range(pol["n_states"]), key=lambda i: int(pol["states"]["done"][i], 16))
+    assert int(pol["states"]["done"][last], 16) == (1 << len(pol["operations"])) - 1
+
+
+def test_pump_plan_parts_per_step(tmp_path):
+    from pathlib import Path
+
+    pump = Path(__file__).resolve().parents[2] / "examples" / "vacuum_pump"
+    doc = build_plan(pump)
+    validate_plan(doc)
+    placed = [p for s in doc["robust_plan"] for p in s["parts"]]
+    assert placed == ["PC", "VT1", "BC", "VT2", "VT1M", "EV", "VT3", "FOR", "VT4"]
+
+
+def test_salbp_plan(shared_data, tmp_path):
+    doc = build_plan(shared_data / "salbp" / "JACKSON.IN2")
+    validate_plan(doc)
+    assert doc["policy"]["agents"] == ["any"]
+    assert doc["robust_plan"][-1]["bound"] == 0
