@@ -287,7 +287,9 @@ def part_relations(
     )
 
 
-def state_graph(assembly: Assembly, *, progress: bool = False) -> StateGraph:
+def state_graph(
+    assembly: Assembly, *, progress: bool = False, max_states: int | None = None
+) -> StateGraph:
     """The assembly state graph: every feasible partial assembly and operation.
 
     Parameters
@@ -295,6 +297,8 @@ def state_graph(assembly: Assembly, *, progress: bool = False) -> StateGraph:
     assembly : Assembly
     progress : bool
         Show progress on stderr.
+    max_states : int, optional
+        State limit (default: the spec's ``max_states``, else 20,000,000).
 
     Returns
     -------
@@ -302,7 +306,9 @@ def state_graph(assembly: Assembly, *, progress: bool = False) -> StateGraph:
     """
     from asp.state_graph import build_state_graph
 
-    return build_state_graph(assembly.spec, assembly.relations, progress=progress)
+    return build_state_graph(
+        assembly.spec, assembly.relations, progress=progress, max_states=max_states
+    )
 
 
 def game(graph: StateGraph, *, cost: str | None = None) -> GameDAG:
@@ -414,6 +420,7 @@ def plan(
     max_k: int | None = None,
     duration_step: float | None = 1.0,
     on_step: Progress | None = None,
+    max_states: int | None = None,
 ) -> AssemblyPlan:
     """Plan an assembly end to end, as ``asmplan plan`` does.
 
@@ -437,6 +444,8 @@ def plan(
         Grid of a person's duration range in the concurrent game (None: its end points).
     on_step : callable, optional
         Called with one line before each step (progress for a person).
+    max_states : int, optional
+        State graph limit (default: the spec's ``max_states``, else 20,000,000).
 
     Returns
     -------
@@ -450,7 +459,7 @@ def plan(
     assembly = source if isinstance(source, Assembly) else load(source, progress=True, on_step=say)
     summary = relations_summary(assembly.relations) if assembly.relations is not None else []
     say("[2/5] building the assembly state graph ...")
-    graph = state_graph(assembly)
+    graph = state_graph(assembly, max_states=max_states)
     sequences = graph.count_sequences()
     say("[3/5] solving the robot-vs-human game ...")
     the_game = Game(game(graph, cost=cost), assembly.descriptions)

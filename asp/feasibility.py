@@ -42,8 +42,6 @@ from asp.spec import DIRECTIONS, AssemblySpec, tool_values
 
 WORD_BITS = 64
 """Bits per word of a state key (a state key is ``W`` uint64 words)."""
-MAX_PARTS = 64
-"""Parts that fit the uint64 assembled-part bitset of the insertion checks."""
 MAX_OPS = 32767
 """Operations that fit the int16 operation index of the transitions."""
 
@@ -52,15 +50,19 @@ MAX_OPS = 32767
 class InsertionOracle:
     """Per-part bitmasks of the geometric insertion test.
 
+    A set of parts is a row of ``PW = ceil(n / 64)`` uint64 words (bit ``j % 64`` of word
+    ``j // 64`` is part ``j``); a batch of ``k`` sets is a ``(k, PW)`` array (``(k,)`` is
+    accepted when ``PW == 1``). Any number of parts fits.
+
     Attributes
     ----------
     parts : tuple of str, length n
         Part ids (bit ``j`` is part ``parts[j]``).
-    contact : (n,) uint64
-        Parts each part touches in some direction.
-    blocked : (n, 6) uint64
+    contact : (n, PW) uint64
+        Parts each part touches in some direction (or comes to rest on, see support).
+    blocked : (n, 6, PW) uint64
         Parts that block each part's motion along each direction.
-    support : (n,) uint64
+    support : (n, PW) uint64
         Parts that keep each part from falling (support along gravity).
     directions : (6,) bool
         Directions a part may be inserted from (all six unless functional is on).
@@ -80,21 +82,38 @@ class InsertionOracle:
     topological: bool
     stability: bool
 
+    @property
+    def n_words(self) -> int:
+        """``PW``: uint64 words per part set."""
+        return int(self.contact.shape[1])
+
     def index(self, part: str) -> int:
         try:
             return self.parts.index(part)
         except ValueError:
             raise ValueError(f"unknown part {part!r}") from None
 
-    def feasible(self, p: int, assembled: np.ndarray, held: bool = False) -> np.ndarray:
+    def sets(self, assembled) -> np.ndarray:
+        """(k, PW) uint64 part sets from ``(k, PW)``, ``(k,)`` (one word) or Python ints."""
+        s = np.asarray(assembled)
+        if s.dtype == object or (s.ndim == 1 and self.n_words > 1):
+            return pack_words([int(x) for x in s.reshape(-1)], self.n_words)
+        s = s.astype(np.uint64, copy=False)
+        return s.reshape(-1, 1) if s.ndim == 1 else s
+
+    def bit(self, p: int) -> np.ndarray:
+        """(PW,) uint64: the set holding part ``p`` alone."""
+        return pack_words([1 << int(p)], self.n_words)[0]
+
+    def feasible(self, p: int, assembled, held: bool = False) -> np.ndarray:
         """Whether part ``p`` may be inserted into each set.
 
         Parameters
         ----------
         p : int
             Part index.
-        assembled : (k,) uint64
-            Bitsets of assembled parts.
+        assembled : (k, PW) or (k,) uint64
+            Sets of assembled parts.
         held : bool
             Skip the stability check.
 
@@ -102,21 +121,33 @@ class InsertionOracle:
         -------
         (k,) bool
         """
-        s = np.asarray(assembled, dtype=np.uint64)
-        zero = np.uint64(0)
-        ok = np.ones(s.shape, dtype=bool)
+        s = self.sets(assembled)
+        ok = np.ones(s.shape[0], dtype=bool)
         if self.topological and self.base >= 0 and p != self.base:
-            ok &= (s & np.uint64(1 << self.base)) != zero
+            ok &= _meets(s, self.bit(self.base))
         if self.geometric:
-            geo = (s & self.contact[p]) != zero
-            free = np.zeros(s.shape, dtype=bool)
+            geo = _meets(s, self.contact[p])
+            free = np.zeros(s.shape[0], dtype=bool)
             for d in np.flatnonzero(self.directions):
-                free |= (s & self.blocked[p, d]) == zero
+                free |= ~_meets(s, self.blocked[p, d])
             geo &= free
             if self.stability and not held:
-                geo &= (s & self.support[p]) != zero
-            ok &= geo | (s == zero)
+                geo &= _meets(s, self.support[p])
+            ok &= geo | ~s.any(axis=1)
         return ok
+
+    def mask(self, row) -> int:
+        """A (PW,) mask row as a Python int."""
+        return unpack_words(row)
+
+    def blockers(self, p: int, assembled: int) -> dict[str, list[str]]:
+        """For each direction, the parts of ``assembled`` that block ``p`` moving along it."""
+        s = int(assembled)
+        out = {}
+        for d, name in enumerate(DIRECTIONS):
+            m = s & self.mask(self.blocked[p, d])
+            out[name] = [self.parts[j] for j in range(len(self.parts)) if m >> j & 1]
+        return out
 
     def reasons(self, p: int, assembled: int, held: bool = False) -> list[str]:
         """Why part ``p`` cannot be inserted into the set ``assembled`` (empty if it can)."""
@@ -126,17 +157,57 @@ class InsertionOracle:
             out.append(f"the base part {self.parts[self.base]} is not placed yet")
         if not self.geometric or s == 0:
             return out
-        if not s & int(self.contact[p]):
+        if not s & self.mask(self.contact[p]):
             out.append("no contact with the assembled parts")
-        free = [DIRECTIONS[d] for d in range(6) if not s & int(self.blocked[p, d])]
+        by = self.blockers(p, s)
+        free = [d for d in DIRECTIONS if not by[d]]
         allowed = [d for d in free if self.directions[DIRECTIONS.index(d)]]
         if not free:
             out.append("no free direction")
         elif not allowed:
             out.append(f"free only along {', '.join(free)}, which the gripper cannot approach")
-        if self.stability and not held and not s & int(self.support[p]):
+        if self.stability and not held and not s & self.mask(self.support[p]):
             out.append("nothing to rest on below it")
         return out
+
+
+def blocked_text(by: dict[str, list[str]], limit: int = 3) -> str:
+    """``"along +x by a, b; along -x by c; ..."`` for the directions that are blocked."""
+    parts = []
+    for d, names in by.items():
+        if names:
+            more = f" and {len(names) - limit} more" if len(names) > limit else ""
+            parts.append(f"along {d} by {', '.join(names[:limit])}{more}")
+    return "; ".join(parts)
+
+
+def _meets(sets: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """(k,) bool: whether each (PW,) row of ``sets`` shares a bit with ``mask``."""
+    if sets.shape[1] == 1:
+        return (sets[:, 0] & mask[0]) != np.uint64(0)
+    return ((sets & mask) != np.uint64(0)).any(axis=1)
+
+
+def pack_words(values: list[int], n_words: int) -> np.ndarray:
+    """(k, n_words) uint64 rows of the Python ints ``values`` (least significant word first)."""
+    rows = [_split(int(v), n_words) for v in values]
+    return np.array(rows, dtype=np.uint64).reshape(len(values), n_words)
+
+
+def bool_words(table: np.ndarray, n_words: int) -> np.ndarray:
+    """(k, n_words) uint64 rows of the (k, m) bool table (column ``j`` is bit ``j``)."""
+    k, m = table.shape
+    padded = np.zeros((k, n_words * WORD_BITS), dtype=bool)
+    padded[:, :m] = table
+    packed = np.packbits(padded, axis=1, bitorder="little")
+    return packed.view("<u8").astype(np.uint64).reshape(k, n_words)
+
+
+def unpack_words(row) -> int:
+    """The Python int of a row of uint64 words (or of an int)."""
+    if isinstance(row, int | np.integer):
+        return int(row)
+    return sum(int(w) << (WORD_BITS * k) for k, w in enumerate(np.asarray(row).reshape(-1)))
 
 
 def insertion_oracle(spec: AssemblySpec, relations=None) -> InsertionOracle:
@@ -145,16 +216,16 @@ def insertion_oracle(spec: AssemblySpec, relations=None) -> InsertionOracle:
     Parameters
     ----------
     relations : cad Relations, optional
-        ``.parts`` (ids), ``.tc`` and ``.tt`` bool arrays ``(n, n, 6)``. Its parts must include
+        ``.parts`` (ids), ``.tc`` and ``.tt`` bool arrays ``(n, n, 6)``, and ``.sp``
+        (support, same shape; contact along gravity when absent). Its parts must include
         every part an operation places and the base part.
     """
     parts = spec.part_ids or tuple(dict.fromkeys(spec.placed_parts))
     n = len(parts)
-    if n > MAX_PARTS:
-        raise ValueError(f"{spec.source}: parts: {n} parts, at most {MAX_PARTS} are supported")
-    contact = np.zeros(n, dtype=np.uint64)
-    blocked = np.zeros((n, 6), dtype=np.uint64)
-    support = np.zeros(n, dtype=np.uint64)
+    n_words = max(1, math.ceil(n / WORD_BITS))
+    contact = np.zeros((n, n), dtype=bool)
+    blocked = np.zeros((n, 6, n), dtype=bool)
+    support = np.zeros((n, n), dtype=bool)
     directions = np.ones(6, dtype=bool)
     c = spec.constraints
     if c.functional:
@@ -179,31 +250,23 @@ def insertion_oracle(spec: AssemblySpec, relations=None) -> InsertionOracle:
                 f"{spec.source}: parts: no geometry (relations) for part {missing[0]!r}"
             )
         g = DIRECTIONS.index(spec.gravity)
-        weights = [1 << k for k in range(n)]
-        ridx = [rel_ids.index(pid) if pid in rel_ids else -1 for pid in parts]
-        for a, ra in enumerate(ridx):
-            if ra < 0:
-                continue
-            cmask, smask, bmask = 0, 0, [0] * 6
-            for b, rb in enumerate(ridx):
-                if rb < 0 or b == a:
-                    continue
-                if tc[ra, rb].any():
-                    cmask |= weights[b]
-                if sp[ra, rb, g]:
-                    smask |= weights[b]
-                    cmask |= weights[b]
-                for d in range(6):
-                    if not tt[ra, rb, d]:
-                        bmask[d] |= weights[b]
-            contact[a], support[a] = cmask, smask
-            blocked[a] = bmask
+        where = {pid: k for k, pid in enumerate(rel_ids)}
+        known = np.array([k for k, pid in enumerate(parts) if pid in where], dtype=np.int64)
+        r = np.array([where[parts[k]] for k in known], dtype=np.int64)
+        ix = np.ix_(known, known)
+        support[ix] = sp[np.ix_(r, r)][:, :, g]
+        contact[ix] = tc[np.ix_(r, r)].any(axis=2) | support[ix]
+        blocked[np.ix_(known, range(6), known)] = ~tt[np.ix_(r, r)].transpose(0, 2, 1)
+        diagonal = np.arange(n)
+        for table in (contact, support):
+            table[diagonal, diagonal] = False
+        blocked[diagonal, :, diagonal] = False
     base = parts.index(spec.base_part) if spec.base_part in parts else -1
     return InsertionOracle(
         parts=parts,
-        contact=contact,
-        blocked=blocked,
-        support=support,
+        contact=bool_words(contact, n_words),
+        blocked=bool_words(blocked.reshape(6 * n, n), n_words).reshape(n, 6, n_words),
+        support=bool_words(support, n_words),
         directions=directions,
         base=base,
         geometric=geometric,
@@ -229,8 +292,8 @@ class OperationModel:
         Operation ``i``'s own bit.
     pred_masks : (n_ops, W) uint64
         Explicit predecessors of each operation (zero when topological is off).
-    op_parts : (n_ops,) uint64
-        Parts each operation places.
+    op_parts : (n_ops, PW) uint64
+        Parts each operation places (part sets, see :class:`InsertionOracle`).
     requires_mask, requires_value : (n_ops, W) uint64
         Tool fields an operation reads and the values they must hold.
     sets_mask, sets_value : (n_ops, W) uint64
@@ -338,8 +401,8 @@ class OperationModel:
         ----------
         keys : (k, W) uint64
             State keys (``(k,)`` is accepted when ``W == 1``).
-        parts : (k,) uint64
-            Assembled-part bitsets of those states.
+        parts : (k, PW) uint64
+            Assembled-part sets of those states (``(k,)`` when ``PW == 1``).
 
         Returns
         -------
@@ -374,7 +437,7 @@ class OperationModel:
                         ok &= (col & masks[:, w]) == values[:, w]
                     else:
                         ok[:, cols] &= (col & masks[cols, w]) == values[cols, w]
-        parts = np.asarray(parts, dtype=np.uint64)
+        parts = self.oracle.sets(parts)
         for i, plist in enumerate(self.part_lists):
             if not plist:
                 continue
@@ -387,7 +450,7 @@ class OperationModel:
             held = self.spec.operations[i].held
             for p in plist:
                 good &= self.oracle.feasible(p, s, held=held)
-                s = s | np.uint64(1 << p)
+                s = s | self.oracle.bit(p)
             column[rows] = good
         return ok
 
@@ -500,7 +563,7 @@ def operation_model(spec: AssemblySpec, relations=None, *, _min_words: int = 1) 
         oracle=oracle,
         op_bits=table([1 << i for i in range(n_ops)]),
         pred_masks=table(pred),
-        op_parts=np.array([sum(1 << p for p in pl) for pl in part_lists], dtype=np.uint64),
+        op_parts=pack_words([sum(1 << p for p in pl) for pl in part_lists], oracle.n_words),
         part_lists=part_lists,
         requires_mask=table(req_m),
         requires_value=table(req_v),

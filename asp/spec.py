@@ -17,6 +17,7 @@ An ``assembly.yaml`` names everything the planner needs besides the part geometr
     constraints: {topological: true, stability: true, functional: true}
     turn_model: alternate
     cost: steps                        # or time
+    max_states: 20000000               # state graph limit (asmplan plan --max-states)
     operations:
       - id: "1.2"                      # ids are strings (1.10 stays "1.10")
         description: Replace hex bit with cross bit on R1
@@ -154,6 +155,7 @@ class AssemblySpec:
     source: str = ""
     units: str | None = None
     credit: str = ""
+    max_states: int | None = None
 
     @property
     def op_ids(self) -> tuple[str, ...]:
@@ -338,6 +340,11 @@ class _Parser:
         cost = str(data.get("cost", "steps"))
         if cost not in COST_MODELS:
             raise self.fail("cost", f"expected 'steps' or 'time', got {cost!r}")
+        max_states = data.get("max_states")
+        if max_states is not None and (
+            isinstance(max_states, bool) or not isinstance(max_states, int) or max_states < 1
+        ):
+            raise self.fail("max_states", f"expected a positive integer, got {max_states!r}")
         return AssemblySpec(
             name=str(data.get("name") or Path(self.source).parent.name or "assembly"),
             operations=ops,
@@ -353,6 +360,7 @@ class _Parser:
             source=self.source,
             units=None if data.get("units") is None else str(data.get("units")),
             credit=str(data.get("credit", "")),
+            max_states=max_states,
         )
 
     def parts(self, raw) -> tuple[Part, ...]:

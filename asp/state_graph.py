@@ -25,8 +25,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from asp.feasibility import OperationModel, operation_model
-from asp.spec import AssemblySpec
+from asp.feasibility import (
+    OperationModel,
+    blocked_text,
+    operation_model,
+    pack_words,
+    unpack_words,
+)
+from asp.spec import DIRECTIONS, AssemblySpec
 
 DEFAULT_MAX_STATES = 20_000_000
 """Above this many states the build stops with a ``ValueError``."""
@@ -45,8 +51,9 @@ class StateGraph:
     keys : (N, W) uint64
         State keys (``W`` words each, see :class:`asp.feasibility.OperationModel`), layer by
         layer; state 0 is the start.
-    parts : (N,) uint64
-        Assembled-part bitset of each state.
+    parts : (N, PW) uint64
+        Assembled-part set of each state (``PW`` words, see
+        :class:`asp.feasibility.InsertionOracle`; any number of parts).
     layer_ptr : (L + 2,) int64
         States of layer ``l`` (``l`` operations done) are ``layer_ptr[l]:layer_ptr[l + 1]``.
     src, dst : (E,) int32
@@ -170,7 +177,7 @@ def build_state_graph(
     relations=None,
     *,
     model: OperationModel | None = None,
-    max_states: int = DEFAULT_MAX_STATES,
+    max_states: int | None = None,
     progress: bool = False,
     check: bool = True,
 ) -> StateGraph:
@@ -182,9 +189,10 @@ def build_state_graph(
         Part relations for the geometric checks (none: explicit precedence only).
     model : OperationModel, optional
         A precompiled model (overrides ``relations``).
-    max_states : int
-        Stop with a one-line ``ValueError`` (states reached, layer, what to do) beyond this
-        many states; a layer sure to go over is not built at all.
+    max_states : int, optional
+        Stop with a one-line ``ValueError`` (states reached, the parts that multiply them,
+        how to raise the limit) beyond this many states; a layer sure to go over is not
+        built at all. Default: the spec's ``max_states``, else :data:`DEFAULT_MAX_STATES`.
     progress : bool
         Print the key width and, per layer, the states, transitions and seconds on stderr.
     check : bool
@@ -192,10 +200,12 @@ def build_state_graph(
         sequence exists.
     """
     model = operation_model(spec, relations) if model is None else model
+    if max_states is None:
+        max_states = spec.max_states or DEFAULT_MAX_STATES
     n_ops, n_words = model.n_ops, model.n_words
     index_type = np.int32 if max_states < 2**31 else np.int64
     keys = model.pack([model.start_key])
-    parts = np.array([model.initial_parts], dtype=np.uint64)
+    parts = pack_words([model.initial_parts], model.oracle.n_words)
     key_layers, part_layers = [keys], [parts]
     src_l, dst_l, op_l = [], [], []
     offset, total = 0, 1
@@ -220,11 +230,11 @@ def build_state_graph(
         # that is sure to go over the limit (its successor keys alone may not fit in memory).
         at_least = total - (-si.size // (layer + 1))
         if at_least > max_states:
-            raise _too_many(spec, max_states, f"at least {at_least:,}", layer, n_words)
+            raise _too_many(model, keys, max_states, f"at least {at_least:,}", layer)
         uniq, inv = _unique_rows(model.successor_keys(keys[si], oi))
         if total + uniq.shape[0] > max_states:
-            raise _too_many(spec, max_states, f"{total + uniq.shape[0]:,}", layer, n_words)
-        new_parts = np.empty(uniq.shape[0], dtype=np.uint64)
+            raise _too_many(model, uniq, max_states, f"{total + uniq.shape[0]:,}", layer)
+        new_parts = np.empty((uniq.shape[0], parts.shape[1]), dtype=np.uint64)
         new_parts[inv] = parts[si] | model.op_parts[oi]
         del si_l, oi_l
         n_new = int(si.size)
@@ -260,37 +270,130 @@ def build_state_graph(
 
 
 def infeasibility_report(graph: StateGraph) -> str:
-    """One line naming the operations (and parts) that can never be done, and why."""
+    """One line naming the root cause of an assembly with no complete sequence.
+
+    The root cause is the first part (by the layer in which its operation first became
+    ready) that can never be inserted for a reason the parts still missing cannot remove
+    (blocked along every free direction, or nothing it could touch or rest on even later),
+    shown in the fullest state where it was tried: why it fails there, blocked along each
+    direction by which parts, and the precedences that put those parts first. Operations
+    that only wait for it (their predecessors or the parts they need never come) are
+    knock-on failures and are counted, not listed. When every operation is done in some
+    state but no order completes them all, the furthest dead end is named with the parts
+    it leaves and why each cannot go in. Never an empty list.
+    """
     model = graph.model
     spec = model.spec
+    n_ops = model.n_ops
     ever = model.unpack(np.bitwise_or.reduce(graph.keys, axis=0)) if graph.n_states else 0
-    never = [i for i in range(model.n_ops) if not ever >> i & 1]
-    problems = []
+    never = [i for i in range(n_ops) if not ever >> i & 1]
+    placed_ever = unpack_words(np.bitwise_or.reduce(graph.parts, axis=0))
+    head = f"{spec.source}: infeasible assembly, no complete sequence: "
+    if not never:
+        return head + _dead_end(graph)
+    layer_of = np.searchsorted(graph.layer_ptr, np.arange(graph.n_states), side="right") - 1
+    found = []  # (root?, first layer, text)
     for i in never:
         op = spec.operations[i]
         rows = np.flatnonzero(model.ready(graph.keys, i))
-        if not op.parts:
-            if rows.size == 0:
-                problems.append(f"operation {op.id} never has its predecessors and tools ready")
-            continue
         if rows.size == 0:
-            # Only report operations blocked by geometry, not their waiting successors.
+            if not op.parts:
+                text = f"operation {op.id} never has its predecessors and tools ready"
+                waits = any(not ever >> spec.op_index(a) & 1 for a in op.after)
+                found.append((not waits, n_ops, text))
             continue
-        common: set[str] | None = None
-        for r in rows[:2000]:
-            s = int(graph.parts[r])
-            why = set()
-            for p in model.part_lists[i]:
-                for reason in model.oracle.reasons(p, s, held=op.held):
-                    why.add(f"{model.oracle.parts[p]}: {reason}")
-                s |= 1 << p
-            common = why if common is None else common & why
-        detail = "; ".join(sorted(common)) if common else "no single reason in every state"
+        if not op.parts:
+            continue
+        first = int(layer_of[rows].min())
+        best = int(rows[np.argmax(layer_of[rows])])  # the fullest state it was tried in
+        root, detail = _why_not(graph, i, best, placed_ever)
         names = ", ".join(op.parts)
-        problems.append(f"part {names} (operation {op.id}) can never be inserted ({detail})")
-    if not problems:
-        problems.append("operations " + ", ".join(spec.operations[i].id for i in never[:5]))
-    return f"{spec.source}: infeasible assembly, no complete sequence: " + "; ".join(problems)
+        text = (
+            f"part {names} (operation {op.id}) can never be inserted ({detail}), e.g. "
+            f"after {graph.label(best)}"
+        )
+        found.append((root, first, text))
+    found.sort(key=lambda x: (not x[0], x[1]))
+    if not found:
+        return head + "operations " + ", ".join(spec.operations[i].id for i in never[:5])
+    roots = [t for root, _, t in found if root][:2] or [found[0][2]]
+    text = "; also ".join(roots)
+    others = len(never) - len(roots)
+    if others > 0:
+        text += f"; {others} more operation(s) never done, knock-on failures of the above"
+    return head + text
+
+
+def _why_not(graph: StateGraph, i: int, state: int, placed_ever: int) -> tuple[bool, str]:
+    """Whether operation ``i``'s failure in ``state`` is a root cause, and why it fails."""
+    model = graph.model
+    spec, oracle = model.spec, model.oracle
+    op = spec.operations[i]
+    s = unpack_words(graph.parts[state])
+    missing = ((1 << len(oracle.parts)) - 1) & ~placed_ever
+    why, root = [], False
+    for p in model.part_lists[i]:
+        for reason in oracle.reasons(p, s, held=op.held):
+            name = oracle.parts[p]
+            if reason == "no free direction":
+                by = oracle.blockers(p, s)
+                allowed = {d: v for d, v in by.items() if oracle.directions[DIRECTIONS.index(d)]}
+                reason += f" (blocked {blocked_text(allowed)}{_precedences(model, i, allowed)})"
+                root = True
+            elif reason.startswith("no contact"):
+                root |= not missing & oracle.mask(oracle.contact[p])
+            elif reason.startswith("nothing to rest on"):
+                root |= not missing & oracle.mask(oracle.support[p])
+                reason += " (it would fall: mark the operation held if an agent holds the part)"
+            else:
+                root = True
+            why.append(f"{name}: {reason}")
+        s |= 1 << p
+    return root, "; ".join(why) or "no reason found"
+
+
+def _precedences(model: OperationModel, i: int, by: dict[str, list[str]]) -> str:
+    """``", which the precedence ... puts first"`` for blockers placed by predecessors of i."""
+    spec = model.spec
+    preds, stack = set(), list(spec.operations[i].after)
+    while stack:
+        a = stack.pop()
+        if a not in preds:
+            preds.add(a)
+            stack.extend(spec.operation(a).after)
+    blockers = {p for names in by.values() for p in names}
+    forced = [
+        f"{p} by operation {op.id}"
+        for op in spec.operations
+        if op.id in preds
+        for p in op.parts
+        if p in blockers
+    ]
+    return f"; placed first by precedence: {', '.join(forced)}" if forced else ""
+
+
+def _dead_end(graph: StateGraph) -> str:
+    """Every operation is done in some order, none completes: the furthest dead end."""
+    model = graph.model
+    spec = model.spec
+    last = int(graph.layer_ptr[-2])
+    key = graph.key(last)
+    left = [i for i in range(model.n_ops) if not key >> i & 1]
+    why = []
+    for i in left[:3]:
+        op = spec.operations[i]
+        if not op.parts:
+            why.append(f"operation {op.id} is not ready")
+            continue
+        _, detail = _why_not(graph, i, last, unpack_words(graph.parts[last]))
+        why.append(f"part {', '.join(op.parts)} (operation {op.id}) cannot be inserted ({detail})")
+    return (
+        f"every order ends in a dead end; the furthest, after {graph.label(last)} "
+        f"({len(graph.layer_ptr) - 2} of {model.n_ops} operations done), leaves "
+        + "; ".join(why)
+        + (f" and {len(left) - 3} more" if len(left) > 3 else "")
+        + ": another order or a subassembly is needed"
+    )
 
 
 def _join(layers: list[np.ndarray], dtype) -> np.ndarray:
@@ -315,14 +418,32 @@ def _unique_rows(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return ordered[first], inv
 
 
-def _too_many(spec: AssemblySpec, limit: int, reached: str, layer: int, n_words: int):
-    """The one-line error of a state graph over ``max_states``."""
-    n_ops = len(spec.operations)
+def _too_many(model: OperationModel, keys: np.ndarray, limit: int, reached: str, layer: int):
+    """The one-line error of a state graph over ``max_states``.
+
+    ``keys`` is the last layer built (or about to be): the operations done in some but not
+    all of its states are the free choices that multiply the states; the parts they place
+    are named, the most balanced choices (done in about half the states) first.
+    """
+    spec = model.spec
+    n_ops = model.n_ops
+    done = model.done_matrix(keys[:200_000]).mean(axis=0)
+    free = np.flatnonzero((done > 0) & (done < 1))
+    order = free[np.argsort(np.abs(done[free] - 0.5), kind="stable")]
+    names = []
+    for i in order:
+        op = spec.operations[int(i)]
+        names.extend(op.parts or (f"operation {op.id}",))
+    names = list(dict.fromkeys(names))
+    shown = ", ".join(names[:8]) + (f" and {len(names) - 8} more" if len(names) > 8 else "")
+    per_state = 8 * model.n_words + 8 * model.oracle.n_words + 8
     return ValueError(
         f"{spec.source}: the state graph exceeds the limit of {limit:,} states: {reached} "
-        f"states after layer {layer + 1} of {n_ops}; raise max_states if memory allows "
-        f"(the graph takes {8 * n_words + 8} bytes a state plus 10 a transition), or add "
-        f"precedences or split the assembly into subassemblies"
+        f"states after layer {layer + 1} of {n_ops}; the free order of {len(names)} parts or "
+        f"operations multiplies them ({shown or 'none'}); raise max_states (the command line's "
+        f"--max-states N or the spec key max_states: N) if memory allows (about {per_state} "
+        f"bytes a state plus 10 a transition), or fix their order with precedences (after:) "
+        f"or build some of them as subassemblies"
     )
 
 

@@ -36,6 +36,9 @@ def graph_command(
         max=LIST_MAX,
         help="Also list up to N feasible complete sequences (the AST).",
     ),
+    max_states: int | None = typer.Option(
+        None, "--max-states", min=1, help="State graph limit (default: spec's, else 20,000,000)."
+    ),
 ) -> None:
     """Build the assembly state graph and the game DAG; print the sizes, write the DAG."""
     from asmplan import pipeline
@@ -45,7 +48,7 @@ def graph_command(
     t0 = time.perf_counter()
     loaded = pipeline.load(assembly, progress=progress, on_step=say if progress else None)
     spec = loaded.spec
-    graph = pipeline.state_graph(loaded, progress=progress)
+    graph = pipeline.state_graph(loaded, progress=progress, max_states=max_states)
     sequences = graph.count_sequences()
     dag = pipeline.game(graph, cost=None if cost is None else cost.value)
     if output is not None:

@@ -91,6 +91,9 @@ def plan_command(
         help="Concurrent: grid of a person's duration range (0: its two end points).",
         callback=finite_or_none,
     ),
+    max_states: int | None = typer.Option(
+        None, "--max-states", min=1, help="State graph limit (default: spec's, else 20,000,000)."
+    ),
 ) -> None:
     """Plan an assembly end to end: relations, state graph, game, robust plan, CP-SAT."""
     from asmplan import pipeline
@@ -106,6 +109,7 @@ def plan_command(
         max_k=max_k,
         duration_step=duration_step or None,
         on_step=say,
+        max_states=max_states,
     )
     for line in plan_summary(result):
         typer.echo(line)

@@ -70,3 +70,12 @@ def test_bad_input_exit_code_2_one_line(tmp_path, content, message):
 def test_missing_file_exit_code_2(tmp_path):
     r = run("solve", str(tmp_path / "none.json"))
     assert r.returncode == 2 and "none.json" in r.stderr
+
+
+def test_graph_state_limit_flag_exists_and_is_named_in_the_error():
+    from pathlib import Path
+
+    pump = Path(__file__).resolve().parents[2] / "examples" / "vacuum_pump"
+    r = run("graph", str(pump), "--max-states", "10")
+    assert r.returncode == 2
+    assert "exceeds the limit of 10 states" in r.stderr and "--max-states N" in r.stderr
