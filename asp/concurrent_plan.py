@@ -41,6 +41,7 @@ from asp.concurrent import (
     state_description,
     timeline,
 )
+from asp.numbers import json_number
 from asp.solve import Solution
 
 
@@ -209,8 +210,7 @@ def plan_entries(plan: ConcurrentPlan, *, policy_limit: int = 20_000) -> dict:
 
 
 def _plain(x):
-    x = float(x)
-    return int(x) if x.is_integer() else round(x, 6)
+    return json_number(float(x), 6)
 
 
 def _line(bars: list[Bar], makespan: float) -> dict:
