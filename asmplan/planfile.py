@@ -223,7 +223,7 @@ def policy_document(
     if edge_op.size:
         move_op[moves] = edge_op[table.edge[moves]]
         move_agent[moves] = edge_agent[table.edge[moves]]
-    move_cost[moves] = dag.costs[table.edge[moves]]
+    move_cost[moves] = rules.move_costs(dag)[table.edge[moves]]
 
     tools: dict[str, list[str]] = {}
     done_col, tools_col, running_col = [], [], []
