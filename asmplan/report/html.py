@@ -1,11 +1,10 @@
 """``report.html``: one self-contained page a person reads (no network: pictures are PNG data URIs).
 
 It shows the metrics, the price-of-robustness curve and the Gantt charts of the concurrent
-game (when it could be solved), the CP-SAT schedule's Gantt chart, the relations table, the
-principal line as pictures of the assembly growing step by step (rendered from the part
-meshes, the parts of each step highlighted) and the game DAG picture.
-
-matplotlib is used without pyplot (no global backend, no figure left open).
+game (when it could be solved; drawn by :mod:`asp.gantt`), the CP-SAT schedule's Gantt
+chart, the relations table, the principal line as pictures of the assembly growing step by
+step (rendered from the part meshes, the parts of each step highlighted) and the game DAG
+picture.
 """
 
 from __future__ import annotations
@@ -13,14 +12,13 @@ from __future__ import annotations
 import base64
 import html
 import io
+from pathlib import Path
 
 import numpy as np
 
 from asmplan.report.meshes import base_parts, part_meshes
 
 NEW, PLACED, GHOST = "#f28c28", "#4f81bd", "#cccccc"
-AGENT_COLOURS = {"H": "#9e9e9e", "R1": "#2e9d4a", "R2": "#f28c28"}
-OTHER = ("#3b6fb6", "#8e44ad", "#c0392b", "#16a085")
 REPORT_MAX_STATES = 5_000
 """Largest state graph whose concurrent game the report solves itself."""
 
@@ -86,85 +84,87 @@ def assembly_steps(plan: dict, *, max_pictures: int = 40) -> list[tuple[dict, st
     return out
 
 
-def gantt(rows: list[dict], title: str) -> str:
-    """A Gantt chart of ``{"agent", "operation"|"task", "start", "end"}`` rows (data URI)."""
-    from matplotlib.figure import Figure
-
-    agents = sorted({str(r["agent"]) for r in rows})
-    fig = Figure(figsize=(9, 0.55 * len(agents) + 1.3))
-    ax = fig.subplots()
-    for r in rows:
-        a = str(r["agent"])
-        colour = AGENT_COLOURS.get(a, OTHER[agents.index(a) % len(OTHER)])
-        start, end = float(r["start"]), float(r["end"])
-        edge = "#d62728" if r.get("deviation") else "black"
-        ax.barh(agents.index(a), end - start, left=start, color=colour, edgecolor=edge, lw=0.6)
-        label = r.get("operation", r.get("task", ""))
-        ax.text((start + end) / 2, agents.index(a), label, ha="center", va="center", fontsize=6)
-    ax.set_yticks(range(len(agents)), agents)
-    ax.set_xlabel("time")
-    ax.set_title(title, fontsize=10)
-    return _png(fig)
+# --------------------------------------------------------------------------- figures
 
 
-def robustness_curve(curve: list[dict], unit: str) -> str:
-    """The price of robustness ``k -> W*(k)`` with ``W*(inf)`` as a dashed line (data URI)."""
-    from matplotlib.figure import Figure
+def report_figures(doc: dict, concurrent_plan=None, *, spec=None, graph=None) -> dict[str, bytes]:
+    """The curve and Gantt PNGs of the report (:mod:`asp.gantt`), by name.
 
-    finite = [c for c in curve if c["k"] is not None]
-    top = [c["bound"] for c in curve if c["k"] is None]
-    fig = Figure(figsize=(5, 3))
-    ax = fig.subplots()
-    ax.plot([c["k"] for c in finite], [c["bound"] for c in finite], "o-", color="#3b6fb6")
-    if top:
-        ax.axhline(top[0], ls="--", color="#d62728", label=f"W*(inf) = {top[0]:g}{unit}")
-        ax.legend(fontsize=8, frameon=False)
-    ax.set_xlabel("deviation budget k")
-    ax.set_ylabel(f"W*(k){unit}")
-    ax.set_xticks([c["k"] for c in finite])
-    ax.set_title("price of robustness", fontsize=10)
-    return _png(fig)
-
-
-# --------------------------------------------------------------------------- the concurrent game
-
-
-def concurrent_summary(spec, graph, *, max_nodes: int = 200_000) -> dict:
-    """The concurrent game's curve and its robust policy's timelines, or why there are none.
-
-    Returns ``{"curve": [...], "follow": rows, "worst": rows, "follow_makespan",
-    "worst_makespan"}`` or ``{"error": reason}`` (too large, or the spec cannot run
-    concurrently).
+    ``concurrent_plan`` (:class:`asp.concurrent_plan.ConcurrentPlan`) gives the curve and
+    the two timelines; without it they are computed here from ``spec`` and ``graph`` when
+    the state graph has at most :data:`REPORT_MAX_STATES` states (else ``"why"`` says why
+    they are missing). The CP-SAT schedule's Gantt chart comes from ``doc["schedule"]``.
     """
-    from asp.concurrent import concurrent_model, robustness, timeline
+    import tempfile
 
-    try:
-        model = concurrent_model(spec, graph)
-        r = robustness(model, max_nodes=max_nodes)
-    except (ValueError, MemoryError) as exc:
-        return {"error": str(exc).splitlines()[0]}
-    out: dict = {"curve": r.to_list()}
-    for human in ("follow", "worst"):
-        bars, makespan = timeline(r.game, r.solution.robot_policy, human)
-        out[human] = [
-            {
-                "agent": b.agent,
-                "operation": b.operation,
-                "start": b.start,
-                "end": b.end,
-                "deviation": b.deviation,
-            }
-            for b in bars
-        ]
-        out[f"{human}_makespan"] = makespan
+    from asp.concurrent import Bar
+    from asp.gantt import plot_gantt, plot_robustness
+
+    out: dict[str, bytes] = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        if concurrent_plan is None and spec is not None and graph is not None:
+            if graph.n_states <= REPORT_MAX_STATES:
+                try:
+                    from asp.concurrent_plan import plan_concurrent
+
+                    concurrent_plan = plan_concurrent(spec, graph, max_nodes=200_000)
+                except (ValueError, MemoryError) as exc:
+                    out["why"] = str(exc).splitlines()[0].encode()
+            else:
+                out["why"] = (
+                    f"{graph.n_states:,} assembly states (the report solves the concurrent "
+                    f"game up to {REPORT_MAX_STATES:,})"
+                ).encode()
+        if concurrent_plan is not None:
+            curve = concurrent_plan.curve.to_list()
+            out["robustness"] = plot_robustness(
+                curve,
+                folder / "r.png",
+                schedule=concurrent_plan.schedule.objective,
+                schedule_rows=concurrent_plan.schedule_worst,
+            ).read_bytes()
+            for name, (bars, makespan) in (
+                ("gantt_cooperative", concurrent_plan.cooperative),
+                ("gantt_worst", concurrent_plan.worst),
+            ):
+                who = "follows the plan" if name == "gantt_cooperative" else "is the worst"
+                out[name] = plot_gantt(
+                    bars,
+                    folder / f"{name}.png",
+                    makespan=makespan,
+                    title=f"concurrent: the person {who}, makespan {makespan:g}",
+                ).read_bytes()
+        rows = (doc.get("schedule") or {}).get("schedule") or []
+        if rows:
+            bars = [
+                Bar(str(r["agent"]), str(r["task"]), float(r["start"]), float(r["end"]))
+                for r in rows
+            ]
+            sched = doc["schedule"]
+            out["gantt_schedule"] = plot_gantt(
+                bars,
+                folder / "s.png",
+                title=f"CP-SAT schedule: makespan {sched.get('objective')} ({sched.get('status')})",
+            ).read_bytes()
     return out
+
+
+def _data_uri(png: bytes) -> str:
+    return "data:image/png;base64," + base64.b64encode(png).decode("ascii")
 
 
 # --------------------------------------------------------------------------- the page
 
 
-def report_html(plan: dict, *, dag_png: bytes | None = None, concurrent: dict | None = None) -> str:
-    """The report page of a plan document (``asmplan-plan/2``) as one HTML string."""
+def report_html(plan: dict, figures: dict[str, bytes] | None = None) -> str:
+    """The report page of a plan document (``asmplan-plan/2``) as one HTML string.
+
+    ``figures``: PNGs by name (``dag``, ``robustness``, ``gantt_cooperative``,
+    ``gantt_worst``, ``gantt_schedule``; :func:`report_figures`) and ``why`` (bytes), the
+    reason the concurrent ones are missing.
+    """
+    figures = figures or {}
     esc = html.escape
     unit = "" if plan.get("cost") == "steps" else " s"
     m = plan.get("metrics", {})
@@ -198,35 +198,16 @@ def report_html(plan: dict, *, dag_png: bytes | None = None, concurrent: dict | 
     body.append("</table>")
 
     body.append("<h2>Price of robustness and the concurrent game</h2>")
-    if concurrent and "curve" in concurrent:
-        body.append(_img(robustness_curve(concurrent["curve"], " s"), "price of robustness"))
-        body.append(
-            _img(
-                gantt(
-                    concurrent["follow"],
-                    f"concurrent, the person follows the plan: makespan "
-                    f"{concurrent['follow_makespan']:g} s",
-                ),
-                "Gantt chart, the person follows",
-            )
-        )
-        body.append(
-            _img(
-                gantt(
-                    concurrent["worst"],
-                    f"concurrent, the worst person (deviations outlined red): makespan "
-                    f"{concurrent['worst_makespan']:g} s",
-                ),
-                "Gantt chart, the worst person",
-            )
-        )
+    if "robustness" in figures:
+        body.append(_img(_data_uri(figures["robustness"]), "price of robustness"))
+        for name in ("gantt_cooperative", "gantt_worst"):
+            body.append(_img(_data_uri(figures[name]), name.replace("_", " ")))
     else:
-        reason = (concurrent or {}).get("error", "not computed")
+        reason = figures.get("why", b"not computed").decode()
         body.append(f"<p class='note'>The concurrent game was not solved: {esc(reason)}.</p>")
-    if sched.get("schedule"):
+    if "gantt_schedule" in figures:
         body.append("<h2>CP-SAT schedule</h2>")
-        title = f"CP-SAT minimum makespan {sched.get('objective')} s ({sched.get('status')})"
-        body.append(_img(gantt(sched["schedule"], title), "CP-SAT Gantt chart"))
+        body.append(_img(_data_uri(figures["gantt_schedule"]), "CP-SAT Gantt chart"))
 
     principal = plan.get("robust_plan", [])
     body.append("<h2>The principal line (the person follows the plan)</h2>")
@@ -261,10 +242,9 @@ def report_html(plan: dict, *, dag_png: bytes | None = None, concurrent: dict | 
                 f"<td>{esc(' '.join(r['free']) or 'none')}</td></tr>"
             )
         body.append("</table>")
-    if dag_png:
+    if "dag" in figures:
         body.append("<h2>The game DAG</h2>")
-        uri = "data:image/png;base64," + base64.b64encode(dag_png).decode("ascii")
-        body.append(_img(uri, "game DAG", width=1100))
+        body.append(_img(_data_uri(figures["dag"]), "game DAG", width=1100))
     if plan.get("credit"):
         body.append(f"<p class='note'>{esc(plan['credit'])}</p>")
     return PAGE.format(title=esc(str(plan.get("assembly", "plan"))), body="\n".join(body))

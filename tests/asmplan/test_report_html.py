@@ -6,7 +6,7 @@ import re
 from pathlib import Path
 
 from asmplan.planfile import build_plan
-from asmplan.report.html import concurrent_summary, report_html
+from asmplan.report.html import report_figures, report_html
 from tests.asmplan.plans import cell_game, cell_plan
 
 PUMP = Path(__file__).resolve().parents[2] / "examples" / "vacuum_pump"
@@ -19,9 +19,9 @@ def _external_references(page: str) -> list[str]:
 
 def test_cell_report_is_self_contained_with_curve_and_gantt():
     spec, graph, _, _ = cell_game()
-    concurrent = concurrent_summary(spec, graph)
-    assert "curve" in concurrent, concurrent
-    page = report_html(cell_plan(), concurrent=concurrent)
+    figures = report_figures(cell_plan(), spec=spec, graph=graph)
+    assert {"robustness", "gantt_cooperative", "gantt_worst"} <= set(figures), figures.get("why")
+    page = report_html(cell_plan(), figures)
     assert _external_references(page) == []
     for heading in ("Metrics", "Price of robustness", "The principal line", "The worst line"):
         assert heading in page
@@ -30,13 +30,13 @@ def test_cell_report_is_self_contained_with_curve_and_gantt():
 
 
 def test_report_says_why_a_part_is_missing():
-    page = report_html(cell_plan(), concurrent={"error": "too large"})
+    page = report_html(cell_plan(), {"why": b"too large"})
     assert "The concurrent game was not solved: too large" in page
 
 
 def test_pump_report_pictures_each_step_that_places_parts():
     doc = build_plan(PUMP)
-    page = report_html(doc, dag_png=b"\x89PNG fake")
+    page = report_html(doc, {"dag": b"\x89PNG fake"})
     steps = [s for s in doc["robust_plan"] if s["parts"]]
     assert page.count("<figure>") == len(steps) == 7
     assert "step 6: 1.4 by H" in page
