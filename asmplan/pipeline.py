@@ -182,7 +182,9 @@ def load_assembly(source: str | os.PathLike[str]) -> AssemblySpec:
     Parameters
     ----------
     source : path
-        A folder holding ``assembly.yaml``, the YAML itself, or a Scholl ``.IN2`` graph.
+        A folder holding ``assembly.yaml``, the YAML itself, a Scholl ``.IN2`` graph, or a
+        CAD file (STEP, glTF/GLB, 3MF, 3DXML) or folder of part meshes, whose spec is
+        generated (``spec.generated``; :mod:`asp.generate`).
 
     Returns
     -------
@@ -195,9 +197,9 @@ def load_assembly(source: str | os.PathLike[str]) -> AssemblySpec:
     FileNotFoundError
         ``source`` does not exist.
     """
-    from asp.spec import load_spec
+    from asp.generate import load_any
 
-    return load_spec(source)
+    return load_any(source)
 
 
 def relations(spec: AssemblySpec, *, progress: bool = False) -> Relations | None:
@@ -222,8 +224,24 @@ def relations(spec: AssemblySpec, *, progress: bool = False) -> Relations | None
 def load(
     source: str | os.PathLike[str], *, progress: bool = False, on_step: Progress | None = None
 ) -> Assembly:
-    """:func:`load_assembly` and, when the spec has meshes, its :func:`relations`."""
+    """:func:`load_assembly` and, when the spec has meshes, its :func:`relations`.
+
+    A generated spec (no ``assembly.yaml``) is announced through ``on_step``, else as a
+    warning.
+    """
     spec = load_assembly(source)
+    if spec.generated:
+        note = (
+            f"no assembly.yaml: generated a spec from {source} ({len(spec.parts)} parts, one "
+            "placement each, agents H and R1, durations from part size); "
+            f"`asmplan init {source} -o assembly.yaml` writes it for editing"
+        )
+        if on_step is not None:
+            on_step(note)
+        else:
+            import warnings
+
+            warnings.warn(note, stacklevel=2)
     rel = None
     if spec.has_geometry:
         if on_step is not None:
@@ -262,13 +280,31 @@ def part_relations(
     """
     import cad
 
-    path = Path(source)
-    if path.is_dir() and (path / "assembly.yaml").is_file():
-        path = path / "assembly.yaml"
-    assembly = cad.load_assembly(path, units=units)
     return cad.compute_relations(
-        assembly, contact_tol=contact_tol, penetration_tol=penetration_tol, progress=progress
+        part_geometry(source, units=units),
+        contact_tol=contact_tol,
+        penetration_tol=penetration_tol,
+        progress=progress,
     )
+
+
+def part_geometry(source: str | os.PathLike[str], *, units: str | None = None):
+    """The part meshes of a spec (a YAML, or a folder holding ``assembly.yaml``), a folder
+    of meshes or a scene file, as a ``cad.Assembly`` (millimetres).
+
+    ``units`` overrides the spec's unit for files that declare none.
+    """
+    from dataclasses import replace
+
+    import cad
+    from asp.generate import spec_geometry
+    from asp.spec import SPEC_FILE, load_spec
+
+    path = Path(source)
+    if path.suffix.lower() in (".yaml", ".yml") or (path.is_dir() and (path / SPEC_FILE).is_file()):
+        spec = load_spec(path)
+        return spec_geometry(spec if units is None else replace(spec, units=units))
+    return cad.load_assembly(path, units=units)
 
 
 def state_graph(

@@ -582,11 +582,11 @@ def operation_model(spec: AssemblySpec, relations=None, *, _min_words: int = 1) 
 def load_relations(spec: AssemblySpec, *, progress: bool = False):
     """Compute the cad relations of ``spec``'s parts (``None`` when it has no geometry).
 
-    Reads the meshes through ``cad.load_assembly`` on the spec's ``assembly.yaml``.
+    Reads the meshes of the spec's parts (:func:`asp.generate.spec_geometry`).
     """
     if not spec.has_geometry:
         return None
     import cad
+    from asp.generate import spec_geometry
 
-    assembly = cad.load_assembly(spec.source, units=spec.units)
-    return cad.compute_relations(assembly, progress=progress)
+    return cad.compute_relations(spec_geometry(spec), progress=progress)

@@ -16,8 +16,7 @@ from asp.dag import GameDAG
 from asp.numbers import cost_text, plain
 from asp.rules import HUMAN, ROBOT
 from asp.solve import Solution
-
-DIRECTIONS = ("+x", "-x", "+y", "-y", "+z", "-z")
+from cad.directions import DIRECTIONS
 
 
 @dataclass(frozen=True)

@@ -4,8 +4,9 @@ An ``assembly.yaml`` names everything the planner needs besides the part geometr
 
     name: vacuum pump                  # free text
     units: mm                          # read by cad/ (ignored here)
-    parts:                             # the same list cad.load_assembly reads
+    parts:                             # part records (cad.bom)
       - {id: BD, name: Main body, file: meshes/BD.stl, quantity: 1, type: component}
+      - {id: NUT, file: model.step#nut_2}   # one part of a scene file (its cleaned id)
     agents:                            # name -> side (human, robot; any for open tasks)
       H: {side: human}
       R1: {side: robot, description: UR3e with screwdriver}
@@ -40,7 +41,11 @@ Semantics:
 - If no operation places the base part, it is on the fixture from the start.
 
 :func:`load_spec` validates everything and raises a one-line ``ValueError`` naming the
-file, the key and the offending operation or part.
+file, the key and the offending operation or part. An unknown key is refused with the
+nearest known one suggested (``gravty`` -> ``gravity``); YAML aliases that expand past
+a limit are refused (:mod:`cad.yamlfile`). For a CAD file or a folder of part meshes,
+:func:`asp.generate.load_any` generates the spec. To add a top-level key, add it to
+:data:`TOP_KEYS` and read it in ``_Parser.parse``.
 """
 
 from __future__ import annotations
@@ -50,25 +55,29 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import networkx as nx
-import yaml
 
-DIRECTIONS = ("+x", "-x", "+y", "-y", "+z", "-z")
-"""Direction order everywhere (same as ``cad.DIRECTIONS``)."""
+from cad.bom import PartRecord, part_records, refuse_unknown_keys
+from cad.directions import DIRECTIONS
+from cad.units import unit_scale
+from cad.yamlfile import read_yaml
+
 SIDES = ("human", "robot", "any")
 COST_MODELS = ("steps", "time")
 CONSTRAINT_KEYS = ("topological", "stability", "functional")
 SPEC_FILE = "assembly.yaml"
+TOP_KEYS = (
+    "name", "units", "parts", "agents", "tools", "base_part", "gravity", "gripper_approach",
+    "constraints", "turn_model", "cost", "operations", "credit", "max_states",
+)  # fmt: skip
+"""The top-level keys of ``assembly.yaml``; any other is refused."""
+OPERATION_KEYS = (
+    "id", "description", "agents", "part", "parts", "requires", "sets", "after", "held",
+)  # fmt: skip
+AGENT_KEYS = ("name", "id", "side", "description")
+TOOL_KEYS = ("initial", "change_time")
 
-
-@dataclass(frozen=True)
-class Part:
-    """A part of the bill of materials (``parts:`` entry)."""
-
-    id: str
-    name: str = ""
-    file: str | None = None
-    quantity: int = 1
-    type: str = ""
+Part = PartRecord
+"""A ``parts:`` entry: the one part record model, shared with BOM files (:mod:`cad.bom`)."""
 
 
 @dataclass(frozen=True)
@@ -156,6 +165,7 @@ class AssemblySpec:
     units: str | None = None
     credit: str = ""
     max_states: int | None = None
+    generated: bool = False
 
     @property
     def op_ids(self) -> tuple[str, ...]:
@@ -199,20 +209,14 @@ class AssemblySpec:
 
     @property
     def folder(self) -> Path | None:
-        return Path(self.source).parent if self.source else None
+        """The folder part files are relative to (the spec's, or the CAD file's)."""
+        if not self.source:
+            return None
+        path = Path(self.source)
+        return path if path.is_dir() else path.parent
 
 
 # --------------------------------------------------------------------------- loading
-
-
-class _Loader(yaml.SafeLoader):
-    """SafeLoader that keeps decimal-looking scalars as strings (``1.10`` stays ``"1.10"``)."""
-
-
-_Loader.yaml_implicit_resolvers = {
-    key: [(tag, regexp) for tag, regexp in resolvers if tag != "tag:yaml.org,2002:float"]
-    for key, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.copy().items()
-}
 
 
 def resolve_spec_path(path: str | os.PathLike[str]) -> Path:
@@ -229,7 +233,10 @@ def resolve_spec_path(path: str | os.PathLike[str]) -> Path:
 
 
 def load_spec(path: str | os.PathLike[str]) -> AssemblySpec:
-    """Load and validate an assembly: a folder with ``assembly.yaml``, the YAML, or a ``.IN2``.
+    """Load and validate an assembly spec: a folder with ``assembly.yaml``, the YAML, a ``.IN2``.
+
+    A CAD file or a folder of part meshes has no spec to load: see
+    :func:`asp.generate.generated_spec` (:func:`asp.generate.load_any` picks).
 
     Raises
     ------
@@ -244,13 +251,7 @@ def load_spec(path: str | os.PathLike[str]) -> AssemblySpec:
 
         return spec_from_dict(in2_assembly(path), source=str(path))
     path = resolve_spec_path(path)
-    try:
-        data = yaml.load(path.read_text(encoding="utf-8"), Loader=_Loader)
-    except yaml.YAMLError as exc:
-        first = " ".join(str(exc).split())
-        raise ValueError(f"{path}: malformed YAML ({first})") from None
-    except UnicodeDecodeError as exc:
-        raise ValueError(f"{path}: not a UTF-8 text file ({exc.reason})") from None
+    data = read_yaml(path, what="assembly spec", decimals_as_text=True)
     return spec_from_dict(data, source=str(path))
 
 
@@ -284,11 +285,14 @@ class _Parser:
             raise self.fail(key, "expected a non-empty name")
         return out
 
-    def mapping(self, value, key: str) -> dict:
+    def mapping(self, value, key: str, known: tuple[str, ...] = ()) -> dict:
+        """A mapping (None: empty); with ``known``, any other key is refused."""
         if value is None:
             return {}
         if not isinstance(value, dict):
             raise self.fail(key, f"expected a mapping, got {type(value).__name__}")
+        if known:
+            refuse_unknown_keys(value, known, f"{self.source}: {key}")
         return value
 
     def direction(self, value, key: str) -> str:
@@ -303,6 +307,13 @@ class _Parser:
     def parse(self, data) -> AssemblySpec:
         if not isinstance(data, dict):
             raise ValueError(f"{self.source}: expected a YAML mapping at the top level")
+        refuse_unknown_keys(data, TOP_KEYS, self.source)
+        units = data.get("units")
+        if units is not None:
+            try:
+                unit_scale(units)
+            except ValueError as exc:
+                raise self.fail("units", str(exc)) from None
         parts = self.parts(data.get("parts"))
         agents = self.agents(data.get("agents"))
         tools = self.tools(data.get("tools"))
@@ -323,11 +334,7 @@ class _Parser:
             raise self.fail("gripper_approach", "expected a non-empty list of directions")
         approach = tuple(dict.fromkeys(self.direction(d, "gripper_approach") for d in approach_raw))
         cons = self.mapping(data.get("constraints"), "constraints")
-        for key in cons:
-            if key not in CONSTRAINT_KEYS:
-                raise self.fail(
-                    "constraints", f"unknown switch {key!r}: expected {', '.join(CONSTRAINT_KEYS)}"
-                )
+        refuse_unknown_keys(cons, CONSTRAINT_KEYS, f"{self.source}: constraints", "switch")
         flags = {}
         for key in CONSTRAINT_KEYS:
             value = cons.get(key, True)
@@ -358,7 +365,7 @@ class _Parser:
             turn_model=turn,
             cost=cost,
             source=self.source,
-            units=None if data.get("units") is None else str(data.get("units")),
+            units=None if units is None else str(units),
             credit=str(data.get("credit", "")),
             max_states=max_states,
         )
@@ -366,33 +373,7 @@ class _Parser:
     def parts(self, raw) -> tuple[Part, ...]:
         if raw is None:
             return ()
-        if not isinstance(raw, list):
-            raise self.fail("parts", "expected a list of {id, name, file, quantity, type}")
-        out, seen = [], set()
-        for k, item in enumerate(raw):
-            if isinstance(item, str):
-                item = {"id": item}
-            if not isinstance(item, dict) or "id" not in item:
-                raise self.fail(f"parts[{k}]", "expected a mapping with an 'id'")
-            pid = self.text(item["id"], f"parts[{k}].id")
-            if pid in seen:
-                raise self.fail("parts", f"duplicate part id {pid!r}")
-            seen.add(pid)
-            qty = item.get("quantity", 1)
-            if not isinstance(qty, int) or isinstance(qty, bool) or qty < 1:
-                raise self.fail(
-                    f"parts[{pid}].quantity", f"expected a positive integer, got {qty!r}"
-                )
-            out.append(
-                Part(
-                    id=pid,
-                    name=str(item.get("name") or pid),
-                    file=None if item.get("file") is None else str(item["file"]),
-                    quantity=qty,
-                    type=str(item.get("type") or ""),
-                )
-            )
-        return tuple(out)
+        return part_records(raw, f"{self.source}: parts")
 
     def agents(self, raw) -> tuple[Agent, ...]:
         if isinstance(raw, list):
@@ -413,7 +394,7 @@ class _Parser:
             seen.add(name)
             if isinstance(item, str):
                 item = {"side": item}
-            item = self.mapping(item, f"agents.{name}")
+            item = self.mapping(item, f"agents.{name}", AGENT_KEYS)
             side = str(item.get("side", "")).lower()
             if side not in SIDES:
                 raise self.fail(
@@ -426,7 +407,7 @@ class _Parser:
         out = []
         for name, item in self.mapping(raw, "tools").items():
             name = self.text(name, "tools")
-            item = self.mapping(item, f"tools.{name}")
+            item = self.mapping(item, f"tools.{name}", TOOL_KEYS)
             if "initial" not in item:
                 raise self.fail(f"tools.{name}", "missing 'initial' value")
             out.append(
@@ -457,12 +438,7 @@ class _Parser:
             if oid in seen:
                 raise self.fail("operations", f"duplicate operation id {oid!r}")
             seen.add(oid)
-            unknown = set(item) - {
-                "id", "description", "agents", "part", "parts", "requires", "sets", "after",
-                "held",
-            }  # fmt: skip
-            if unknown:
-                raise self.fail(where, f"unknown key {sorted(unknown)[0]!r}")
+            refuse_unknown_keys(item, OPERATION_KEYS, f"{self.source}: {where}")
             agents_raw = self.mapping(item.get("agents"), f"{where}.agents")
             if not agents_raw:
                 raise self.fail(f"{where}.agents", "no agent may do this operation")

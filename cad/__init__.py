@@ -4,7 +4,7 @@ Public API::
 
     from cad import load_assembly, compute_relations, rtc, rtt, tt_set, truth_table
 
-    assembly = load_assembly("examples/bracket/")      # folder, scene or assembly.yaml
+    assembly = load_assembly("examples/bracket/")      # folder of meshes or scene file
     rel = compute_relations(assembly)                  # rel.tc, rel.tt: (n, n, 6) bool
     rtt(rel, "screw", {"base", "plate"})
 
@@ -12,19 +12,34 @@ Directions are ``DIRECTIONS = ("+x", "-x", "+y", "-y", "+z", "-z")``; see
 :mod:`cad.freedom` for the exact sweep method and :mod:`cad.tolerances` for defaults.
 """
 
-from cad.assembly import Assembly, Part, unit_scale
-from cad.contact import contact_relation
-from cad.directions import DIRECTION_VECTORS, DIRECTIONS, direction_index, opposite
-from cad.freedom import check_interpenetration, translational_freedom
-from cad.loading import load_assembly, read_bom
-from cad.relations import Relations, compute_relations, rtc, rtt, tt_set
-from cad.tolerances import (
-    CONTACT_NORMAL_MIN,
-    DEFAULT_CONTACT_TOL_MM,
-    DEFAULT_PENETRATION_TOL_MM,
-    default_penetration_tol,
-)
-from cad.truth_table import TruthTable, truth_table
+_LOCATION = {
+    "Assembly": "cad.assembly",
+    "CONTACT_NORMAL_MIN": "cad.tolerances",
+    "DEFAULT_CONTACT_TOL_MM": "cad.tolerances",
+    "DEFAULT_PENETRATION_TOL_MM": "cad.tolerances",
+    "DIRECTIONS": "cad.directions",
+    "DIRECTION_VECTORS": "cad.directions",
+    "Part": "cad.assembly",
+    "PartRecord": "cad.bom",
+    "Relations": "cad.relations",
+    "TruthTable": "cad.truth_table",
+    "check_interpenetration": "cad.freedom",
+    "compute_relations": "cad.relations",
+    "contact_relation": "cad.contact",
+    "default_penetration_tol": "cad.tolerances",
+    "direction_index": "cad.directions",
+    "load_assembly": "cad.loading",
+    "load_parts": "cad.loading",
+    "opposite": "cad.directions",
+    "read_bom": "cad.bom",
+    "rtc": "cad.relations",
+    "rtt": "cad.relations",
+    "translational_freedom": "cad.freedom",
+    "truth_table": "cad.truth_table",
+    "tt_set": "cad.relations",
+    "unit_scale": "cad.units",
+}
+"""Where each public name lives; modules load on first use (``import cad.bom`` stays light)."""
 
 __all__ = [
     "CONTACT_NORMAL_MIN",
@@ -34,6 +49,7 @@ __all__ = [
     "DIRECTION_VECTORS",
     "Assembly",
     "Part",
+    "PartRecord",
     "Relations",
     "TruthTable",
     "check_interpenetration",
@@ -42,6 +58,7 @@ __all__ = [
     "default_penetration_tol",
     "direction_index",
     "load_assembly",
+    "load_parts",
     "opposite",
     "read_bom",
     "rtc",
@@ -51,3 +68,13 @@ __all__ = [
     "tt_set",
     "unit_scale",
 ]
+
+
+def __getattr__(name: str):
+    if name in _LOCATION:
+        import importlib
+
+        value = getattr(importlib.import_module(_LOCATION[name]), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'cad' has no attribute {name!r}")

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 import trimesh
+
+from cad.units import unit_scale
 
 
 @dataclass(frozen=True, eq=False)
@@ -26,6 +29,8 @@ class Part:
         Optional part type from the BOM, e.g. ``"screw"``; empty if not given.
     source : str
         File (and node, for scenes) the mesh came from.
+    shape : str
+        Shape class from the spec or BOM (empty: not given; see :mod:`cad.identical`).
     """
 
     id: str
@@ -34,6 +39,7 @@ class Part:
     quantity: int = 1
     type: str = ""
     source: str = ""
+    shape: str = ""
 
     @property
     def bounds(self) -> np.ndarray:
@@ -54,11 +60,15 @@ class Assembly:
         differ). Meshes are always stored in millimetres, whatever the source unit.
     source : str
         Path the assembly was read from (empty if built in code).
+    groups : tuple of (str, tuple of str)
+        The hierarchy the file gives (a STEP sub-assembly, a glTF parent node): group id
+        -> ids of the parts below it, outermost first. Empty when the source has none.
     """
 
     parts: tuple[Part, ...]
     units: str = "mm"
     source: str = ""
+    groups: tuple[tuple[str, tuple[str, ...]], ...] = ()
 
     def __post_init__(self) -> None:
         seen: set[str] = set()
@@ -78,8 +88,6 @@ class Assembly:
     @classmethod
     def from_meshes(cls, meshes: dict[str, trimesh.Trimesh], *, units: str = "mm") -> Assembly:
         """Build an assembly from ``{id: mesh}`` given in ``units`` (converted to mm)."""
-        from cad.loading import prepare_part
-
         parts = tuple(
             prepare_part(pid, mesh, scale=unit_scale(units), source="<memory>")
             for pid, mesh in meshes.items()
@@ -87,48 +95,47 @@ class Assembly:
         return cls(parts=parts, units=units)
 
 
-_UNIT_TO_MM = {
-    "mm": 1.0,
-    "millimeter": 1.0,
-    "millimeters": 1.0,
-    "millimetre": 1.0,
-    "millimetres": 1.0,
-    "cm": 10.0,
-    "centimeter": 10.0,
-    "centimeters": 10.0,
-    "centimetre": 10.0,
-    "centimetres": 10.0,
-    "m": 1000.0,
-    "meter": 1000.0,
-    "meters": 1000.0,
-    "metre": 1000.0,
-    "metres": 1000.0,
-    "um": 1e-3,
-    "micron": 1e-3,
-    "microns": 1e-3,
-    "micrometer": 1e-3,
-    "micrometers": 1e-3,
-    "in": 25.4,
-    "inch": 25.4,
-    "inches": 25.4,
-    "ft": 304.8,
-    "foot": 304.8,
-    "feet": 304.8,
-}
+def prepare_part(
+    pid: str,
+    mesh: trimesh.Trimesh,
+    *,
+    scale: float,
+    source: str,
+    name: str | None = None,
+    quantity: int = 1,
+    type: str = "",
+    shape: str = "",
+) -> Part:
+    """Validate a mesh, scale it to millimetres and wrap it as a :class:`Part`.
 
-
-def unit_scale(units: str) -> float:
-    """Millimetres per one ``units`` (``"m"`` -> 1000.0); ValueError for unknown units."""
-    key = str(units).strip().lower()
-    if key not in _UNIT_TO_MM:
-        raise ValueError(f"unknown length unit {units!r}; use e.g. mm, cm, m, in")
-    return _UNIT_TO_MM[key]
-
-
-def canonical_unit(units: str) -> str:
-    """Short name of a unit (``"millimeter"`` -> ``"mm"``)."""
-    scale = unit_scale(units)
-    for short in ("mm", "cm", "m", "um", "in", "ft"):
-        if _UNIT_TO_MM[short] == scale:
-            return short
-    return str(units)  # pragma: no cover
+    The mesh is copied, duplicate vertices merged and, for a closed mesh with inward
+    normals, the winding flipped. An empty mesh is a ValueError; a mesh that is not
+    watertight gives a warning naming the part.
+    """
+    if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
+        raise ValueError(f"part {pid!r} ({source}): empty mesh")
+    mesh = trimesh.Trimesh(
+        vertices=np.asarray(mesh.vertices, dtype=float) * scale,
+        faces=np.asarray(mesh.faces),
+        process=True,
+    )
+    mesh.remove_unreferenced_vertices()
+    if len(mesh.faces) == 0 or not np.all(np.isfinite(mesh.vertices)):
+        raise ValueError(f"part {pid!r} ({source}): empty or invalid mesh")
+    if mesh.is_watertight:
+        if mesh.volume < 0:
+            mesh.invert()
+    else:
+        warnings.warn(
+            f"part {pid!r} ({source}) is not watertight; its relations may be unreliable",
+            stacklevel=3,
+        )
+    return Part(
+        id=pid,
+        name=name or pid,
+        mesh=mesh,
+        quantity=quantity,
+        type=type,
+        source=source,
+        shape=shape,
+    )

@@ -50,7 +50,11 @@ def plan_summary(result) -> list[str]:
 
 @app.command("plan")
 def plan_command(
-    assembly: Path = typer.Argument(..., help="Folder with assembly.yaml, the YAML, or a .IN2."),
+    assembly: Path = typer.Argument(
+        ...,
+        help="Folder with assembly.yaml, the YAML, a .IN2, or a CAD file (STEP, glTF/GLB, 3MF, "
+        "3DXML) or folder of part meshes (a spec is generated; `asmplan init` writes it).",
+    ),
     output: Path | None = typer.Option(
         None, "--output", "-o", help="Folder for plan.json, dag.png (and manifest.json)."
     ),

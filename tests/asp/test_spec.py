@@ -122,3 +122,77 @@ def test_vacuum_pump_spec():
     assert spec.operation("2.1").sets == (("R1.bit", "hex"),)
     assert spec.base_part == "BD" and "BD" not in spec.placed_parts
     assert spec.has_geometry
+
+
+# ---------------------------------------------------------------- one part model (issue 10)
+
+
+@pytest.mark.parametrize(
+    ("path", "value", "message"),
+    [
+        (("gravty",), "+z", r"toy\.yaml: unknown key 'gravty' \(did you mean 'gravity'\?\)"),
+        (("operatons",), [], r"unknown key 'operatons' \(did you mean 'operations'\?\)"),
+        (("parts", 0, "qty"), 2, r"parts\[0\]: unknown key 'qty'"),
+        (("parts", 0, "fiel"), "a.stl", r"did you mean 'file'"),
+        (("agents", "H", "sde"), "human", r"agents\.H: unknown key 'sde' \(did you mean 'side'"),
+        (("tools", "R1.bit", "inital"), "hex", r"did you mean 'initial'"),
+        (("operations", 0, "afterr"), ["2"], r"did you mean 'after'"),
+        (("units",), "furlong", r"units: unknown length unit 'furlong'"),
+        (("parts", 0, "quantity"), "many", r"quantity 'many' is not a positive integer"),
+        (("parts", 0, "quantity"), 0, r"quantity 0 is not a positive integer"),
+    ],
+)
+def test_unknown_keys_are_refused_with_the_nearest_one(path, value, message):
+    with pytest.raises(ValueError, match=message):
+        spec_from_dict(variant(path, value), source="toy.yaml")
+
+
+def test_spec_and_bom_accept_the_same_parts(tmp_path):
+    # quantity "2" (as CSV gives it) and a bare part name: one model, one validation
+    spec = spec_from_dict(variant(("parts",), ["A", {"id": "B", "quantity": "2"}]), "toy.yaml")
+    assert [(p.id, p.quantity, p.file) for p in spec.parts] == [("A", 1, None), ("B", 2, None)]
+    from cad import read_bom
+
+    bom = tmp_path / "bom.yaml"
+    bom.write_text("parts: [A, {id: B, quantity: '2'}]\n")
+    assert read_bom(bom) == spec.parts
+    csv = tmp_path / "bom.csv"
+    csv.write_text("id,quantity\nA,\nB,2\n")
+    assert read_bom(csv) == spec.parts
+
+
+def test_a_part_without_a_mesh_is_named_when_geometry_is_needed(tmp_path):
+    from asp.generate import spec_geometry
+
+    spec = spec_from_dict(variant(("parts",), ["A", {"id": "B", "file": "b.stl"}]), "x.yaml")
+    with pytest.raises(ValueError, match="part 'A' has no mesh file"):
+        spec_geometry(spec)
+
+
+ALIAS_BOMB = """\
+a: &a ["lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol", "lol"]
+b: &b [*a, *a, *a, *a, *a, *a, *a, *a, *a]
+c: &c [*b, *b, *b, *b, *b, *b, *b, *b, *b]
+d: &d [*c, *c, *c, *c, *c, *c, *c, *c, *c]
+e: &e [*d, *d, *d, *d, *d, *d, *d, *d, *d]
+f: &f [*e, *e, *e, *e, *e, *e, *e, *e, *e]
+g: &g [*f, *f, *f, *f, *f, *f, *f, *f, *f]
+name: *g
+"""
+
+
+def test_a_yaml_alias_bomb_is_refused(tmp_path):
+    path = tmp_path / "assembly.yaml"
+    path.write_text(ALIAS_BOMB)
+    with pytest.raises(ValueError, match="expands to more than 1,000,000 values"):
+        load_spec(path)
+    path.write_text("a: &x [1, 2]\nb: [*x, *x]\n")  # a few aliases are fine (then: unknown key)
+    with pytest.raises(ValueError, match="unknown key 'a'"):
+        load_spec(path)
+
+
+def test_a_self_referencing_yaml_is_refused(tmp_path):
+    path = tmp_path / "assembly.yaml"
+    path.write_text("name: &x [*x]\n")
+    with pytest.raises(ValueError, match="expands to more than"):
+        load_spec(path)

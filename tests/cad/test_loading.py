@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 import trimesh
 
+from asmplan.pipeline import part_geometry as load_geometry
 from cad import Assembly, compute_relations, load_assembly, read_bom
 from tests.cad import shapes
 
@@ -96,21 +97,23 @@ def test_bom_yaml_and_scene(tmp_path):
     bom.write_text("parts:\n  - {id: B, file: bottom}\n  - {id: T, file: top, type: lid}\n")
     assembly = load_assembly(path, bom=bom)
     assert assembly.ids == ("B", "T")
-    assert [r["type"] for r in read_bom(bom)] == ["", "lid"]
+    assert [r.type for r in read_bom(bom)] == ["", "lid"]
 
 
-def test_assembly_yaml_ignores_unknown_keys(tmp_path, reference):
+def test_assembly_yaml_parts_load_through_the_spec(tmp_path, reference):
+    # cad takes part records, not YAML: the spec's one parser reads the parts
     write_folder(tmp_path / "meshes", shapes.boxed_container(), scale=0.1)
     spec = tmp_path / "assembly.yaml"
     spec.write_text(
         "units: cm\n"
-        "operations: [{id: '1.1'}]\n"
+        "agents: {H: human}\n"
+        "operations: [{id: '1.1', agents: {H: 1}}]\n"
         "parts:\n"
         "  - {id: item, file: meshes/item.stl}\n"
         "  - {id: lid, name: Lid, file: meshes/lid.stl, quantity: 1, type: cover}\n"
         "  - {id: tray, file: meshes/tray.stl}\n"
     )
-    assembly = load_assembly(spec)
+    assembly = load_geometry(spec)
     assert assembly.ids == ("item", "lid", "tray")
     assert assembly.parts[1].name == "Lid"
     assert same_tables(compute_relations(assembly), reference)
@@ -164,7 +167,14 @@ BAD = [
         ValueError,
         "furlong",
     ),
-    ("yaml without parts", lambda d: _write(d / "b.yaml", "name: x\n"), ValueError, "parts"),
+    (
+        "yaml without parts",
+        lambda d: _write(
+            d / "b.yaml", "name: x\nagents: {H: human}\noperations: [{id: 1, agents: {H: 1}}]\n"
+        ),
+        ValueError,
+        "parts",
+    ),
 ]
 
 
@@ -179,7 +189,7 @@ def _write(path: Path, text: str) -> Path:
 def test_bad_input(tmp_path, make, error, message):
     folder = write_folder(tmp_path / "asm", shapes.boxed_container())
     with pytest.raises(error, match=message):
-        load_assembly(make(folder))
+        load_geometry(make(folder))
 
 
 def test_empty_mesh_in_code_names_part():

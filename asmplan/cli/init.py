@@ -1,0 +1,42 @@
+"""``asmplan init``: write the spec generated from a CAD file, for the user to edit."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from asmplan.cli.app import app
+
+
+@app.command("init")
+def init_command(
+    source: Path = typer.Argument(
+        ..., help="CAD file (STEP, glTF/GLB, 3MF, 3DXML, mesh) or folder of part meshes."
+    ),
+    output: Path = typer.Option(
+        Path("assembly.yaml"), "--output", "-o", help="Spec file to write."
+    ),
+    force: bool = typer.Option(False, "--force", help="Overwrite an existing spec file."),
+) -> None:
+    """Generate assembly.yaml from CAD: parts, a default cell (H, R1), one placement each."""
+    import yaml
+
+    from asp.atomic import write_text
+    from asp.generate import spec_text
+    from asp.spec import spec_from_dict
+    from cad.yamlfile import DecimalsAsText
+
+    if not source.exists():
+        raise FileNotFoundError(f"{source}: no such file or folder")
+    if output.exists() and not force:
+        raise ValueError(f"{output} exists (use --force to overwrite it)")
+    text = spec_text(source, spec_folder=output.parent)
+    # the text must read back as a valid spec before it is written
+    spec = spec_from_dict(yaml.load(text, Loader=DecimalsAsText), source=str(output))  # noqa: S506
+    write_text(output, text)
+    typer.echo(
+        f"wrote {output}: {len(spec.parts)} parts, {len(spec.operations)} operations, "
+        f"agents {', '.join(a.name for a in spec.agents)}; edit it, then "
+        f"`asmplan plan {output}`"
+    )

@@ -1,0 +1,251 @@
+"""Specs generated from CAD: a first plan from a CAD file alone, and the geometry of a spec.
+
+:func:`generated_spec` turns a CAD file (STEP, glTF/GLB, 3MF, 3DXML, a mesh) or a folder
+of part meshes into a valid :class:`~asp.spec.AssemblySpec`; :func:`spec_text` writes the
+same spec as a commented ``assembly.yaml`` for the user to edit (``asmplan init``). The
+rule, fixed so that a generated spec plans the same as the file it writes:
+
+- parts: one per mesh node of the file (ids and names from the file, :mod:`cad.scene`),
+  or per mesh file of the folder (a ``bom.csv``/``bom.yaml`` in the folder still names
+  them); ``shape`` is the shape class (identical parts share it, :mod:`cad.identical`);
+- the base part: the largest part (by bounding-box volume), placed first;
+- agents: one human ``H`` and one robot ``R1``;
+- one placement operation per part, ids ``"1"``, ``"2"``, ... in the order base first,
+  then the others from the lowest to the highest (against gravity), open to both agents;
+- durations (:func:`placement_durations`): the human takes 3 s plus 1 s per 25 mm of
+  the part's bounding-box diagonal, at most 60 s, in whole seconds; the robot takes 1.5
+  times as long (rounded to whole seconds); the cost model is ``time``;
+- gravity ``-z``, every gripper approach direction, every constraint on; the units are
+  the file's (meshes in other units are read as millimetres unless the spec says).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections import Counter
+from pathlib import Path
+
+import numpy as np
+
+from asp.spec import SPEC_FILE, AssemblySpec, load_spec, spec_from_dict
+
+HUMAN_BASE_S = 3.0
+HUMAN_S_PER_MM = 1.0 / 25.0
+MAX_DURATION_S = 60.0
+ROBOT_FACTOR = 1.5
+
+
+def placement_durations(diagonal_mm: float) -> tuple[float, float]:
+    """``(human, robot)`` seconds to place a part of bounding-box diagonal ``diagonal_mm``."""
+    human = min(MAX_DURATION_S, float(round(HUMAN_BASE_S + HUMAN_S_PER_MM * diagonal_mm)))
+    return human, float(round(ROBOT_FACTOR * human))
+
+
+def spec_geometry(spec: AssemblySpec):
+    """The meshes of ``spec``'s parts as a ``cad.Assembly`` (files relative to the spec).
+
+    Raises
+    ------
+    ValueError
+        The spec names no parts, or a part has no mesh file (named).
+    """
+    from cad.loading import load_parts
+
+    if not spec.parts:
+        raise ValueError(f"{spec.source}: the spec names no parts (a 'parts:' list with files)")
+    return load_parts(spec.parts, spec.folder, spec.units)
+
+
+def cad_assembly(path: str | Path):
+    """The geometry of a CAD file or a folder of part meshes (``cad.load_assembly``)."""
+    from cad.loading import load_assembly
+
+    return load_assembly(path)
+
+
+def spec_data(path: str | Path, spec_folder: str | Path | None = None) -> tuple[dict, object]:
+    """The generated spec of a CAD file or folder, as the YAML mapping, and its geometry.
+
+    Part files are written relative to ``spec_folder`` (default: the CAD file's folder,
+    or the folder of meshes itself).
+
+    Returns
+    -------
+    (dict, cad.Assembly)
+        The mapping :func:`asp.spec.spec_from_dict` reads, and the parts it was made from.
+    """
+    from cad.identical import shape_classes
+
+    path = Path(path)
+    assembly = cad_assembly(path)
+    shapes = shape_classes(assembly.parts)
+    counts = Counter(shapes)
+    if spec_folder is None:
+        spec_folder = path if path.is_dir() else path.parent
+    parts = []
+    for part, shape in zip(assembly.parts, shapes, strict=True):
+        source, _, node = part.source.partition("#")
+        file = Path(os.path.relpath(Path(source).resolve(), Path(spec_folder).resolve()))
+        record = {"id": part.id, "name": part.name}
+        record["file"] = f"{file.as_posix()}#{node}" if node else file.as_posix()
+        if part.quantity != 1:
+            record["quantity"] = part.quantity
+        if part.type:
+            record["type"] = part.type
+        if counts[shape] > 1:
+            record["shape"] = shape
+        parts.append(record)
+    bounds = np.array([p.bounds for p in assembly.parts])  # (n, 2, 3) in mm
+    extents = bounds[:, 1] - bounds[:, 0]
+    base = int(np.argmax(np.prod(np.maximum(extents, 1e-9), axis=1)))
+    order = [base] + sorted(
+        (k for k in range(len(assembly.parts)) if k != base),
+        key=lambda k: (bounds[k, 0, 2], bounds[k, 1, 2], k),
+    )
+    operations = []
+    for number, k in enumerate(order, start=1):
+        part = assembly.parts[k]
+        human, robot = placement_durations(float(np.linalg.norm(extents[k])))
+        operations.append(
+            {
+                "id": str(number),
+                "description": f"place {part.id}"
+                + (f" ({part.name})" if part.name != part.id else ""),
+                "agents": {"H": _num(human), "R1": _num(robot)},
+                "part": part.id,
+            }
+        )
+    data = {
+        "name": path.stem if path.is_file() else path.name,
+        "units": assembly.units if assembly.units != "mixed" else "mm",
+        "parts": parts,
+        "agents": {
+            "H": {"side": "human", "description": "operator"},
+            "R1": {"side": "robot", "description": "robot arm with a gripper"},
+        },
+        "base_part": assembly.parts[base].id,
+        "gravity": "-z",
+        "gripper_approach": ["+x", "-x", "+y", "-y", "+z", "-z"],
+        "constraints": {"topological": True, "stability": True, "functional": True},
+        "turn_model": "alternate",
+        "cost": "time",
+        "operations": operations,
+    }
+    return data, assembly
+
+
+def is_cad_input(path: str | os.PathLike[str]) -> bool:
+    """True for a CAD scene file or a folder of part meshes without an ``assembly.yaml``."""
+    from cad.loading import MESH_SUFFIXES
+
+    path = Path(path)
+    if path.is_dir():
+        return not (path / SPEC_FILE).is_file() and any(
+            f.suffix.lower() in MESH_SUFFIXES for f in path.iterdir() if f.is_file()
+        )
+    return path.is_file() and path.suffix.lower() in MESH_SUFFIXES
+
+
+def load_any(path: str | os.PathLike[str]) -> AssemblySpec:
+    """The spec of ``path``: generated for a CAD file or a folder of part meshes without an
+    ``assembly.yaml`` (:func:`generated_spec`), else read (:func:`asp.spec.load_spec`)."""
+    return generated_spec(path) if is_cad_input(path) else load_spec(path)
+
+
+def generated_spec(path: str | Path) -> AssemblySpec:
+    """The spec generated from a CAD file or a folder of part meshes (``generated=True``).
+
+    Its ``source`` is the spec file it stands for (``assembly.yaml`` beside the CAD file,
+    which need not exist), so that part files resolve as in the written spec.
+    """
+    from dataclasses import replace
+
+    path = Path(path)
+    data, _ = spec_data(path)
+    folder = path if path.is_dir() else path.parent
+    spec = spec_from_dict(data, source=str(folder / SPEC_FILE))
+    return replace(spec, generated=True, source=str(path))
+
+
+def spec_text(path: str | Path, spec_folder: str | Path | None = None) -> str:
+    """The generated spec of a CAD file or folder as a commented ``assembly.yaml``.
+
+    Part files are relative to ``spec_folder``, where the file will be written.
+    """
+    data, assembly = spec_data(path, spec_folder)
+    path = Path(path)
+    lines = [
+        f"# Assembly spec generated by `asmplan init` from {path.name}: edit it, then run",
+        "#   asmplan plan assembly.yaml -o plan/",
+        "# Format: see asp/spec.py. Every key below may be changed; what usually needs a look:",
+        "#   - part names (ids are used in operations: rename both together);",
+        "#   - durations in seconds, generated from part size: human "
+        f"{HUMAN_BASE_S:g} s + 1 s per {1 / HUMAN_S_PER_MM:g} mm",
+        f"#     of bounding-box diagonal (at most {MAX_DURATION_S:g} s), robot x{ROBOT_FACTOR:g};",
+        "#   - which agent may do what (remove H or R1 from an operation), tool changes;",
+        "#   - `held: true` for a part an agent must hold until a later part fixes it;",
+        "#   - `after:` for precedences the geometry cannot see (glue, screws to tighten).",
+        f"name: {_scalar(data['name'])}",
+        f"units: {data['units']}   # for mesh files that declare no unit "
+        "(STEP, glTF: metres; 3MF: its own)",
+        "",
+        "parts:   # id: used in operations; file: the mesh (file#part: one part of a scene);",
+        "         # shape: shared by identical parts (the same shape up to a rigid motion)",
+    ]
+    counts = Counter(r["shape"] for r in data["parts"] if "shape" in r)
+    for record in data["parts"]:
+        fields = ", ".join(f"{k}: {_scalar(v)}" for k, v in record.items())
+        lines.append(f"  - {{{fields}}}")
+    if counts:
+        lines.append(
+            "# identical parts: " + ", ".join(f"{n} x {s}" for s, n in sorted(counts.items()))
+        )
+    if assembly.groups:
+        lines.append("# hierarchy in the file (sub-assemblies):")
+        for gid, members in assembly.groups:
+            lines.append(f"#   {gid}: [{', '.join(members)}]")
+    lines += [
+        "",
+        "agents:   # name -> side (human, robot); add R2, H2, ... as the cell has them",
+        "  H: {side: human, description: operator}",
+        "  R1: {side: robot, description: robot arm with a gripper}",
+        "",
+        f"base_part: {data['base_part']}      # the largest part, placed first",
+        "gravity: -z                # direction of gravity in the file's frame",
+        "gripper_approach: [+x, -x, +y, -y, +z, -z]   # directions a part may be inserted from",
+        "constraints: {topological: true, stability: true, functional: true}",
+        "turn_model: alternate",
+        "cost: time                 # or steps (1 per operation)",
+        "",
+        "operations:   # one placement per part: base first, then from the lowest part up",
+    ]
+    for op in data["operations"]:
+        agents = ", ".join(f"{a}: {d}" for a, d in op["agents"].items())
+        lines.append(
+            f"  - {{id: {_scalar(op['id'])}, description: {_scalar(op['description'])}, "
+            f"agents: {{{agents}}}, part: {op['part']}}}"
+        )
+    return "\n".join(lines) + "\n"
+
+
+def _num(x: float) -> int | float:
+    return int(x) if float(x).is_integer() else x
+
+
+def _scalar(value) -> str:
+    """A YAML flow scalar: plain when safe, else double-quoted."""
+    import json
+
+    text = str(value)
+    plain = (
+        text
+        and text[0].isalpha()
+        and all(c.isalnum() or c in " _-./()#" for c in text)
+        and text.lower() not in ("yes", "no", "true", "false", "null", "on", "off", "y", "n")
+        and not text.endswith(" ")
+        and " #" not in text
+    )
+    if isinstance(value, int | float) and not isinstance(value, bool):
+        return str(value) if not math.isnan(value) else json.dumps(text)
+    return text if plain else json.dumps(text)

@@ -1,0 +1,165 @@
+"""Part records: the one model of a bill-of-materials row, for BOM files and assembly specs.
+
+A part record names a part and where its mesh is; it holds no geometry. The same record
+and the same validation serve a BOM file (CSV or YAML, :func:`read_bom`) and the
+``parts:`` list of an ``assembly.yaml`` (``asp.spec``), so both accept the same things.
+
+Keys: ``id`` (required), ``name``, ``file``, ``quantity``, ``type``, ``shape``. ``file`` is
+a mesh file relative to the spec or BOM, or ``scene.step#node`` for one part of a scene
+file (the node's cleaned id or its name in the file). ``shape`` is the shape class: parts
+with the same shape up to a rigid motion share it (``asmplan init`` fills it in). A bare
+string in a ``parts:`` list is a record with that id.
+"""
+
+from __future__ import annotations
+
+import csv
+import difflib
+from collections.abc import Iterable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from cad.yamlfile import read_yaml
+
+PART_KEYS = ("id", "name", "file", "quantity", "type", "shape")
+
+
+@dataclass(frozen=True)
+class PartRecord:
+    """One part of the bill of materials.
+
+    Attributes
+    ----------
+    id : str
+        Unique identifier, used in operations and relation tables.
+    name : str
+        Human-readable name (the id if not given).
+    file : str or None
+        Mesh file relative to the BOM/spec, ``file#node`` for one node of a scene file, or
+        None (a part without geometry).
+    quantity : int
+        BOM quantity (informative; each record is one part in the relations).
+    type : str
+        Free part type from the BOM, e.g. ``"screw"``.
+    shape : str
+        Shape class: parts with equal shapes up to a rigid motion share it (empty: unknown).
+    """
+
+    id: str
+    name: str = ""
+    file: str | None = None
+    quantity: int = 1
+    type: str = ""
+    shape: str = ""
+
+
+def unknown_key_message(key: object, known: Iterable[str], word: str = "key") -> str:
+    """``unknown key 'gravty' (did you mean 'gravity'?)``, the nearest known key suggested."""
+    known = list(known)
+    near = difflib.get_close_matches(str(key), known, n=1, cutoff=0.6)
+    hint = f" (did you mean {near[0]!r}?)" if near else f" (known: {', '.join(known)})"
+    return f"unknown {word} {str(key)!r}{hint}"
+
+
+def refuse_unknown_keys(mapping: dict, known: Iterable[str], where: str, word="key") -> None:
+    """Raise ``ValueError`` ``where: unknown key ...`` for the first key not in ``known``."""
+    known = tuple(known)
+    for key in mapping:
+        if key not in known:
+            raise ValueError(f"{where}: {unknown_key_message(key, known, word)}")
+
+
+def part_record(row: Any, where: str) -> PartRecord:
+    """Validate one BOM row or ``parts:`` entry.
+
+    Parameters
+    ----------
+    row : str or dict
+        A bare id, or a mapping with the keys of :data:`PART_KEYS` (only ``id`` required).
+    where : str
+        Location for messages, e.g. ``"assembly.yaml: parts[3]"``.
+
+    Raises
+    ------
+    ValueError
+        ``where: ...`` naming the problem: not a mapping, no id, an unknown key (the nearest
+        known one suggested), a quantity that is not a positive integer.
+    """
+    if isinstance(row, str | int) and not isinstance(row, bool):
+        row = {"id": row}
+    if not isinstance(row, dict):
+        raise ValueError(f"{where}: expected a mapping with an 'id' or a part id")
+    refuse_unknown_keys(row, PART_KEYS, where)
+    raw_id = row.get("id")
+    pid = "" if raw_id is None or isinstance(raw_id, dict | list) else str(raw_id).strip()
+    if not pid:
+        raise ValueError(f"{where}: part has no id")
+    return PartRecord(
+        id=pid,
+        name=_text(row.get("name")) or pid,
+        file=_text(row.get("file")) or None,
+        quantity=_quantity(row.get("quantity"), f"{where} (part {pid!r})"),
+        type=_text(row.get("type")),
+        shape=_text(row.get("shape")),
+    )
+
+
+def part_records(rows: Any, where: str) -> tuple[PartRecord, ...]:
+    """Validate a list of rows (:func:`part_record`); duplicate ids are an error."""
+    if not isinstance(rows, list):
+        raise ValueError(f"{where}: expected a list of parts {{id, name, file, quantity, type}}")
+    out, seen = [], set()
+    for k, row in enumerate(rows):
+        record = part_record(row, f"{where}[{k}]")
+        if record.id in seen:
+            raise ValueError(f"{where}: duplicate part id {record.id!r}")
+        seen.add(record.id)
+        out.append(record)
+    return tuple(out)
+
+
+def read_bom(path: str | Path) -> tuple[PartRecord, ...]:
+    """Records of a BOM file: CSV with a header row, or YAML list / ``{parts: [...]}``.
+
+    Raises
+    ------
+    FileNotFoundError
+        No such file.
+    ValueError
+        Unreadable file or an invalid row (:func:`part_record`), naming the file and row.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"BOM not found: {path}")
+    if path.suffix.lower() == ".csv":
+        try:
+            with path.open(newline="", encoding="utf-8-sig") as handle:
+                rows: Any = [
+                    {str(k).strip().lower(): v for k, v in row.items() if k and v not in (None, "")}
+                    for row in csv.DictReader(handle)
+                ]
+        except (OSError, UnicodeDecodeError, csv.Error) as exc:
+            raise ValueError(f"unreadable BOM {path}: {exc}") from None
+    else:
+        data = read_yaml(path, what="BOM")
+        rows = data.get("parts", []) if isinstance(data, dict) else data
+    if not isinstance(rows, list):
+        raise ValueError(f"BOM {path} must be a list of parts")
+    return part_records(rows, f"BOM {path}: row")
+
+
+def _text(value: Any) -> str:
+    return "" if value is None else str(value).strip()
+
+
+def _quantity(value: Any, where: str) -> int:
+    """A positive integer; integer-looking text (``"2"``, as CSV gives) is accepted."""
+    if value is None or value == "":
+        return 1
+    number = value
+    if isinstance(value, str) and value.strip().isdigit():
+        number = int(value.strip())
+    if not isinstance(number, int) or isinstance(number, bool) or number < 1:
+        raise ValueError(f"{where}: quantity {value!r} is not a positive integer")
+    return number

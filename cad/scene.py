@@ -1,0 +1,250 @@
+"""Scene files: one part per mesh node, named from the file, with the file's hierarchy.
+
+A scene (STEP through cascadio, GLB/glTF, 3MF, 3DXML) is a tree of nodes. Every node
+that carries a mesh is a part; every other node with two or more parts below it is a
+group of the file's hierarchy (a STEP sub-assembly, a glTF parent node).
+
+Part ids are the names the file gives, cleaned into short unique ids (:func:`clean_name`,
+:func:`unique_ids`): ``"Hex Nut M6<2>"`` -> ``hex_nut_m6``, numbered when a name repeats
+(``nut_1``, ``nut_2``), in the file's order. Instance paths and numbers
+(``bearing#1:23:2:16``, ``Bolt:1``, ``Part1<3>``) are cut off; names that say nothing
+(``NAUO7``, ``12``, ``Open CASCADE STEP translator 7.8 1.1``, ``mesh_0``) give way to the
+mesh's name or the nearest named parent, else ``part``.
+"""
+
+from __future__ import annotations
+
+import re
+from collections import Counter
+from dataclasses import dataclass
+from functools import lru_cache
+from pathlib import Path
+
+import trimesh
+
+from cad.units import canonical_unit
+
+SCENE_SUFFIXES = (".glb", ".gltf", ".3mf", ".step", ".stp", ".3dxml")
+"""Files that hold several parts (one per mesh node)."""
+DECLARED_METRES = (".glb", ".gltf", ".step", ".stp")
+"""Formats whose unit is the metre (STEP through cascadio, glTF by definition)."""
+MAX_ID_LENGTH = 32
+_EXTENSIONS = r"\.(stp|step|sldprt|sldasm|ipt|iam|prt|asm|stl|obj|glb|gltf|3mf)$"
+
+_GENERIC = re.compile(
+    r"^((nauo|solid|body|mesh|shape|geometry|node|object|component|compound|part|g)_?\d*|"
+    r"\d+|unnamed\w*|noname\w*|default\w*|world|root|scene|open_cascade_step_translator\w*)$"
+)
+
+
+def clean_name(raw: str) -> str:
+    """A short lowercase id from a CAD name (empty if nothing is left).
+
+    Instance suffixes (``#...``, ``:1``, ``<2>``, ``(3)``) and file extensions are cut off,
+    everything but letters and digits becomes ``_``, at most :data:`MAX_ID_LENGTH` chars.
+    """
+    name = str(raw).strip()
+    name = re.split(r"[#<]", name, maxsplit=1)[0]
+    name = re.sub(r":\d+$", "", name)
+    name = re.sub(r"\(\d+\)$", "", name)
+    name = re.sub(_EXTENSIONS, "", name, flags=re.IGNORECASE)
+    name = re.sub(r"[^0-9a-zA-Z]+", "_", name).strip("_").lower()
+    if len(name) > MAX_ID_LENGTH:
+        cut = name[:MAX_ID_LENGTH]
+        name = cut.rsplit("_", 1)[0] if "_" in cut[8:] else cut
+    if name and name[0].isdigit() and not name.isdigit():
+        name = "p_" + name
+    return name
+
+
+def is_generic(name: str) -> bool:
+    """True for a cleaned name that says nothing about the part (``nauo7``, ``12``, ``mesh``)."""
+    return not name or bool(_GENERIC.match(name))
+
+
+def best_name(candidates: list[str], fallback: str = "part") -> str:
+    """The first meaningful cleaned name among ``candidates`` (raw names), else ``fallback``."""
+    for raw in candidates:
+        name = clean_name(raw)
+        if not is_generic(name):
+            return name
+    return fallback
+
+
+def unique_ids(names: list[str], taken: set[str] | None = None) -> list[str]:
+    """Number repeated names in order (``nut`` x2 -> ``nut_1``, ``nut_2``); keep single ones.
+
+    ``taken`` ids are avoided as well (a suffix ``_<n>`` is added until free).
+    """
+    taken = set() if taken is None else set(taken)
+    counts = Counter(names)
+    seen: Counter[str] = Counter()
+    out = []
+    for name in names:
+        if counts[name] > 1:
+            seen[name] += 1
+            candidate = f"{name}_{seen[name]}"
+        else:
+            candidate = name
+        k = 1
+        base = candidate
+        while candidate in taken:
+            k += 1
+            candidate = f"{base}_{k}"
+        taken.add(candidate)
+        out.append(candidate)
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class SceneParts:
+    """The parts of a scene file.
+
+    Attributes
+    ----------
+    ids : tuple of str
+        Cleaned unique part ids, in the file's order.
+    names : tuple of str
+        The node names as the file gives them.
+    meshes : tuple of trimesh.Trimesh
+        Each part's mesh in the scene frame, in the file's unit. Shared: copy to change.
+    groups : tuple of (str, tuple of str)
+        The file's hierarchy: group id -> ids of the parts below it (groups of two parts
+        or more, outermost first; the root is not a group).
+    units : str or None
+        The unit the file declares (short name), or None.
+    """
+
+    ids: tuple[str, ...]
+    names: tuple[str, ...]
+    meshes: tuple[trimesh.Trimesh, ...]
+    groups: tuple[tuple[str, tuple[str, ...]], ...]
+    units: str | None
+
+    def find(self, node: str) -> int | None:
+        """Index of the part whose id or node name is ``node`` (None if there is none)."""
+        for k, (pid, name) in enumerate(zip(self.ids, self.names, strict=True)):
+            if node in (pid, name):
+                return k
+        return None
+
+
+def load_scene_file(path: Path) -> trimesh.Scene:
+    """Load a mesh or scene file as a trimesh scene; one-line errors for bad files."""
+    if not path.is_file():
+        raise FileNotFoundError(f"mesh file not found: {path}")
+    if path.suffix.lower() in (".step", ".stp"):
+        try:
+            import cascadio  # noqa: F401
+        except ImportError:
+            raise ValueError(
+                f"cannot read STEP file {path}: install the optional extra "
+                "'asmplan[step]' (cascadio)"
+            ) from None
+    if path.stat().st_size == 0:
+        raise ValueError(f"empty mesh file {path}")
+    try:
+        scene = trimesh.load(str(path), force="scene")
+    except Exception as exc:  # trimesh raises many types for bad files
+        raise ValueError(f"unreadable mesh file {path}: {type(exc).__name__}: {exc}") from None
+    if not isinstance(scene, trimesh.Scene):  # pragma: no cover - force="scene"
+        scene = trimesh.Scene(scene)
+    return scene
+
+
+def declared_units(path: Path, scene: trimesh.Scene) -> str | None:
+    """The unit the file format declares (short name), or None."""
+    suffix = path.suffix.lower()
+    if suffix not in (".3mf", ".3dxml", *DECLARED_METRES):
+        return None
+    declared = scene.units
+    if declared is None:
+        for geom in scene.geometry.values():
+            declared = geom.units or geom.metadata.get("units")
+            if declared:
+                break
+    if declared is None:
+        if suffix in DECLARED_METRES:
+            declared = "m"
+        elif suffix == ".3mf":
+            declared = "mm"
+        else:
+            return None
+    return canonical_unit(declared)
+
+
+def read_scene(path: str | Path) -> SceneParts:
+    """The named parts and hierarchy of a scene file (cached while the file is unchanged)."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"mesh file not found: {path}")
+    stat = path.stat()
+    return _read_scene_cached(str(path.resolve()), stat.st_mtime_ns, stat.st_size)
+
+
+@lru_cache(maxsize=4)
+def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
+    file = Path(path)
+    scene = load_scene_file(file)
+    graph = scene.graph
+    children: dict[str, list[str]] = {}
+    for parent, child in graph.transforms.edge_data:
+        children.setdefault(str(parent), []).append(str(child))
+    all_nodes = set(graph.nodes)
+
+    def original(node: str) -> str:
+        """Undo trimesh's renaming of a repeated node name (``Cap_1`` next to ``Cap``)."""
+        match = re.match(r"^(.*)_\d+$", node)
+        return match.group(1) if match and match.group(1) in all_nodes else node
+
+    part_nodes: list[tuple[str, list[str]]] = []  # (node, ancestors nearest first)
+    group_nodes: list[tuple[str, list[str]]] = []  # (node, part nodes below)
+
+    def walk(node: str, ancestors: list[str]) -> list[str]:
+        below: list[str] = []
+        geom_name = graph.transforms.node_data.get(node, {}).get("geometry")
+        geom = scene.geometry.get(geom_name) if geom_name is not None else None
+        if isinstance(geom, trimesh.Trimesh) and len(geom.faces):
+            part_nodes.append((node, ancestors))
+            below.append(node)
+        slot = len(group_nodes)
+        for child in sorted(children.get(node, []), key=_natural):
+            below += walk(child, [node, *ancestors])
+        if geom_name is None and ancestors and len(below) >= 2:
+            group_nodes.insert(slot, (node, list(below)))
+        return below
+
+    walk(graph.base_frame, [])
+    # the node holding every part (the product itself) is not a group
+    group_nodes = [(g, b) for g, b in group_nodes if len(b) < len(part_nodes)]
+
+    names, meshes = [], []
+    for node, _ in part_nodes:
+        transform, geom_name = graph[node]
+        meshes.append(scene.geometry[geom_name].copy().apply_transform(transform))
+        names.append(original(node))
+    bases = [
+        best_name([original(node), str(graph[node][1]), *[original(a) for a in anc]])
+        for node, anc in part_nodes
+    ]
+    ids = unique_ids(bases)
+    id_of = {node: pid for (node, _), pid in zip(part_nodes, ids, strict=True)}
+    group_ids = unique_ids(
+        [best_name([original(g)], fallback="group") for g, _ in group_nodes], taken=set(ids)
+    )
+    groups = tuple(
+        (gid, tuple(id_of[n] for n in below))
+        for gid, (_, below) in zip(group_ids, group_nodes, strict=True)
+    )
+    return SceneParts(
+        ids=tuple(ids),
+        names=tuple(names),
+        meshes=tuple(meshes),
+        groups=groups,
+        units=declared_units(file, scene),
+    )
+
+
+def _natural(name: str) -> list:
+    """Sort key that puts ``part9`` before ``part10``."""
+    return [int(t) if t.isdigit() else t.lower() for t in re.split(r"(\d+)", name)]

@@ -1,0 +1,101 @@
+"""Read YAML safely: no code, bounded alias expansion, optionally decimals kept as text.
+
+YAML aliases share one node, so a 1 KB file of nested aliases ("billion laughs") loads in
+microseconds but expands to gigabytes once written out (a plan echoes its input). The
+loaded document is therefore measured as if every alias were expanded, and refused past
+:data:`MAX_EXPANDED_VALUES`.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+MAX_EXPANDED_VALUES = 1_000_000
+"""Most values (scalars, lists, mappings, counted with aliases expanded) a file may hold."""
+
+
+class DecimalsAsText(yaml.SafeLoader):
+    """SafeLoader that keeps decimal-looking scalars as strings (``1.10`` stays ``"1.10"``)."""
+
+
+DecimalsAsText.yaml_implicit_resolvers = {
+    key: [(tag, regexp) for tag, regexp in resolvers if tag != "tag:yaml.org,2002:float"]
+    for key, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.copy().items()
+}
+
+
+def read_yaml(path: str | Path, *, what: str, decimals_as_text: bool = False) -> Any:
+    """The parsed YAML document of ``path``.
+
+    Parameters
+    ----------
+    path : str or Path
+        The file.
+    what : str
+        What the file is, for messages (``"assembly spec"``, ``"BOM"``).
+    decimals_as_text : bool
+        Keep ``1.10`` as the string ``"1.10"`` (operation ids) instead of a float.
+
+    Raises
+    ------
+    ValueError
+        One line naming the file: malformed YAML, not UTF-8 text, or aliases that expand
+        past :data:`MAX_EXPANDED_VALUES` values.
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"{path}: not a UTF-8 text file ({exc.reason})") from None
+    loader = DecimalsAsText if decimals_as_text else yaml.SafeLoader
+    try:
+        data = yaml.load(text, Loader=loader)  # noqa: S506 - a SafeLoader subclass
+    except yaml.YAMLError as exc:
+        first = " ".join(str(exc).split())
+        raise ValueError(f"{path}: malformed YAML in {what} ({first})") from None
+    except RecursionError:
+        raise ValueError(f"{path}: {what} is nested too deeply") from None
+    if expanded_size(data) > MAX_EXPANDED_VALUES:
+        raise ValueError(
+            f"{path}: {what} expands to more than {MAX_EXPANDED_VALUES:,} values through "
+            "YAML aliases (refused: an alias bomb or a runaway file)"
+        )
+    return data
+
+
+def expanded_size(data: Any) -> int:
+    """Number of values in ``data`` with every shared (aliased) node counted each time.
+
+    Linear in the number of distinct nodes (sizes are memoised by identity); a
+    self-referencing document counts as infinitely large.
+    """
+    sizes: dict[int, float] = {}
+    open_nodes: set[int] = set()
+
+    def size(node: Any) -> float:
+        if not isinstance(node, dict | list):
+            return 1
+        key = id(node)
+        if key in sizes:
+            return sizes[key]
+        if key in open_nodes:
+            return float("inf")
+        open_nodes.add(key)
+        children = [*node.keys(), *node.values()] if isinstance(node, dict) else node
+        total = 1.0
+        for child in children:
+            total += size(child)
+            if total > MAX_EXPANDED_VALUES:
+                break
+        open_nodes.discard(key)
+        sizes[key] = total
+        return total
+
+    try:
+        total = size(data)
+    except RecursionError:
+        return MAX_EXPANDED_VALUES + 1
+    return int(min(total, MAX_EXPANDED_VALUES + 1))

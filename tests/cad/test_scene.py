@@ -1,0 +1,116 @@
+"""Scene files: part ids and names from the file, its hierarchy, units, identical parts."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+
+from cad import load_assembly, load_parts
+from cad.bom import PartRecord
+from cad.identical import shape_classes
+from cad.scene import clean_name, is_generic, read_scene, unique_ids
+from tests.cad import shapes
+
+DATA = Path(__file__).parent / "data"
+
+
+@pytest.mark.parametrize(
+    ("raw", "clean"),
+    [
+        ("Hex Nut M6<2>", "hex_nut_m6"),
+        ("bearing#1:23:2:16:4:13:10:12:11", "bearing"),
+        ("Bolt:1", "bolt"),
+        ("Bracket (3)", "bracket"),
+        ("Side Panel.SLDPRT", "side_panel"),
+        ("608-2RS bearing", "p_608_2rs_bearing"),
+        ("NAUO7", "nauo7"),
+        (
+            "a-very-long-name-of-a-part-that-goes-on-and-on-forever",
+            "a_very_long_name_of_a_part_that",
+        ),
+    ],
+)
+def test_clean_name(raw, clean):
+    assert clean_name(raw) == clean
+
+
+@pytest.mark.parametrize(
+    ("name", "generic"),
+    [("nauo7", True), ("12", True), ("open_cascade_step_translator_7_8_1_1", True),
+     ("mesh_0", True), ("mesh0", True), ("g3", True), ("bolt", False), ("", True)],
+)  # fmt: skip
+def test_generic_names(name, generic):
+    assert is_generic(name) == generic
+
+
+def test_unique_ids_number_repeats_in_order():
+    assert unique_ids(["nut", "bolt", "nut", "nut"]) == ["nut_1", "bolt", "nut_2", "nut_3"]
+    assert unique_ids(["cap"], taken={"cap"}) == ["cap_2"]
+
+
+def test_step_in_inches_with_a_product_tree():
+    pytest.importorskip("cascadio")
+    assembly = load_assembly(DATA / "table_frame_in.step")
+    assert assembly.ids == ("base_plate", "cap_1", "pillar_1", "cap_2", "pillar_2", "top_plate")
+    assert [p.name for p in assembly.parts][:3] == ["Base Plate", "Cap", "Pillar"]
+    assert assembly.groups == (
+        ("pillar_unit_1", ("cap_1", "pillar_1")),
+        ("pillar_unit_2", ("cap_2", "pillar_2")),
+    )
+    # 4 x 4 x 0.5 inch base plate, read in millimetres
+    base = assembly.parts[0]
+    assert np.allclose(base.mesh.extents, [101.6, 101.6, 12.7], atol=1e-3)
+    assert shape_classes(assembly.parts) == (
+        "base_plate", "cap", "pillar", "cap", "pillar", "top_plate",
+    )  # fmt: skip
+
+
+def test_a_spec_may_name_one_part_of_a_scene():
+    pytest.importorskip("cascadio")
+    records = [
+        PartRecord(id="c", file="table_frame_in.step#cap_2"),
+        PartRecord(id="b", file="table_frame_in.step#Base Plate"),
+    ]
+    assembly = load_parts(records, DATA)
+    assert assembly.ids == ("c", "b")
+    assert np.isclose(assembly.parts[0].mesh.bounds[0][0], 69.85, atol=1e-3)
+    with pytest.raises(ValueError, match=r"no part 'cap_9' in .*its parts: base_plate, cap_1"):
+        load_parts([PartRecord(id="x", file="table_frame_in.step#cap_9")], DATA)
+
+
+def write_named_glb(path: Path) -> Path:
+    """A glTF in metres: a product node over two groups, CAD-style instance names."""
+    scene = trimesh.Scene()
+    parts = {
+        "Bottom Plate#1:2:3": shapes.box_between((0, 0, 0), (40, 40, 5)),
+        "bearing#1:23:2:16:4": shapes.box_between((5, 5, 5), (15, 15, 15)),
+        "bearing#1:23:2:16:5": shapes.box_between((25, 5, 5), (35, 15, 15)),
+        "NAUO7": shapes.box_between((0, 0, 15), (40, 40, 20)),
+    }
+    scene.graph.update(frame_from="world", frame_to="Pump Assembly")
+    scene.graph.update(frame_from="Pump Assembly", frame_to="Bearing Set")
+    for k, (name, mesh) in enumerate(parts.items()):
+        parent = "Bearing Set" if name.startswith("bearing") else "Pump Assembly"
+        scene.add_geometry(
+            mesh.copy().apply_scale(0.001),
+            node_name=name,
+            geom_name=f"Mesh_{k}",
+            parent_node_name=parent,
+        )
+    scene.export(path)
+    return path
+
+
+def test_gltf_names_and_hierarchy(tmp_path):
+    path = write_named_glb(tmp_path / "pump.glb")
+    scene = read_scene(path)
+    assert scene.ids == ("bearing_1", "bearing_2", "bottom_plate", "pump_assembly")
+    assert scene.groups == (("bearing_set", ("bearing_1", "bearing_2")),)
+    assembly = load_assembly(path)
+    assert assembly.units == "m"
+    assert np.allclose(assembly.parts[2].mesh.extents, [40, 40, 5], atol=1e-4)
+    classes = shape_classes(assembly.parts)
+    assert classes[0] == classes[1] == "bearing" and classes[2] == "bottom_plate"
