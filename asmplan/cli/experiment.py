@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import signal
+from collections.abc import Iterator
+from contextlib import contextmanager
 from enum import StrEnum
 from pathlib import Path
 
@@ -45,11 +48,27 @@ class TableChoice(StrEnum):
 DEFAULT_TRIALS = {TableChoice.table3: 1, TableChoice.table4: 10}
 
 
+@contextmanager
+def sigterm_as_interrupt() -> Iterator[None]:
+    """Within the block, SIGTERM interrupts like Ctrl-C (``KeyboardInterrupt``), so that a
+    terminated sweep stops its workers and keeps its finished tasks the same way."""
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGTERM, interrupt)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def _run(experiment: str, output: Path, trials: int, **options) -> None:
     from asmplan.experiments.runner import TasksFailed, run_experiment
 
     try:
-        report = run_experiment(experiment, output, trials=trials, **options)
+        with sigterm_as_interrupt():
+            report = run_experiment(experiment, output, trials=trials, **options)
     except ValueError as exc:
         fail(str(exc).splitlines()[0] if str(exc) else type(exc).__name__)
     except TasksFailed as exc:

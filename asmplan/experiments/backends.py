@@ -10,7 +10,13 @@ Ray is optional (``pip install 'asmplan[cluster]'``) and imported only when used
 
 from __future__ import annotations
 
+import contextlib
+import ctypes
 import os
+import signal
+import sys
+import threading
+import time
 from collections.abc import Iterator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass
@@ -23,10 +29,40 @@ Outcome = TaskResult | BaseException
 THREAD_ENV = ("OMP_NUM_THREADS", "MKL_NUM_THREADS", "OPENBLAS_NUM_THREADS", "NUMBA_NUM_THREADS")
 
 
-def _init_pool_worker() -> None:
+PARENT_POLL_S = 0.5
+"""How often a pool worker checks that the process that started it is still there."""
+_PR_SET_PDEATHSIG = 1
+
+
+def _init_pool_worker(parent: int) -> None:
     # Every core runs a task of its own: keep the numerical libraries to one thread each.
     for name in THREAD_ENV:
         os.environ[name] = "1"
+    die_with_parent(parent)
+
+
+def die_with_parent(parent: int) -> None:
+    """End this process as soon as ``parent`` (the pid that started it) is gone.
+
+    On Linux the kernel kills it when the parent dies (``prctl(PR_SET_PDEATHSIG)``), at
+    once, even in the middle of a task; everywhere a daemon thread also polls the parent
+    pid (a process whose parent died is re-parented) every :data:`PARENT_POLL_S` seconds.
+    Without this, a worker of a killed ``asmplan experiment`` waits forever for its next
+    task: it holds the write end of the task queue itself, so the queue never closes.
+    """
+    if sys.platform.startswith("linux"):
+        # Without prctl (no libc symbol) the thread below suffices.
+        with contextlib.suppress(OSError, AttributeError):
+            ctypes.CDLL(None).prctl(_PR_SET_PDEATHSIG, signal.SIGKILL)
+    if os.getppid() != parent:  # the parent died before the death signal was set
+        os._exit(1)
+
+    def watch() -> None:
+        while os.getppid() == parent:
+            time.sleep(PARENT_POLL_S)
+        os._exit(1)
+
+    threading.Thread(target=watch, name="watch-parent", daemon=True).start()
 
 
 @dataclass(frozen=True)
@@ -49,7 +85,9 @@ class LocalBackend:
     """A pool of ``workers`` processes on this machine (default: one per core).
 
     The pool uses the ``spawn`` start method, so workers never inherit threads (torch,
-    Ray, tqdm) from the parent.
+    Ray, tqdm) from the parent. Workers die with this process (:func:`die_with_parent`);
+    when the sweep is interrupted (Ctrl-C, SIGTERM through the command line, or the
+    caller stops iterating) the running tasks are terminated and the queued ones dropped.
     """
 
     workers: int | None = None
@@ -61,8 +99,12 @@ class LocalBackend:
             return
         workers = min(self.workers or os.cpu_count() or 1, len(specs))
         pool = ProcessPoolExecutor(
-            max_workers=workers, mp_context=get_context("spawn"), initializer=_init_pool_worker
+            max_workers=workers,
+            mp_context=get_context("spawn"),
+            initializer=_init_pool_worker,
+            initargs=(os.getpid(),),
         )
+        finished = False
         try:
             pending: dict[Future, TaskSpec] = {pool.submit(run_task, s): s for s in specs}
             while pending:
@@ -71,8 +113,11 @@ class LocalBackend:
                     spec = pending.pop(future)
                     exc = future.exception()
                     yield spec, (exc if exc is not None else future.result())
+            finished = True
         finally:
-            # On an interrupt, drop the queued tasks instead of finishing them.
+            if not finished:  # interrupted: stop the running tasks too, not only the queue
+                for process in list((pool._processes or {}).values()):  # no public API (3.11)
+                    process.terminate()
             pool.shutdown(wait=True, cancel_futures=True)
 
 
@@ -84,8 +129,9 @@ class RayBackend:
     ----------
     address : str
         ``"auto"`` (a cluster started with ``ray start`` on this machine), ``"host:port"``
-        (a remote cluster; the local ``asp`` and ``arl`` packages are shipped to it with
-        ``runtime_env={"py_modules": ...}`` so every node runs this code), or ``"local"``
+        (a remote cluster; the local ``cad``, ``asp``, ``arl`` and ``asmplan`` packages are
+        shipped to it with ``runtime_env={"py_modules": ...}`` so every node runs this
+        code), or ``"local"``
         (a private Ray instance on this machine, shut down afterwards). When this process
         is already connected to Ray (``ray.is_initialized()``), that connection is used.
     workers : int, optional
@@ -156,10 +202,13 @@ def connect_ray(ray, address: str, workers: int | None = None) -> bool:
 
 
 def _project_modules() -> list[str]:
+    """The project's packages, shipped to a remote cluster so every node runs this code."""
     import arl
+    import asmplan
     import asp
+    import cad
 
-    return [str(Path(m.__file__).parent) for m in (asp, arl)]
+    return [str(Path(m.__file__).parent) for m in (cad, asp, arl, asmplan)]
 
 
 def make_backend(name: str, *, workers: int | None = None, address: str = "auto"):
