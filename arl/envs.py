@@ -230,7 +230,11 @@ class TurnEnv(gym.Env):
     def set_opponent(self, opponent: Opponent) -> None:
         """Freeze a new opponent (takes effect at its next move)."""
         self._opponent = opponent_function(
-            self.tables, 1 - self.player, opponent, self.observer, self.opponent_deterministic
+            self.tables,
+            rules.other(self.player),
+            opponent,
+            self.observer,
+            self.opponent_deterministic,
         )
 
     def _own(self, mover: int, cost: float) -> float:
@@ -241,7 +245,7 @@ class TurnEnv(gym.Env):
         reward = 0.0
         while not self.game.done and self.game.player != self.player:
             edge = self._opponent(self.game.node, self.np_random)
-            reward += self._own(1 - self.player, self.game.play_edge(edge))
+            reward += self._own(rules.other(self.player), self.game.play_edge(edge))
         return reward
 
     # ----------------------------------------------------------------- gym API
@@ -347,7 +351,7 @@ class GameVecEnv(VecEnv):
 
     def set_opponent(self, table: np.ndarray | None, epsilon: float = 0.0) -> None:
         """Freeze the opponent as a probability table (see :func:`probability_table`)."""
-        probs = probability_table(self.tables, 1 - self.player, table, epsilon)
+        probs = probability_table(self.tables, rules.other(self.player), table, epsilon)
         cdf = np.cumsum(probs, axis=1)
         cdf[:, -1] = 2.0  # guard against rounding: the last bucket catches everything
         self._opp_cdf = cdf
@@ -355,7 +359,7 @@ class GameVecEnv(VecEnv):
     # ---------------------------------------------------------------- game core
     def _opponent_turns(self, idx: np.ndarray, rewards: np.ndarray) -> None:
         """Opponent moves (and passes) in envs ``idx`` until the learner is on turn."""
-        t, me, opp = self.tables, self.player, 1 - self.player
+        t, me, opp = self.tables, self.player, rules.other(self.player)
         active = idx[self.node[idx] != t.end]
         while active.size:
             movers = active[t.can_move[opp, self.node[active]]]

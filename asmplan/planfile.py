@@ -34,9 +34,11 @@ from pathlib import Path
 import numba
 import numpy as np
 
+from asp import rules
 from asp.atomic import write_text
-from asp.dag import ANY, HUMAN, ROBOT, GameDAG
+from asp.dag import HUMAN, ROBOT, GameDAG
 from asp.errors import FormatError
+from asp.rules import close_kernel
 from asp.solve import Solution, node_order
 
 FORMAT = "asmplan-plan/2"
@@ -79,34 +81,6 @@ def alternate_states(graph, dag: GameDAG) -> StateDescriber:
 # --------------------------------------------------------------------------- policy table
 
 
-@numba.njit(cache=True)
-def _reach_kernel(indptr, targets, sides, robot_policy, order, start, end):  # pragma: no cover
-    """(n, 2) bool: game states the robust robot reaches against any human."""
-    n = indptr.shape[0] - 1
-    reach = np.zeros((n, 2), np.bool_)
-    reach[start, ROBOT] = True
-    for k in range(n):
-        v = order[k]
-        if v == end:
-            continue
-        for _ in range(2):  # a pass flips the turn at the same node
-            if reach[v, ROBOT]:
-                e = robot_policy[v]
-                if e >= 0:
-                    reach[targets[e], HUMAN] = True
-                else:
-                    reach[v, HUMAN] = True
-            if reach[v, HUMAN]:
-                moved = False
-                for e in range(indptr[v], indptr[v + 1]):
-                    if sides[e] == ANY or sides[e] == HUMAN:
-                        reach[targets[e], ROBOT] = True
-                        moved = True
-                if not moved:
-                    reach[v, ROBOT] = True
-    return reach
-
-
 @dataclass(frozen=True, eq=False)
 class PolicyTable:
     """The reachable game states of the robust policy and their moves (arrays).
@@ -143,7 +117,7 @@ def policy_table(dag: GameDAG, solution: Solution) -> PolicyTable:
     """Every state the robust robot reaches against any human, with its moves."""
     order = node_order(dag)
     policy = np.asarray(solution.robot_policy, dtype=np.int64)
-    reach = _reach_kernel(dag.indptr, dag.targets, dag.sides, policy, order, dag.start, dag.end)
+    reach = rules.reachable_states(dag, policy)
     rank = np.empty(dag.n_nodes, dtype=np.int64)
     rank[order] = np.arange(dag.n_nodes)
     flat = np.flatnonzero(reach.ravel())  # index v * 2 + p
@@ -152,11 +126,13 @@ def policy_table(dag: GameDAG, solution: Solution) -> PolicyTable:
     nodes, turns = nodes[sort], turns[sort]
     index = np.full((dag.n_nodes, 2), -1, dtype=np.int64)
     index[nodes, turns] = np.arange(nodes.size)
+    t = rules.kernel_tables(dag)
     ptr, edge, nxt, instruction = _moves_kernel(
-        dag.indptr,
-        dag.targets,
-        dag.costs,
-        dag.sides,
+        t.indptr,
+        t.targets,
+        t.cost,
+        t.may,
+        t.tol,
         policy,
         nodes,
         turns.astype(np.int64),
@@ -178,7 +154,7 @@ def policy_table(dag: GameDAG, solution: Solution) -> PolicyTable:
 
 @numba.njit(cache=True)
 def _moves_kernel(
-    indptr, targets, costs, sides, policy, nodes, turns, index, value, coop, end
+    indptr, targets, costs, may, tol, policy, nodes, turns, index, value, coop, end
 ):  # pragma: no cover - compiled
     s_count = nodes.shape[0]
     ptr = np.zeros(s_count + 1, np.int64)
@@ -190,7 +166,7 @@ def _moves_kernel(
                 k = 1
             else:
                 for e in range(indptr[v], indptr[v + 1]):
-                    if sides[e] == ANY or sides[e] == HUMAN:
+                    if may[HUMAN, e]:
                         k += 1
                 k = max(k, 1)
         ptr[i + 1] = ptr[i] + k
@@ -209,14 +185,18 @@ def _moves_kernel(
             continue
         best, best_coop = np.inf, np.inf
         for e in range(indptr[v], indptr[v + 1]):
-            if sides[e] == ANY or sides[e] == HUMAN:
+            if may[HUMAN, e]:
                 t = targets[e]
                 edge[j] = e
                 nxt[j] = index[t, ROBOT]
                 val = costs[e] + value[t, ROBOT]
                 cv = costs[e] + coop[t, ROBOT]
-                tol = 1e-9 * (1.0 + abs(val) + abs(best))
-                if val < best - tol or (abs(val - best) <= tol and cv < best_coop - 1e-9):
+                same = close_kernel(val, best, tol)
+                if (
+                    instruction[i] < 0
+                    or (val < best and not same)
+                    or (same and cv < best_coop and not close_kernel(cv, best_coop, tol))
+                ):
                     best, best_coop, instruction[i] = val, cv, j
                 j += 1
         if j == ptr[i]:  # the person has no move: a pass

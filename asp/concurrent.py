@@ -58,6 +58,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from asp.dag import HUMAN, ROBOT, GameDAG, from_arrays
+from asp.numbers import json_number
+from asp.rules import costs_close
 from asp.solve import Solution, evaluate_policy, solve
 from asp.spec import AssemblySpec
 from asp.state_graph import StateGraph
@@ -643,13 +645,8 @@ class Robustness:
 
     def to_list(self) -> list[dict]:
         """``[{"k": 0, "bound": ...}, ..., {"k": None, "bound": W*(inf)}]``."""
-        out = [{"k": k, "bound": _num(b)} for k, b in enumerate(self.bounds)]
-        return [*out, {"k": None, "bound": _num(self.unbounded)}]
-
-
-def _num(x: float):
-    x = float(x)
-    return int(x) if x.is_integer() else round(x, 6)
+        out = [{"k": k, "bound": json_number(b, 6)} for k, b in enumerate(self.bounds)]
+        return [*out, {"k": None, "bound": json_number(self.unbounded, 6)}]
 
 
 def value(game: ConcurrentGame, solution: Solution, budget: int) -> float:
@@ -716,7 +713,7 @@ def robustness(
 
 
 def _same(a: float, b: float) -> bool:
-    return abs(a - b) <= 1e-9 * (1.0 + abs(a) + abs(b))
+    return bool(costs_close(a, b))
 
 
 # --------------------------------------------------------------------------- policies
@@ -828,7 +825,11 @@ def state_description(game: ConcurrentGame, v: int) -> dict:
         "done": model.graph.model.done_ops(key),
         "tools": model.graph.model.tool_state(key),
         "running": [
-            {"agent": model.workers[w].name, "operation": ids[o], "remaining": _num(model.time(r))}
+            {
+                "agent": model.workers[w].name,
+                "operation": ids[o],
+                "remaining": json_number(model.time(r), 6),
+            }
             for w, (o, r) in enumerate(running)
             if o != WAIT
         ],

@@ -90,7 +90,7 @@ def run(args: argparse.Namespace) -> dict:
                     "minimax": res.minimax,
                     "certified_wcpl": res.certified_wcpl,
                     "wcpl": res.wcpl,
-                    "robust_optimal": res.certified_wcpl == res.minimax,
+                    "robust_optimal": res.robust_optimal,
                     "converged": res.converged,
                     "cycles": len(res.cycles),
                     "wall_s": wall,

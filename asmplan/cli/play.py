@@ -15,6 +15,7 @@ import typer
 from asmplan.cli.app import app, choices
 from asmplan.cli.options import SEED_MAX, CostModel
 from asp.dag import SIDE_NAMES
+from asp.rules import cost_at_most, costs_close
 
 HELP_TEXT = """\
 How to play
@@ -73,7 +74,7 @@ def _state_lines(session, fmt) -> list[str]:
         f" | cooperative best remaining {fmt(session.coop_remaining)}{u}"
     )
     out = [f"  state: {state}", line]
-    if abs(session.minimax_remaining - session.worst_remaining) > 1e-9:
+    if not costs_close(session.minimax_remaining, session.worst_remaining):
         out.append(f"  (W* from here: {fmt(session.minimax_remaining)}{u} remaining)")
     return out
 
@@ -106,9 +107,9 @@ def _turn_line(turn, fmt, person: int) -> str:
     if turn.by == "person":
         note = ""
         delta = turn.worst_after - turn.worst_before
-        if person == HUMAN and delta < -1e-9:
+        if person == HUMAN and not cost_at_most(turn.worst_before, turn.worst_after):
             note = f"  (that helps: the worst case drops to {fmt(turn.worst_after)})"
-        elif person == ROBOT and delta > 1e-9:
+        elif person == ROBOT and not cost_at_most(turn.worst_after, turn.worst_before):
             note = f"  (that raises the worst case to {fmt(turn.worst_after)}, +{fmt(delta)})"
         return f"  you ({who}): {what}{note}"
     return f"  {who}: {what}: {turn.reason}"

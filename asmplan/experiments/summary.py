@@ -17,6 +17,8 @@ from asmplan.experiments.paper_values import (
     PAPER_TABLE4_QUOTED,
 )
 from asmplan.experiments.tasks import ResultRow
+from asp.numbers import cost_text
+from asp.rules import cost_at_most, costs_close
 
 TITLES = {"table3": "Table 3 (six configurations)", "table4": "Table 4 (ten 20/10 graphs)"}
 
@@ -41,8 +43,7 @@ class RunInfo:
 def _n(x: float | None) -> str:
     if x is None or (isinstance(x, float) and np.isnan(x)):
         return "–"
-    x = float(x)
-    return str(int(x)) if x.is_integer() else f"{x:.2f}"
+    return cost_text(x, ".2f")
 
 
 def _p(x: float | None) -> str:
@@ -142,7 +143,7 @@ def explanation(rows: Sequence[ResultRow]) -> str:
     """Why certified RR is 100% by construction and why the paper's RR is below it."""
     ours = primary_rows(rows)
     arl = [r for r in ours if r.solver == "arl"]
-    certified_equals_max = all(abs(r.max_random - r.certified_wcpl) < 1e-9 for r in ours)
+    certified_equals_max = all(costs_close(r.max_random, r.certified_wcpl) for r in ours)
     text = [
         "The **certified WCPL** of a robot policy is its cost against an exact best-response "
         "human: the maximum over *all* human strategies. Every game a uniformly random human "
@@ -161,7 +162,7 @@ def explanation(rows: Sequence[ResultRow]) -> str:
         "the extreme case.",
     ]
     if arl:
-        short = [r for r in arl if r.wcpl < r.certified_wcpl - 1e-9]
+        short = [r for r in arl if not cost_at_most(r.certified_wcpl, r.wcpl)]
         optimal = [r for r in arl if r.robust_optimal]
         text += [
             "",

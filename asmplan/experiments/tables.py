@@ -14,6 +14,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict
 
 from asmplan.experiments.tasks import ResultRow
+from asp.numbers import cost_text
 
 Column = tuple[str, Callable[[ResultRow], str]]
 
@@ -21,8 +22,7 @@ Column = tuple[str, Callable[[ResultRow], str]]
 def _num(x: float | None) -> str:
     if x is None:
         return ""
-    x = float(x)
-    return str(int(x)) if x.is_integer() else f"{x:.2f}"
+    return cost_text(x, ".2f")
 
 
 def _pct(x: float) -> str:
