@@ -38,6 +38,7 @@ from asp import rules
 from asp.atomic import write_text
 from asp.dag import HUMAN, ROBOT, GameDAG
 from asp.errors import FormatError
+from asp.numbers import plain
 from asp.rules import close_kernel
 from asp.solve import Solution, node_order
 
@@ -266,7 +267,7 @@ def policy_document(
         "n_states": int(table.node.size),
         "n_moves": int(table.edge.size),
         "states": {
-            "node": [_plain(dag.node_ids[v]) for v in table.node.tolist()],
+            "node": [plain(dag.node_ids[v]) for v in table.node.tolist()],
             "turn": turn_names,
             "done": done_col,
             "tools": tools_col,
@@ -302,10 +303,6 @@ def _numbers(arr: np.ndarray) -> list:
     if np.all(np.isfinite(arr)) and np.all(arr == np.round(arr)):
         return arr.astype(np.int64).tolist()
     return arr.tolist()
-
-
-def _plain(x):
-    return x.item() if hasattr(x, "item") else x
 
 
 # --------------------------------------------------------------------------- lines

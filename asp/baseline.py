@@ -117,7 +117,9 @@ def integer_scale(values) -> int:
     arr = np.asarray(list(values), dtype=np.float64)
     for k in range(MAX_SCALE_DIGITS + 1):
         scaled = arr * 10**k
-        if np.all(np.abs(scaled - np.round(scaled)) <= 1e-9 * np.maximum(1.0, np.abs(scaled))):
+        if np.all(
+            np.abs(scaled - np.round(scaled)) <= rules.COST_TOL * np.maximum(1.0, np.abs(scaled))
+        ):
             return 10**k
     return 10**MAX_SCALE_DIGITS
 

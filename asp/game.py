@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from asp import rules
 from asp.dag import ANY, HUMAN, ROBOT, GameDAG, from_arrays
 from asp.state_graph import StateGraph
 
@@ -51,7 +52,7 @@ def game_dag(
     spec = graph.spec
     model = graph.model
     cost = spec.cost if cost is None else cost
-    if cost not in ("steps", "time"):
+    if cost not in rules.COST_MODELS:
         raise ValueError(f"cost: expected 'steps' or 'time', got {cost!r}")
     alive = graph.coreachable()
     done = graph.complete

@@ -28,6 +28,7 @@ from pathlib import Path
 
 import numpy as np
 
+from asp.numbers import json_number
 from asp.spec import SPEC_FILE, AssemblySpec, load_spec, spec_from_dict
 
 HUMAN_BASE_S = 3.0
@@ -112,7 +113,7 @@ def spec_data(path: str | Path, spec_folder: str | Path | None = None) -> tuple[
                 "id": str(number),
                 "description": f"place {part.id}"
                 + (f" ({part.name})" if part.name != part.id else ""),
-                "agents": {"H": _num(human), "R1": _num(robot)},
+                "agents": {"H": json_number(human), "R1": json_number(robot)},
                 "part": part.id,
             }
         )
@@ -227,10 +228,6 @@ def spec_text(path: str | Path, spec_folder: str | Path | None = None) -> str:
             f"agents: {{{agents}}}, part: {op['part']}}}"
         )
     return "\n".join(lines) + "\n"
-
-
-def _num(x: float) -> int | float:
-    return int(x) if float(x).is_integer() else x
 
 
 def _scalar(value) -> str:

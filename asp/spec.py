@@ -56,13 +56,13 @@ from pathlib import Path
 
 import networkx as nx
 
+from asp.rules import COST_MODELS
 from cad.bom import PartRecord, part_records, refuse_unknown_keys
 from cad.directions import DIRECTIONS
 from cad.units import unit_scale
 from cad.yamlfile import read_yaml
 
 SIDES = ("human", "robot", "any")
-COST_MODELS = ("steps", "time")
 CONSTRAINT_KEYS = ("topological", "stability", "functional")
 SPEC_FILE = "assembly.yaml"
 TOP_KEYS = (
