@@ -22,9 +22,14 @@ import numpy as np
 from asp import rules
 from asp.rules import ANY, HUMAN, PLAYERS, ROBOT, SIDE_NAMES, side_from_name
 
+MAX_COST = 1e12
+"""Largest cost of one move (seconds or steps): sums over any path stay exact enough in
+float64 and within CP-SAT's integers; larger numbers are refused when a DAG is built."""
+
 __all__ = [
     "ANY",
     "HUMAN",
+    "MAX_COST",
     "PLAYERS",
     "ROBOT",
     "SIDE_NAMES",
@@ -135,8 +140,14 @@ class GameDAG:
 
     # ---------------------------------------------------------------- convert
     def to_networkx(self) -> nx.DiGraph:
-        """A networkx DiGraph keyed by original node ids, edges carrying ``cost`` and labels."""
-        g = nx.DiGraph(start=self.node_ids[self.start], end=self.node_ids[self.end])
+        """A networkx DiGraph keyed by original node ids, edges carrying ``cost`` and labels.
+
+        A graph with parallel edges (two moves between the same nodes) gives a
+        ``MultiDiGraph``, so that no move is lost.
+        """
+        pairs = self.sources.astype(np.int64) * self.n_nodes + self.targets
+        kind = nx.MultiDiGraph if np.unique(pairs).size < pairs.size else nx.DiGraph
+        g = kind(start=self.node_ids[self.start], end=self.node_ids[self.end])
         g.graph["cost_model"] = self.cost_model
         for i, nid in enumerate(self.node_ids):
             attrs = {"label": self.node_labels[i]} if self.node_labels is not None else {}
@@ -361,11 +372,14 @@ def validate_dag(dag: GameDAG) -> None:
     if dag.turn_model != "alternate":
         raise ValueError(f"turn_model: expected 'alternate', got {dag.turn_model!r}")
     if dag.n_edges:
-        bad = np.flatnonzero(~np.isfinite(dag.costs) | (dag.costs < 0))
+        bad = np.flatnonzero(~np.isfinite(dag.costs) | (dag.costs < 0) | (dag.costs > MAX_COST))
         if bad.size:
             e = int(bad[0])
             u, v = dag.node_ids[int(dag.sources[e])], dag.node_ids[int(dag.targets[e])]
-            raise ValueError(f"edge ({u!r}, {v!r}) has negative or non-finite cost {dag.costs[e]}")
+            raise ValueError(
+                f"edge ({u!r}, {v!r}) has negative, non-finite or too large cost "
+                f"{dag.costs[e]}: expected 0 to {MAX_COST:g}"
+            )
         if np.any((dag.sides < 0) | (dag.sides > ANY)):
             raise ValueError("sides: expected values 0 (robot), 1 (human) or 2 (any)")
         loops = np.flatnonzero(dag.sources == dag.targets)
@@ -402,13 +416,14 @@ def reachable(dag: GameDAG, source: int | None = None) -> np.ndarray:
 
 
 def from_networkx(g: nx.DiGraph, *, start=None, end=None, cost_model: str | None = None) -> GameDAG:
-    """Build a :class:`GameDAG` from a networkx DiGraph.
+    """Build a :class:`GameDAG` from a networkx DiGraph (or MultiDiGraph).
 
     Start and end come from the arguments, else the graph attributes ``start`` / ``end``,
     else the one node without in-edges / out-edges. Edge attributes used: ``cost``
     (default 1), ``side`` (``robot``/``human``/``any``, default any), ``operation``, ``agent``.
+    Parallel edges of a ``MultiDiGraph`` are distinct moves, as in ``asmplan-dag/1``.
     """
-    if not isinstance(g, nx.DiGraph) or g.is_multigraph():
+    if not isinstance(g, nx.DiGraph):
         raise ValueError(f"expected a networkx DiGraph, got {type(g).__name__}")
     nodes = list(g.nodes)
     start = g.graph.get("start") if start is None else start

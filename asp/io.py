@@ -15,7 +15,10 @@
 
 Edge keys other than ``source`` and ``target`` are optional (cost 1, side ``any``).
 A GraphML file written by plain networkx works: start is the one node without in-edges,
-end the one without out-edges, edge attribute ``cost`` (default 1).
+end the one without out-edges, edge attribute ``cost`` (default 1). Parallel edges (a
+multigraph) are kept, each a move of its own, exactly as two JSON edges between the same
+nodes are: the cooperative TCT takes the cheapest, a maximising human the dearest. A DAG
+with parallel edges is written as a multigraph, so GraphML round-trips every move.
 """
 
 from __future__ import annotations
@@ -28,7 +31,8 @@ from pathlib import Path
 import networkx as nx
 
 from asp.atomic import write_bytes, write_text
-from asp.dag import SIDE_NAMES, GameDAG, from_edges, from_networkx, side_from_name
+from asp.dag import MAX_COST, SIDE_NAMES, GameDAG, from_edges, from_networkx, side_from_name
+from asp.errors import FormatError, GraphError
 from asp.numbers import json_number, plain
 
 FORMAT = "asmplan-dag/1"
@@ -75,15 +79,15 @@ def dag_to_dict(dag: GameDAG) -> dict:
 def dag_from_dict(data: dict, source: str = "<dict>") -> GameDAG:
     """Build a :class:`GameDAG` from an ``asmplan-dag/1`` object; ``source`` names it in errors."""
     if not isinstance(data, dict):
-        raise ValueError(f"{source}: expected a JSON object, got {type(data).__name__}")
+        raise FormatError(f"{source}: expected a JSON object, got {type(data).__name__}")
     fmt = data.get("format", FORMAT)
     if fmt != FORMAT:
-        raise ValueError(f"{source}: expected format {FORMAT!r}, got {fmt!r}")
+        raise FormatError(f"{source}: expected format {FORMAT!r}, got {fmt!r}")
     for key in ("nodes", "edges"):
         if not isinstance(data.get(key), list):
-            raise ValueError(f"{source}: key {key!r} must be a list")
+            raise FormatError(f"{source}: key {key!r} must be a list")
     if data.get("turn_model", "alternate") != "alternate":
-        raise ValueError(f"{source}: turn_model must be 'alternate', got {data['turn_model']!r}")
+        raise GraphError(f"{source}: turn_model must be 'alternate', got {data['turn_model']!r}")
     try:
         ids = [n["id"] if isinstance(n, dict) else n for n in data["nodes"]]
         labels = [n.get("label") if isinstance(n, dict) else None for n in data["nodes"]]
@@ -107,9 +111,11 @@ def dag_from_dict(data: dict, source: str = "<dict>") -> GameDAG:
             metadata=data.get("metadata") or {},
         )
     except (KeyError, TypeError, AttributeError) as exc:
-        raise ValueError(f"{source}: malformed graph ({type(exc).__name__}: {exc})") from None
+        raise FormatError(f"{source}: malformed graph ({type(exc).__name__}: {exc})") from None
+    except OverflowError:
+        raise GraphError(f"{source}: a cost is too large (the limit is {MAX_COST:g})") from None
     except ValueError as exc:
-        raise ValueError(f"{source}: {exc}") from None
+        raise GraphError(f"{source}: {exc}") from None
 
 
 def load_dag(path: str | os.PathLike[str]) -> GameDAG:
@@ -125,20 +131,24 @@ def load_dag(path: str | os.PathLike[str]) -> GameDAG:
         try:
             data = json.loads(path.read_text(encoding="utf-8"))
         except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-            raise ValueError(f"{path}: malformed JSON ({exc})") from None
+            raise FormatError(f"{path}: malformed JSON ({exc})") from None
+        except RecursionError:
+            raise FormatError(f"{path}: malformed JSON (nested too deeply)") from None
         return dag_from_dict(data, source=str(path))
     if suffix in GRAPHML_SUFFIXES:
         try:
             g = nx.read_graphml(path)
         except Exception as exc:  # networkx raises several XML error types
-            raise ValueError(f"{path}: malformed GraphML ({exc})") from None
+            raise FormatError(f"{path}: malformed GraphML ({' '.join(str(exc).split())})") from None
         if not g.is_directed():
-            raise ValueError(f"{path}: expected a directed graph")
+            raise GraphError(f"{path}: expected a directed graph")
         try:
-            return from_networkx(nx.DiGraph(g))
+            return from_networkx(g)
+        except OverflowError:
+            raise GraphError(f"{path}: a cost is too large (the limit is {MAX_COST:g})") from None
         except ValueError as exc:
-            raise ValueError(f"{path}: {exc}") from None
-    raise ValueError(f"{path}: unknown graph format {suffix!r}: expected .json or .graphml")
+            raise GraphError(f"{path}: {exc}") from None
+    raise FormatError(f"{path}: unknown graph format {suffix!r}: expected .json or .graphml")
 
 
 def save_dag(dag: GameDAG, path: str | os.PathLike[str]) -> Path:
@@ -148,9 +158,9 @@ def save_dag(dag: GameDAG, path: str | os.PathLike[str]) -> Path:
     if suffix in JSON_SUFFIXES:
         # Indented for a person to read; compact above that size (8x faster, 30% smaller).
         if dag.n_edges <= READABLE_EDGES:
-            text = json.dumps(dag_to_dict(dag), indent=1)
+            text = json.dumps(dag_to_dict(dag), indent=1, allow_nan=False)
         else:
-            text = json.dumps(dag_to_dict(dag), separators=(",", ":"))
+            text = json.dumps(dag_to_dict(dag), separators=(",", ":"), allow_nan=False)
         return write_text(path, text + "\n")
     if suffix in GRAPHML_SUFFIXES:
         g = dag.to_networkx()
@@ -159,4 +169,4 @@ def save_dag(dag: GameDAG, path: str | os.PathLike[str]) -> Path:
         buffer = io.BytesIO()
         nx.write_graphml(g, buffer)
         return write_bytes(path, buffer.getvalue())
-    raise ValueError(f"{path}: unknown graph format {suffix!r}: expected .json or .graphml")
+    raise FormatError(f"{path}: unknown graph format {suffix!r}: expected .json or .graphml")

@@ -3,7 +3,8 @@
 Every consumer of the game asks this module what a move is: the exact solver and the
 policy evaluator (:mod:`asp.solve`), the metrics (:mod:`asp.metrics`), the play session
 (:mod:`asp.play`), the readable plan (:mod:`asp.plan`), the CP-SAT path
-(:mod:`asp.baseline`), and the learners' game, environments and trainer (:mod:`arl`). The
+(:mod:`asp.baseline`), the learners' game, environments and trainer (:mod:`arl`), and the
+plan file's policy table (``asmplan.planfile``). The
 compiled kernels cannot call Python, so they take the rules as tables built here
 (:func:`kernel_tables`): one change here changes every consumer.
 
@@ -28,8 +29,10 @@ Every ``dag`` argument is an :class:`asp.dag.GameDAG` (not imported: :mod:`asp.d
 this module, and imports flow one way).
 
 Numba caches a compiled kernel per source file and does not notice a change in a function
-it calls from another file: the kernels therefore take the tolerance as an argument, and
-after editing :func:`costs_close` clear the ``__pycache__`` folders (``make clean``).
+it calls from another file: the kernels therefore take the tables and the tolerance as
+arguments (data, never stale); only the formula of :func:`costs_close` is compiled into
+them (``asp/solve.py``, ``asmplan/planfile.py``): after editing it, delete the
+``__pycache__`` folders under ``asp/`` and ``asmplan/`` so that those kernels are rebuilt.
 """
 
 from __future__ import annotations

@@ -106,3 +106,50 @@ def test_large_graph_is_written_compactly_and_round_trips(tmp_path):
     path = save_dag(dag, tmp_path / "big.json")
     assert path.read_text().count("\n") == 1  # one line: compact
     _same(dag, load_dag(path))
+
+
+def test_graphml_parallel_edges_are_moves_not_the_last_one(tmp_path):
+    """Issue 14, item 8: costs 1 and 9 between the same nodes gave TCT 9 (the last kept)."""
+    from asp.solve import solve
+
+    g = nx.MultiDiGraph()
+    g.add_edge("s", "t", cost=1)
+    g.add_edge("s", "t", cost=9)
+    nx.write_graphml(g, tmp_path / "parallel.graphml")
+    dag = load_dag(tmp_path / "parallel.graphml")
+    assert sorted(dag.costs.tolist()) == [1, 9]
+    assert solve(dag).tct == 1
+
+
+def test_parallel_edges_round_trip_through_graphml(tmp_path):
+    dag = from_edges(
+        ["s", "t"],
+        [("s", "t"), ("s", "t")],
+        costs=[2, 5],
+        sides=[0, HUMAN],
+        operations=["1", "1"],
+        agents=["R1", "H"],
+    )
+    back = load_dag(save_dag(dag, tmp_path / "g.graphml"))
+    assert back.n_edges == 2
+    assert sorted(zip(back.agents, back.costs.tolist(), strict=True)) == [("H", 5), ("R1", 2)]
+
+
+@pytest.mark.parametrize(
+    ("content", "message"),
+    [
+        ('{"nodes": [1, 2], "edges": [{"source": 1, "target": 2, "cost": 1e400}]}', "1e\\+12"),
+        ('{"nodes": [1, 2], "edges": [{"source": 1, "target": 2, "cost": NaN}]}', "non-finite"),
+        ('{"nodes": [1, 2], "edges": [{"source": 1, "target": 2, "cost": 1e13}]}', "too large"),
+        ('{"nodes": [1, 2], "edges": [{"source": 1, "target": 2, "cost": 1' + "0" * 400 + "}]}",
+         "too large"),
+        ("[" * 200_000 + "]" * 200_000, "nested too deeply"),
+    ],
+)  # fmt: skip
+def test_numbers_past_the_limit_and_deep_nesting_are_refused(tmp_path, content, message):
+    """Issue 14, items 5 and 6: overflowing costs, NaN and deep JSON name the file."""
+    path = tmp_path / "bad.json"
+    path.write_text(content)
+    with pytest.raises(ValueError, match=message) as info:
+        load_dag(path)
+    assert "bad.json" in str(info.value)

@@ -1,0 +1,128 @@
+"""``asmplan plan --output``: the outputs of one run are one unit (issue 14, item 4)."""
+
+from __future__ import annotations
+
+import json
+import os
+
+import pytest
+from typer.testing import CliRunner
+
+from asmplan import pipeline
+from asmplan.cli import app
+from asp.atomic import MANIFEST, OutputSet, remove_stale_temps, write_text
+from tests.conftest import REPO
+
+PUMP = REPO / "examples" / "vacuum_pump"
+
+
+@pytest.fixture(scope="module")
+def pump_plan():
+    return pipeline.plan(PUMP, time_limit=20)
+
+
+def dead_pid() -> int:
+    """A process id that no process has now."""
+    pid = 2**22 + 12345
+    while True:
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return pid
+        except PermissionError:
+            pass
+        pid += 1
+
+
+def test_a_complete_run_names_its_files_last(pump_plan, tmp_path):
+    written = pipeline.write_plan(pump_plan, tmp_path)
+    assert [p.name for p in written] == ["plan.json", "dag.png"]
+    manifest = json.loads((tmp_path / MANIFEST).read_text())
+    assert manifest == {"format": "asmplan-manifest/1", "files": ["plan.json", "dag.png"]}
+    assert json.loads((tmp_path / "plan.json").read_text()) == json.loads(
+        json.dumps(pump_plan.to_dict())
+    )
+
+
+def test_a_failure_mid_write_leaves_no_mixed_folder(pump_plan, tmp_path, monkeypatch):
+    """A new plan.json never sits beside an old dag.png: the write fails after plan.json."""
+    pipeline.write_plan(pump_plan, tmp_path)
+    (tmp_path / "mine.txt").write_text("the user's own file")
+    old_png = (tmp_path / "dag.png").read_bytes()
+
+    import asmplan.report.plot as plot
+
+    def killed(*args, **kwargs):
+        assert (tmp_path / "plan.json").is_file()  # the new plan.json is written by now
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(plot, "plot_dag", killed)
+    with pytest.raises(OSError, match="No space"):
+        pipeline.write_plan(pump_plan, tmp_path)
+    names = sorted(p.name for p in tmp_path.iterdir())
+    assert names == ["mine.txt"], "no half run, no old run, the user's file kept"
+    assert old_png  # the previous picture existed before the failed run
+
+    monkeypatch.undo()
+    pipeline.write_plan(pump_plan, tmp_path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        ["mine.txt", "plan.json", "dag.png", MANIFEST]
+    )
+
+
+def test_temp_files_of_a_killed_write_are_gone_when_the_next_run_starts(pump_plan, tmp_path):
+    stale = tmp_path / f".plan.json.{dead_pid()}.abc123.tmp"
+    stale.write_text('{"half": ')
+    live = tmp_path / f".plan.json.{os.getpid()}.def456.tmp"  # a writer still running
+    live.write_text("")
+    pipeline.write_plan(pump_plan, tmp_path)
+    assert not stale.exists() and live.exists()
+    assert not [p for p in tmp_path.iterdir() if p.name.endswith(".tmp") and p != live]
+
+
+def test_a_kill_inside_an_atomic_write_leaves_a_temp_file_the_next_run_removes(
+    tmp_path, monkeypatch
+):
+    """The kill is injected: ``os.replace`` never runs, as when the process dies."""
+    import asp.atomic as atomic
+
+    def die(*args):
+        raise SystemExit("killed")
+
+    monkeypatch.setattr(atomic.Path, "unlink", lambda self, missing_ok=False: None)
+    monkeypatch.setattr(atomic.os, "replace", die)
+    with pytest.raises(SystemExit):
+        write_text(tmp_path / "plan.json", "{}")
+    monkeypatch.undo()
+    leftovers = [p for p in tmp_path.iterdir() if p.name.endswith(".tmp")]
+    assert len(leftovers) == 1 and str(os.getpid()) in leftovers[0].name
+    # The dead process's pid is in the name; pretend it has ended.
+    renamed = leftovers[0].with_name(leftovers[0].name.replace(str(os.getpid()), str(dead_pid())))
+    leftovers[0].rename(renamed)
+    assert remove_stale_temps(tmp_path) == [renamed]
+    with OutputSet(tmp_path) as out:
+        out.write_text("plan.json", "{}")
+    assert sorted(p.name for p in tmp_path.iterdir()) == [MANIFEST, "plan.json"]
+
+
+def test_a_folder_written_before_manifests_loses_its_old_picture(pump_plan, tmp_path):
+    (tmp_path / "dag.png").write_bytes(b"old")
+    (tmp_path / "plan.json").write_text("{}")
+    with OutputSet(tmp_path, owns=pipeline.PLAN_FILES) as out:
+        out.write_text("plan.json", "{}")  # a run too large to draw writes no dag.png
+    assert sorted(p.name for p in tmp_path.iterdir()) == [MANIFEST, "plan.json"]
+
+
+def test_bad_input_creates_no_output_folder(tmp_path):
+    target = tmp_path / "out"
+    result = CliRunner().invoke(app, ["plan", str(tmp_path / "missing"), "--output", str(target)])
+    assert result.exit_code == 2
+    assert not target.exists()
+
+
+def test_make_demo_path(tmp_path):
+    """``make demo`` runs exactly this."""
+    result = CliRunner().invoke(app, ["plan", str(PUMP), "--output", str(tmp_path / "pump")])
+    assert result.exit_code == 0, result.output
+    assert f"wrote {tmp_path / 'pump' / 'plan.json'} and" in result.output
+    assert (tmp_path / "pump" / MANIFEST).is_file()
