@@ -19,6 +19,7 @@ from asmplan.cli.options import SEED_MAX, TIME_LIMIT_MAX, CostModel, check_outpu
 
 def plan_summary(result) -> list[str]:
     """The lines ``asmplan plan`` prints for an :class:`~asmplan.pipeline.AssemblyPlan`."""
+    from asp.numbers import cost_unit
     from asp.plan import plan_text, relations_text
 
     spec, graph, dag, solution = result.assembly.spec, result.graph, result.dag, result.solution
@@ -33,7 +34,7 @@ def plan_summary(result) -> list[str]:
         f"state graph: {graph.n_states:,} states, {graph.n_transitions:,} transitions, "
         f"{result.sequences:,} feasible sequences"
     )
-    unit = "" if dag.cost_model == "steps" else " s"
+    unit = cost_unit(dag.cost_model)
     lines += [
         f"game DAG ({dag.cost_model}): {dag.n_nodes} nodes, {dag.n_edges} edges",
         f"TCT (cooperative) {solution.tct:g}{unit}, W* (robust) {solution.minimax:g}{unit}",
