@@ -38,6 +38,7 @@ from asp import rules
 from asp.atomic import write_text
 from asp.dag import HUMAN, ROBOT, GameDAG
 from asp.errors import FormatError
+from asp.metrics import adversarial_tax
 from asp.numbers import plain
 from asp.rules import close_kernel
 from asp.solve import Solution, node_order
@@ -418,7 +419,7 @@ def plan_document(
             "minimax": solution.minimax,
             "w0": w0,
             "worst_line": worst[-1]["elapsed"] if worst else 0.0,
-            "adversarial_tax": solution.minimax / solution.tct if solution.tct > 0 else 1.0,
+            "adversarial_tax": adversarial_tax(solution.tct, solution.minimax),
             "avg_random": float(solution.expected[dag.start, ROBOT]),
             "policy_states": policy["n_states"],
             "policy_moves": policy["n_moves"],

@@ -21,6 +21,7 @@ CP-SAT works on integers: costs and durations are scaled by the smallest power o
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 
@@ -102,14 +103,46 @@ class BaselineResult:
             "kind": self.kind,
             "name": self.name,
             "status": self.status,
-            "objective": json_number(self.objective, 6),
-            "bound": json_number(self.bound, 6),
+            "objective": json_number(_significant(self.objective)),
+            "bound": json_number(_significant(self.bound)),
             "wall_s": round(self.wall_s, 3),
         }
         out.update(self.detail)
         if self.credit:
             out["credit"] = self.credit
         return out
+
+
+def _significant(x, digits: int = 12):
+    """``x`` to ``digits`` significant digits (a tiny cost stays visible, unlike round(x, 6))."""
+    return None if x is None else float(f"{float(x):.{digits}g}")
+
+
+EXACT_HEADROOM = 2**53
+"""Scaled sums stay below this: integers there are exact in float64 and well inside CP-SAT's
+int64."""
+
+
+def exact_scale(values, n_terms: int) -> tuple[int, bool]:
+    """The power of ten making every value an integer, as CP-SAT needs, and whether it is exact.
+
+    The smallest ``10**k`` that makes every value integral (to the relative cost tolerance,
+    :data:`asp.rules.COST_TOL`; a nonzero value never becomes 0) while
+    ``n_terms`` of the largest value, scaled, stay within :data:`EXACT_HEADROOM`; if none
+    does, the largest such scale and ``False``: the values are then rounded to ``1 / scale``.
+    """
+    arr = np.abs(np.asarray(values, dtype=np.float64))
+    top = float(arr.max()) if arr.size else 0.0
+    best = 1
+    for k in range(19):
+        scale = 10**k
+        if k and top * scale * max(n_terms, 1) > EXACT_HEADROOM:
+            break
+        best = scale
+        scaled = arr * scale
+        if np.all(np.abs(scaled - np.round(scaled)) <= rules.COST_TOL * scaled):
+            return scale, True
+    return best, False
 
 
 def integer_scale(values) -> int:
@@ -208,9 +241,18 @@ def min_cost_path(
     """
     from ortools.sat.python import cp_model
 
-    # Data: the arcs (DAG edges, or game-state moves and passes) and integer costs.
+    name = str(dag.metadata.get("assembly", dag.metadata.get("source", "game DAG")))
+    credit = str(dag.metadata.get("credit", ""))
+    if dag.start == dag.end:  # nothing to do: the empty path, cost 0
+        detail = {"arcs": 0, "scale": 1, "path": [plain(dag.node_ids[dag.start])], "edges": []}
+        if dag.operations is not None:
+            detail["operations"] = []
+        return BaselineResult("path", name, "OPTIMAL", 0.0, 0.0, 0.0, detail, credit)
+
+    # Data: the arcs (DAG edges, or game-state moves and passes) and integer costs, scaled
+    # exactly when int64 allows (else rounded, and the result says so).
     tail, head, cost, edge, source, sinks = path_arcs(dag)
-    scale = integer_scale(cost) if cost.size else 1
+    scale, exact = exact_scale(cost, tail.size)
     icost = np.round(cost * scale).astype(np.int64)
 
     # Model.
@@ -244,13 +286,16 @@ def min_cost_path(
     t0 = time.perf_counter()
     status = solver.solve(model)
     wall = time.perf_counter() - t0
-    name, found = _status(solver, status)
+    status_name, found = _status(solver, status)
     detail: dict = {"arcs": int(tail.size), "scale": scale}
+    if not exact:
+        detail["rounded"] = True  # costs rounded to 1/scale: optimality is up to that rounding
     objective = bound = None
     if found:
-        objective = solver.objective_value / scale
-        bound = solver.best_objective_bound / scale
         taken = {int(tail[a]): a for a in range(tail.size) if solver.boolean_value(use[a])}
+        # The objective is the exact cost of the path found (the float costs, summed).
+        objective = math.fsum(float(cost[a]) for a in taken.values())
+        bound = min(solver.best_objective_bound / scale, objective)
         state, nodes, edges = source, [], []
         game_states = len(sinks) == 2
         while state not in sink_set:
@@ -266,13 +311,13 @@ def min_cost_path(
             detail["operations"] = [dag.edge_label(e) for e in edges]
     return BaselineResult(
         kind="path",
-        name=str(dag.metadata.get("assembly", dag.metadata.get("source", "game DAG"))),
-        status=name,
+        name=name,
+        status=status_name,
         objective=objective,
         bound=bound,
         wall_s=wall,
         detail=detail,
-        credit=str(dag.metadata.get("credit", "")),
+        credit=credit,
     )
 
 
@@ -714,31 +759,3 @@ def schedule_violation(model, rows: list[dict]) -> tuple[str, list[tuple[int, in
             state = nxt[0]
             done.add(i)
     return None
-
-
-def assembly_makespan(
-    spec, graph, *, time_limit: float = 60.0, workers: int = 1, seed: int = 0
-) -> tuple[AssemblySchedule, BaselineResult]:
-    """The minimum-makespan schedule of an assembly that respects the state graph.
-
-    Exact by lazy cuts: CP-SAT solves the schedule with the precedences the state graph
-    implies (:func:`assembly_schedule`); each schedule is replayed through the state graph
-    (:func:`schedule_violation`, the concurrent game's rule); a schedule that fails adds
-    its cut and CP-SAT solves again. Cuts only remove infeasible schedules, so the first
-    proven optimum that passes is the optimum of the physically feasible schedules; the
-    status is ``OPTIMAL`` only then, ``FEASIBLE`` for a passing schedule found within the
-    time limit, else ``UNKNOWN`` with no schedule. ``detail`` holds ``cuts`` and ``replay``.
-    """
-    from asp.concurrent import concurrent_model
-
-    sched = assembly_schedule(spec, graph)
-    model = concurrent_model(spec, graph, step=None)
-
-    def replay(rows):
-        found = schedule_violation(model, rows)
-        return None if found is None else found[1]
-
-    result = min_makespan(
-        sched.problem, time_limit=time_limit, workers=workers, seed=seed, replay=replay
-    )
-    return sched, result

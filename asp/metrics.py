@@ -269,7 +269,7 @@ class PlanMetrics:
     rr_sampled: float
     games: int
     seed: int
-    adversarial_tax: float
+    adversarial_tax: float | None
     exact_distribution: bool
 
     def to_dict(self) -> dict:
@@ -333,6 +333,18 @@ def plan_metrics(
         rr_sampled=resilience_ratio(sampled, reference),
         games=int(n_games),
         seed=int(seed),
-        adversarial_tax=(solution.minimax / solution.tct) if solution.tct > 0 else 1.0,
+        adversarial_tax=adversarial_tax(solution.tct, solution.minimax),
         exact_distribution=exact,
     )
+
+
+def adversarial_tax(tct: float, minimax: float) -> float | None:
+    """``W* / TCT``: how much an adversarial human can cost over full cooperation.
+
+    1.0 when both are 0 (nothing to do, nothing to lose); undefined (``None``, ``null`` in
+    JSON) when TCT is 0 but W* is not: no finite ratio says "free when cooperating, costly
+    against an adversary".
+    """
+    if tct > rules.COST_TOL:
+        return minimax / tct
+    return 1.0 if minimax <= rules.COST_TOL else None

@@ -10,8 +10,10 @@ code 2, whatever raised it:
 - a bad command line (unknown option, value out of range, missing argument): Typer's
   multi-line error box becomes the same one line.
 
-The policy lives in :class:`AsmplanGroup`, the click group behind ``app``, so ``main()``,
-``python -m asmplan`` and ``typer.testing.CliRunner().invoke(app, ...)`` behave alike.
+A library warning (a non-watertight part, a generated spec) is one line
+``asmplan: warning: <message>``. The policy lives in :class:`AsmplanGroup`, the click group
+behind ``app``, so ``main()``, ``python -m asmplan`` and
+``typer.testing.CliRunner().invoke(app, ...)`` behave alike.
 Outputs go through :mod:`asp.atomic`, so a failed command never leaves a half-written file.
 """
 
@@ -19,6 +21,7 @@ from __future__ import annotations
 
 import importlib
 import sys
+import warnings
 from enum import StrEnum
 
 import typer
@@ -58,6 +61,11 @@ class AsmplanGroup(TyperGroup):
     """The command group: runs a command and applies the one-line error policy."""
 
     def main(self, args=None, prog_name=None, complete_var=None, standalone_mode=True, **extra):
+        with warnings.catch_warnings():
+            warnings.showwarning = _show_warning
+            return self._run(args, prog_name, complete_var, standalone_mode, **extra)
+
+    def _run(self, args, prog_name, complete_var, standalone_mode, **extra):
         try:
             code = super().main(
                 args=args,
@@ -82,6 +90,12 @@ class AsmplanGroup(TyperGroup):
         if not standalone_mode:
             return code
         sys.exit(code if isinstance(code, int) else 0)
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """A library warning as one line: ``asmplan: warning: <message>``."""
+    text = " ".join(str(message).split())
+    print(f"asmplan: warning: {text}", file=sys.stderr if file is None else file, flush=True)
 
 
 def _report(message: str) -> int:

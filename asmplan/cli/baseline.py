@@ -69,6 +69,11 @@ def baseline_command(
     if "lower_bound" in data:
         typer.echo(f"  state-graph lower bound  {data['lower_bound']:g}")
     typer.echo(f"  wall       {data['wall_s']} s")
+    if data.get("rounded"):
+        typer.echo(
+            f"  note       costs rounded to 1/{data['scale']} for CP-SAT (int64); the objective "
+            "is the exact cost of the path found"
+        )
     if result.kind == "path" and "operations" in data:
         typer.echo("  path: " + " -> ".join(data["operations"]))
     if result.kind == "schedule" and "schedule" in data and len(data["schedule"]) <= 60:

@@ -58,7 +58,10 @@ NEW_COLUMNS: tuple[Column, ...] = (
     ("Max Random (1000 games)", lambda r: _num(r.max_random_sampled)),
     ("Avg Random (1000 games)", lambda r: _num(r.avg_random_sampled)),
     ("RR (1000 games)", lambda r: _pct(r.rr_sampled)),
-    ("Adversarial tax W*/TCT", lambda r: f"{r.adversarial_tax:.2f}"),
+    (
+        "Adversarial tax W*/TCT",
+        lambda r: "-" if r.adversarial_tax is None else f"{r.adversarial_tax:.2f}",
+    ),
     ("Converged", lambda r: _yes(r.converged)),
     ("Time (s)", lambda r: f"{r.train_s:.2f}"),
 )

@@ -28,10 +28,14 @@ def metrics_text(m: PlanMetrics, title: str = "") -> str:
             f"avg {m.avg_random_sampled:.3f}, max {_num(m.max_random_sampled)}, "
             f"RR {100 * m.rr_sampled:.1f}%",
         ),
-        ("adversarial tax (W*/TCT)", f"{m.adversarial_tax:.2f}"),
+        ("adversarial tax (W*/TCT)", _tax(m.adversarial_tax)),
     ]
     width = max(len(k) for k, _ in rows)
     lines = [title] if title else []
     lines += [f"{k.ljust(width)}  {v}" for k, v in rows]
     lines.append("robust path (both play minimax): " + " -> ".join(str(x) for x in m.robust_path))
     return "\n".join(lines)
+
+
+def _tax(tax: float | None) -> str:
+    return "undefined (TCT 0, W* > 0)" if tax is None else f"{tax:.2f}"

@@ -107,3 +107,20 @@ def test_os_errors_name_the_path(capsys, tmp_path):
 def test_help_still_works(capsys):
     code, out = run_out(capsys, "solve", "--help")
     assert code == 0 and "--games" in out
+
+
+def test_library_warnings_are_one_line(capsys, graph, monkeypatch):
+    import warnings
+
+    import asp.io
+
+    real = asp.io.load_dag
+
+    def load_with_a_warning(path):
+        warnings.warn("part X is not watertight:\nvolume may be wrong", stacklevel=2)
+        return real(path)
+
+    monkeypatch.setattr(asp.io, "load_dag", load_with_a_warning)
+    code, err = run(capsys, "solve", graph, "--games", "10")
+    assert code == 0
+    assert err == "asmplan: warning: part X is not watertight: volume may be wrong\n"

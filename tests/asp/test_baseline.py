@@ -178,3 +178,27 @@ def test_in2_tasks_open_to_either_side_use_both_sides_in_parallel(tmp_path, time
     assert result.status == "OPTIMAL" and result.objective == makespan
     assert sched.lower_bound <= makespan
     assert sched.load_bound == pytest.approx(sum(times) / 2)
+
+
+def test_one_node_graph_is_the_empty_path():
+    """Issue 14, item 9: a one-node graph was INFEASIBLE although TCT is 0."""
+    dag = from_edges(["only"], [], start="only", end="only")
+    result = min_cost_path(dag)
+    assert (result.status, result.objective) == ("OPTIMAL", 0)
+    assert result.to_dict()["path"] == ["only"] and solve(dag).tct == 0
+
+
+@pytest.mark.parametrize(
+    ("costs", "rounded"),
+    [((2e-7, 2e-7, 2e-7), False), ((8e-7,), False), ((1 / 3, 1 / 7), False), ((1e9, 1e-9), True)],
+)
+def test_tiny_and_unscalable_costs(costs, rounded):
+    """Issue 14, item 9: a path of cost 6e-7 reported objective 0 (costs scaled by 10**6)."""
+    n = len(costs) + 1
+    dag = from_arrays(list(range(n)), np.arange(n - 1), np.arange(1, n), costs=list(costs))
+    result = min_cost_path(dag)
+    assert result.objective == pytest.approx(solve(dag).tct, rel=1e-12)
+    assert result.to_dict()["objective"] == pytest.approx(sum(costs), rel=1e-9)
+    assert result.detail.get("rounded", False) is rounded
+    if not rounded:
+        assert result.bound == pytest.approx(result.objective, rel=1e-9)

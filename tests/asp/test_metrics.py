@@ -123,3 +123,23 @@ def test_fractional_110_node_graph_is_exact_and_bounded():
     assert m.max_random == m.certified_wcpl and m.min_random <= m.avg_random <= m.max_random
     lower = plan_metrics(dag, solution=sol, wcpl=(m.avg_random + m.max_random) / 2)
     assert 0.0 < lower.rr < 1.0 or not lower.exact_distribution
+
+
+def test_adversarial_tax_is_undefined_when_cooperation_costs_nothing():
+    """Issue 14, item 9: the tax was 1.0 when TCT = 0 and W* > 0."""
+    import json
+
+    from asp.dag import HUMAN, ROBOT, from_edges
+    from asp.metrics import adversarial_tax
+
+    dag = from_edges(
+        ["s", "m", "x", "t"],
+        [("s", "m"), ("m", "t"), ("m", "x"), ("x", "t")],
+        costs=[0, 0, 5, 0],
+        sides=[ROBOT, HUMAN, HUMAN, ROBOT],
+    )
+    m = plan_metrics(dag, n_games=10)
+    assert (m.tct, m.minimax) == (0, 5)
+    assert m.adversarial_tax is None
+    assert json.loads(json.dumps(m.to_dict(), allow_nan=False))["adversarial_tax"] is None
+    assert adversarial_tax(0, 0) == 1.0 and adversarial_tax(2, 3) == 1.5
