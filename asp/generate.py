@@ -8,7 +8,9 @@ rule, fixed so that a generated spec plans the same as the file it writes:
 - parts: one per mesh node of the file (ids and names from the file, :mod:`cad.scene`),
   or per mesh file of the folder (a ``bom.csv``/``bom.yaml`` in the folder still names
   them); ``shape`` is the shape class (identical parts share it, :mod:`cad.identical`);
-- the base part: the largest part (by bounding-box volume), placed first;
+- the base part, placed first: the part standing lowest (its bottom within 2% of the
+  assembly's height of the lowest), of those the one with the largest footprint (its
+  bounding box's area across gravity, ``-z``);
 - agents: one human ``H`` and one robot ``R1``;
 - one placement operation per part, ids ``"1"``, ``"2"``, ... in the order base first,
   then the others from the lowest to the highest (against gravity), open to both agents;
@@ -41,6 +43,15 @@ def placement_durations(diagonal_mm: float) -> tuple[float, float]:
     """``(human, robot)`` seconds to place a part of bounding-box diagonal ``diagonal_mm``."""
     human = min(MAX_DURATION_S, float(round(HUMAN_BASE_S + HUMAN_S_PER_MM * diagonal_mm)))
     return human, float(round(ROBOT_FACTOR * human))
+
+
+def base_index(bounds: np.ndarray) -> int:
+    """The part that stands lowest, the largest footprint first; ``bounds`` shape (n, 2, 3)."""
+    bottom = bounds[:, 0, 2]
+    height = float(bounds[:, 1, 2].max() - bottom.min())
+    low = np.flatnonzero(bottom <= bottom.min() + 0.02 * height)
+    footprint = np.prod(bounds[low, 1, :2] - bounds[low, 0, :2], axis=1)
+    return int(low[np.argmax(footprint)])
 
 
 def spec_geometry(spec: AssemblySpec):
@@ -99,7 +110,7 @@ def spec_data(path: str | Path, spec_folder: str | Path | None = None) -> tuple[
         parts.append(record)
     bounds = np.array([p.bounds for p in assembly.parts])  # (n, 2, 3) in mm
     extents = bounds[:, 1] - bounds[:, 0]
-    base = int(np.argmax(np.prod(np.maximum(extents, 1e-9), axis=1)))
+    base = base_index(bounds)
     order = [base] + sorted(
         (k for k in range(len(assembly.parts)) if k != base),
         key=lambda k: (bounds[k, 0, 2], bounds[k, 1, 2], k),
@@ -212,7 +223,7 @@ def spec_text(path: str | Path, spec_folder: str | Path | None = None) -> str:
         "  H: {side: human, description: operator}",
         "  R1: {side: robot, description: robot arm with a gripper}",
         "",
-        f"base_part: {data['base_part']}      # the largest part, placed first",
+        f"base_part: {data['base_part']}      # placed first: the lowest part, largest footprint",
         "gravity: -z                # direction of gravity in the file's frame",
         "gripper_approach: [+x, -x, +y, -y, +z, -z]   # directions a part may be inserted from",
         "constraints: {topological: true, stability: true, functional: true}",

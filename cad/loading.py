@@ -20,6 +20,7 @@ load.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -28,10 +29,13 @@ import trimesh
 from cad.assembly import Assembly, prepare_part
 from cad.bom import PartRecord, read_bom
 from cad.scene import SCENE_SUFFIXES, read_scene
+from cad.unit_hints import part_scale_hint
 from cad.units import unit_scale
 
 MESH_SUFFIXES = (".stl", ".obj", ".ply", ".off", *SCENE_SUFFIXES)
 BOM_NAMES = ("bom.csv", "bom.yaml", "bom.yml")
+METRES_ONLY = ((1000.0, "metres"),)
+"""Size ratios warned about on load (small parts are often 10-60 times smaller)."""
 
 
 def load_assembly(
@@ -137,7 +141,12 @@ def load_parts(
     _check_unique([p.id for p in parts], base)
     distinct = sorted(set(used))
     combined = distinct[0] if len(distinct) == 1 else ("mixed" if distinct else units or "mm")
-    return Assembly(parts=tuple(parts), units=combined, source=str(base))
+    assembly = Assembly(parts=tuple(parts), units=combined, source=str(base))
+    for k in range(len(parts) if len(parts) > 2 else 0):
+        hint = part_scale_hint(assembly, k, factors=METRES_ONLY)
+        if hint:
+            warnings.warn(hint, stacklevel=2)
+    return assembly
 
 
 def _record_mesh(row: PartRecord, base: Path, units: str | None):

@@ -73,3 +73,14 @@ def test_init_writes_a_spec_that_plans_the_same(tmp_path):
         assert from_file[key] == from_spec[key], key
     again = CliRunner().invoke(app, ["init", str(STEP), "-o", str(spec)])
     assert again.exit_code == 2 and "--force" in again.stderr
+
+
+def test_relations_why_prints_blockers_and_depth(tmp_path):
+    pytest.importorskip("cascadio")
+    result = CliRunner().invoke(app, ["relations", str(STEP), "--why", "pillar_1"])
+    assert result.exit_code == 0, result.output
+    assert "+z  blocked by cap_1, top_plate (depth 2)" in result.stdout
+    assert "-z  blocked by base_plate (depth 1)" in result.stdout
+    assert "+x  free (depth 0)" in result.stdout
+    bad = CliRunner().invoke(app, ["relations", str(STEP), "--why", "pilar_1"])
+    assert bad.exit_code == 2 and "did you mean pillar_1" in bad.stderr
