@@ -36,6 +36,7 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # pragma: no cover - types only
     from asp.baseline import BaselineResult
+    from asp.concurrent_plan import ConcurrentPlan
     from asp.dag import GameDAG
     from asp.plan import PlanStep
     from asp.solve import Solution
@@ -48,6 +49,9 @@ GRAPH_SUFFIXES = (".json", ".graphml", ".xml")
 """Suffixes read as a game DAG file rather than an assembly."""
 PLAN_FILES = ("plan.json", "dag.png")
 """The files ``asmplan plan`` writes (besides ``manifest.json``)."""
+CONCURRENT_FILES = ("robustness.png", "gantt_cooperative.png", "gantt_worst.png")
+"""The figures ``asmplan plan --turn-model concurrent`` adds (:mod:`asp.concurrent_plan`)."""
+TURN_MODELS = ("alternate", "concurrent")
 
 Progress = Callable[[str], None]
 """A callback that shows one line of progress (e.g. prints it on stderr)."""
@@ -139,6 +143,9 @@ class AssemblyPlan:
         Per part: contacts (with directions) and free directions.
     schedule : Schedule
         CP-SAT minimum makespan with the agents in parallel.
+    concurrent : asp.concurrent_plan.ConcurrentPlan or None
+        With the turn model ``concurrent``: the curve ``W*(k)``, the CP-SAT schedule's
+        certified worst case, the timelines.
     """
 
     assembly: Assembly
@@ -149,6 +156,7 @@ class AssemblyPlan:
     steps: tuple[PlanStep, ...]
     relations_summary: list[dict]
     schedule: Schedule
+    concurrent: ConcurrentPlan | None = None
 
     @property
     def dag(self) -> GameDAG:
@@ -158,7 +166,7 @@ class AssemblyPlan:
         """The ``asmplan-plan/2`` object written as ``plan.json`` (:mod:`asmplan.planfile`)."""
         from asmplan.planfile import alternate_states, plan_document
 
-        return plan_document(
+        doc = plan_document(
             spec=self.assembly.spec,
             dag=self.game.dag,
             solution=self.solution,
@@ -171,6 +179,14 @@ class AssemblyPlan:
                 "schedule": self.schedule.to_dict(),
             },
         )
+        if self.concurrent is not None:
+            from asp.concurrent_plan import plan_entries
+
+            doc.update(plan_entries(self.concurrent))
+            doc["schedule"].update(
+                chain_bound=self.schedule.chain_bound, load_bound=self.schedule.load_bound
+            )
+        return doc
 
 
 # --------------------------------------------------------------------------- steps
@@ -400,7 +416,11 @@ def schedule(
     workers: int = 1,
     seed: int = 0,
 ) -> Schedule:
-    """CP-SAT minimum makespan with the agents working in parallel.
+    """CP-SAT minimum makespan with the agents working in parallel, physically feasible.
+
+    Every schedule is replayed through the state graph and cut until one passes
+    (:func:`asp.concurrent.assembly_makespan`); the status is ``OPTIMAL`` only for a
+    proven optimum that passed.
 
     Parameters
     ----------
@@ -418,10 +438,11 @@ def schedule(
     -------
     Schedule
     """
-    from asp.baseline import assembly_schedule, min_makespan
+    from asp.concurrent import assembly_makespan
 
-    sched = assembly_schedule(assembly.spec, graph)
-    result = min_makespan(sched.problem, time_limit=time_limit, workers=workers, seed=seed)
+    sched, result = assembly_makespan(
+        assembly.spec, graph, time_limit=time_limit, workers=workers, seed=seed
+    )
     return Schedule(result, sched.lower_bound, sched.chain_bound, sched.load_bound)
 
 
@@ -431,6 +452,9 @@ def plan(
     cost: str | None = None,
     time_limit: float = 30.0,
     seed: int = 0,
+    turn_model: str | None = None,
+    max_k: int | None = None,
+    duration_step: float | None = 1.0,
     on_step: Progress | None = None,
     max_states: int | None = None,
 ) -> AssemblyPlan:
@@ -446,6 +470,14 @@ def plan(
         CP-SAT time limit, seconds.
     seed : int
         CP-SAT random seed.
+    turn_model : {"alternate", "concurrent"}, optional
+        Default: the spec's. ``concurrent`` adds the concurrent game
+        (:func:`asp.concurrent_plan.plan_concurrent`).
+    max_k : int, optional
+        Largest deviation budget of the concurrent curve (default
+        :data:`asp.concurrent.DEFAULT_MAX_K`).
+    duration_step : float or None
+        Grid of a person's duration range in the concurrent game (None: its end points).
     on_step : callable, optional
         Called with one line before each step (progress for a person).
     max_states : int, optional
@@ -471,7 +503,27 @@ def plan(
     steps = robust_plan(the_game, solution)
     say("[4/5] CP-SAT minimum-makespan schedule ...")
     sched = schedule(assembly, graph, time_limit=time_limit, seed=seed)
-    return AssemblyPlan(assembly, graph, sequences, the_game, solution, steps, summary, sched)
+    turn = assembly.spec.turn_model if turn_model is None else turn_model
+    concurrent = None
+    if turn not in TURN_MODELS:
+        from asp.errors import GraphError
+
+        raise GraphError(f"--turn-model: expected alternate or concurrent, got {turn!r}")
+    if turn == "concurrent":
+        from asp.concurrent import DEFAULT_MAX_K
+        from asp.concurrent_plan import plan_concurrent
+
+        say("[4/5] solving the concurrent game, W*(k) until flat ...")
+        concurrent = plan_concurrent(
+            assembly.spec,
+            graph,
+            max_k=DEFAULT_MAX_K if max_k is None else max_k,
+            step=duration_step,
+            schedule=(sched.result, sched.lower_bound),
+        )
+    return AssemblyPlan(
+        assembly, graph, sequences, the_game, solution, steps, summary, sched, concurrent
+    )
 
 
 def write_plan(
@@ -493,7 +545,7 @@ def write_plan(
     from asp.solve import play
 
     dag, solution = result.game.dag, result.solution
-    with OutputSet(output, owns=PLAN_FILES) as out:
+    with OutputSet(output, owns=PLAN_FILES + CONCURRENT_FILES) as out:
         doc = result.to_dict()
         out.write_text("plan.json", json.dumps(doc, separators=(",", ":"), allow_nan=False) + "\n")
         path, _ = play(dag, solution.robot_policy, solution.human_policy)
@@ -504,6 +556,10 @@ def write_plan(
             title=f"{result.assembly.spec.name}: game DAG ({dag.cost_model}), robust plan "
             f"in red, TCT {solution.tct:g}, W* {solution.minimax:g}",
         )
+        if result.concurrent is not None:
+            from asp.concurrent_plan import write_figures
+
+            write_figures(result.concurrent, out.path)
     return out.written
 
 

@@ -759,31 +759,3 @@ def schedule_violation(model, rows: list[dict]) -> tuple[str, list[tuple[int, in
             state = nxt[0]
             done.add(i)
     return None
-
-
-def assembly_makespan(
-    spec, graph, *, time_limit: float = 60.0, workers: int = 1, seed: int = 0
-) -> tuple[AssemblySchedule, BaselineResult]:
-    """The minimum-makespan schedule of an assembly that respects the state graph.
-
-    Exact by lazy cuts: CP-SAT solves the schedule with the precedences the state graph
-    implies (:func:`assembly_schedule`); each schedule is replayed through the state graph
-    (:func:`schedule_violation`, the concurrent game's rule); a schedule that fails adds
-    its cut and CP-SAT solves again. Cuts only remove infeasible schedules, so the first
-    proven optimum that passes is the optimum of the physically feasible schedules; the
-    status is ``OPTIMAL`` only then, ``FEASIBLE`` for a passing schedule found within the
-    time limit, else ``UNKNOWN`` with no schedule. ``detail`` holds ``cuts`` and ``replay``.
-    """
-    from asp.concurrent import concurrent_model
-
-    sched = assembly_schedule(spec, graph)
-    model = concurrent_model(spec, graph, step=None)
-
-    def replay(rows):
-        found = schedule_violation(model, rows)
-        return None if found is None else found[1]
-
-    result = min_makespan(
-        sched.problem, time_limit=time_limit, workers=workers, seed=seed, replay=replay
-    )
-    return sched, result

@@ -44,7 +44,7 @@ Exactness of W*(0): with budget 0 and fixed durations the robot side controls ev
 the best makespan over event-driven schedules (each operation starts at time 0 or at a
 completion) is the optimum over all schedules (a left shift of any feasible schedule is
 event-driven), so ``W*(0)`` equals the CP-SAT optimum on the same rules
-(:func:`asp.baseline.min_makespan_replayed`).
+(:func:`assembly_makespan`).
 """
 
 from __future__ import annotations
@@ -57,7 +57,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from asp.baseline import (
+    AssemblySchedule,
+    BaselineResult,
+    assembly_schedule,
+    integer_scale,
+    min_makespan,
+    schedule_violation,
+)
 from asp.dag import HUMAN, ROBOT, GameDAG, from_arrays
+from asp.errors import GameError, SpecError
 from asp.numbers import json_number
 from asp.rules import costs_close
 from asp.solve import Solution, evaluate_policy, solve
@@ -206,11 +215,9 @@ def concurrent_model(
         One line naming the spec and the fault: a robot with a duration range, an agent
         with no operation it may do, an operation nobody may do, a bad duration or step.
     """
-    from asp.baseline import integer_scale
-
     where = spec.source or spec.name
     if step is not None and not (math.isfinite(step) and step > 0):
-        raise ValueError(f"{where}: duration step: expected a positive number, got {step}")
+        raise SpecError(f"{where}: duration step: expected a positive number, got {step}")
     workers = []
     for side in (ROBOT, HUMAN):
         for a in spec.agents:
@@ -223,24 +230,24 @@ def concurrent_model(
     ranges = [[None] * len(ops) for _ in workers]
     for i, op in enumerate(ops):
         if not op.durations:
-            raise ValueError(f"{where}: operations[{op.id}]: no agent may do this operation")
+            raise SpecError(f"{where}: operations[{op.id}]: no agent may do this operation")
         for w, x in enumerate(workers):
             if x.agent in op.agents:
                 lo, hi = duration_range(op, x.agent)
                 if not (math.isfinite(lo) and math.isfinite(hi)) or lo < 0 or lo > hi:
-                    raise ValueError(
+                    raise SpecError(
                         f"{where}: operations[{op.id}].agents.{x.agent}: expected a duration "
                         f">= 0 or a range [min, max] with 0 <= min <= max, got [{lo}, {hi}]"
                     )
                 if lo != hi and x.side == ROBOT:
-                    raise ValueError(
+                    raise SpecError(
                         f"{where}: operations[{op.id}].agents.{x.agent}: a duration range is "
                         "for a human; a robot's duration is one number"
                     )
                 ranges[w][i] = (lo, hi)
     for a in spec.agents:
         if not any(a.name in op.agents for op in ops):
-            raise ValueError(f"{where}: agents.{a.name}: this agent may do no operation")
+            raise SpecError(f"{where}: agents.{a.name}: this agent may do no operation")
     numbers = [v for row in ranges for r in row if r is not None for v in r]
     numbers += [t.change_time for t in spec.tools] + ([step] if step is not None else [])
     scale = integer_scale(numbers)
@@ -389,7 +396,7 @@ def build_game(
     else:
         k = int(budgets)
         if k < 0:
-            raise ValueError(f"k: expected a deviation budget >= 0, got {k}")
+            raise GameError(f"k: expected a deviation budget >= 0, got {k}")
         levels = list(range(k + 1))
     nw = len(model.workers)
     idle = tuple((WAIT, 0) for _ in range(nw))
@@ -403,7 +410,7 @@ def build_game(
         if v is None:
             v = len(nodes)
             if v >= max_nodes:
-                raise ValueError(
+                raise GameError(
                     f"{where}: the concurrent game exceeds {max_nodes:,} nodes (budgets "
                     f"{levels[0]}..{levels[-1]}); bound the deviation budget with --max-k, "
                     "coarsen the human duration grid (--duration-step), or add precedences"
@@ -617,12 +624,14 @@ class Robustness:
     Attributes
     ----------
     bounds : tuple of float
-        ``W*(0), W*(1), ..., W*(K)``: up to the first ``k`` with ``W*(k) == W*(inf)``, or
-        ``max_k``.
+        ``W*(0), W*(1), ..., W*(K)``: at least up to ``k = 2`` and up to a ``k`` with
+        ``W*(k) == W*(inf)`` (budgets double until then), or ``max_k``.
     unbounded : float
         ``W*(inf)``, the fully adversarial bound.
     game, solution : ConcurrentGame, Solution
-        The game with budgets ``0..K`` and its exact solution (the robust policy).
+        The game with budgets ``0..K`` and its exact solution: the robust plan is its policy
+        from the start of budget ``K`` (it guarantees ``W*(K)`` against any person who
+        deviates at most ``K`` times; ``W*(K) == W*(inf)`` when ``flat``).
     adversary, adversary_solution : ConcurrentGame, Solution
         The unbounded game and its solution.
     flat : bool
@@ -667,7 +676,7 @@ def robustness(
     covers every human decision; ``max_k`` bounds the search (then ``flat`` is False).
     """
     if max_k < 0:
-        raise ValueError(f"max_k: expected a deviation budget >= 0, got {max_k}")
+        raise GameError(f"max_k: expected a deviation budget >= 0, got {max_k}")
     t0 = time.perf_counter()
     adversary = build_game(model, None, max_nodes=max_nodes, progress=progress)
     adv_sol = solve(adversary.dag)
@@ -689,17 +698,10 @@ def robustness(
                 f"{game.dag.n_edges:,} edges ({game.seconds:.2f} s)",
                 file=sys.stderr,
             )
-        hit = [b for b in range(k + 1) if _same(bounds[b], top)]
-        if hit or k >= max_k:
+        flat = _same(bounds[-1], top)
+        if flat or k >= max_k:
             break
         k = min(2 * k, max_k)
-    flat = bool(hit)
-    if hit and hit[0] < k:
-        # The robust plan is the game with the smallest flat budget.
-        k = hit[0]
-        game = build_game(model, k, max_nodes=max_nodes)
-        sol = solve(game.dag)
-        bounds = bounds[: k + 1]
     return Robustness(
         bounds=tuple(bounds),
         unbounded=top,
@@ -930,3 +932,33 @@ def timeline(game: ConcurrentGame, robot_policy: np.ndarray, human: str = "worst
         v = int(dag.targets[e])
     bars.sort(key=lambda x: (x.start, x.agent))
     return bars, model.time(t)
+
+
+# --------------------------------------------------------------------------- CP-SAT
+
+
+def assembly_makespan(
+    spec, graph, *, time_limit: float = 60.0, workers: int = 1, seed: int = 0
+) -> tuple[AssemblySchedule, BaselineResult]:
+    """The minimum-makespan schedule of an assembly that respects the state graph.
+
+    Exact by lazy cuts: CP-SAT solves the schedule with the precedences the state graph
+    implies (:func:`asp.baseline.assembly_schedule`); each schedule is replayed through the
+    state graph (:func:`asp.baseline.schedule_violation`, the concurrent game's rule); a
+    schedule that fails adds its cut and CP-SAT solves again. Cuts only remove infeasible
+    schedules, so the first
+    proven optimum that passes is the optimum of the physically feasible schedules; the
+    status is ``OPTIMAL`` only then, ``FEASIBLE`` for a passing schedule found within the
+    time limit, else ``UNKNOWN`` with no schedule. ``detail`` holds ``cuts`` and ``replay``.
+    """
+    sched = assembly_schedule(spec, graph)
+    model = concurrent_model(spec, graph, step=None)
+
+    def replay(rows):
+        found = schedule_violation(model, rows)
+        return None if found is None else found[1]
+
+    result = min_makespan(
+        sched.problem, time_limit=time_limit, workers=workers, seed=seed, replay=replay
+    )
+    return sched, result

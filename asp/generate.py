@@ -8,7 +8,9 @@ rule, fixed so that a generated spec plans the same as the file it writes:
 - parts: one per mesh node of the file (ids and names from the file, :mod:`cad.scene`),
   or per mesh file of the folder (a ``bom.csv``/``bom.yaml`` in the folder still names
   them); ``shape`` is the shape class (identical parts share it, :mod:`cad.identical`);
-- the base part: the largest part (by bounding-box volume), placed first;
+- the base part, placed first: the part standing lowest (its bottom within 2% of the
+  assembly's height of the lowest), of those the one with the largest footprint (its
+  bounding box's area across gravity, ``-z``);
 - agents: one human ``H`` and one robot ``R1``;
 - one placement operation per part, ids ``"1"``, ``"2"``, ... in the order base first,
   then the others from the lowest to the highest (against gravity), open to both agents;
@@ -28,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
+from asp.errors import SpecError
 from asp.numbers import json_number
 from asp.spec import SPEC_FILE, AssemblySpec, load_spec, spec_from_dict
 
@@ -43,26 +46,45 @@ def placement_durations(diagonal_mm: float) -> tuple[float, float]:
     return human, float(round(ROBOT_FACTOR * human))
 
 
+def base_index(bounds: np.ndarray) -> int:
+    """The part that stands lowest, the largest footprint first; ``bounds`` shape (n, 2, 3)."""
+    bottom = bounds[:, 0, 2]
+    height = float(bounds[:, 1, 2].max() - bottom.min())
+    low = np.flatnonzero(bottom <= bottom.min() + 0.02 * height)
+    footprint = np.prod(bounds[low, 1, :2] - bounds[low, 0, :2], axis=1)
+    return int(low[np.argmax(footprint)])
+
+
 def spec_geometry(spec: AssemblySpec):
     """The meshes of ``spec``'s parts as a ``cad.Assembly`` (files relative to the spec).
 
     Raises
     ------
-    ValueError
+    SpecError
         The spec names no parts, or a part has no mesh file (named).
     """
     from cad.loading import load_parts
 
     if not spec.parts:
-        raise ValueError(f"{spec.source}: the spec names no parts (a 'parts:' list with files)")
+        raise SpecError(f"{spec.source}: the spec names no parts (a 'parts:' list with files)")
     return load_parts(spec.parts, spec.folder, spec.units)
 
 
 def cad_assembly(path: str | Path):
-    """The geometry of a CAD file or a folder of part meshes (``cad.load_assembly``)."""
-    from cad.loading import load_assembly
+    """The geometry of a CAD file or a folder of part meshes (``cad.load_assembly``).
 
-    return load_assembly(path)
+    A ``bom.csv``/``bom.yaml`` beside a scene file adds or overrides part data
+    (:func:`cad.loading.apply_bom`); in a folder of meshes it names the parts.
+    """
+    from cad.bom import read_bom
+    from cad.loading import BOM_NAMES, apply_bom, load_assembly
+
+    path = Path(path)
+    assembly = load_assembly(path)
+    bom = next((path.parent / n for n in BOM_NAMES if (path.parent / n).is_file()), None)
+    if path.is_file() and bom is not None:
+        assembly = apply_bom(assembly, read_bom(bom), path.parent)
+    return assembly
 
 
 def spec_data(path: str | Path, spec_folder: str | Path | None = None) -> tuple[dict, object]:
@@ -99,7 +121,7 @@ def spec_data(path: str | Path, spec_folder: str | Path | None = None) -> tuple[
         parts.append(record)
     bounds = np.array([p.bounds for p in assembly.parts])  # (n, 2, 3) in mm
     extents = bounds[:, 1] - bounds[:, 0]
-    base = int(np.argmax(np.prod(np.maximum(extents, 1e-9), axis=1)))
+    base = base_index(bounds)
     order = [base] + sorted(
         (k for k in range(len(assembly.parts)) if k != base),
         key=lambda k: (bounds[k, 0, 2], bounds[k, 1, 2], k),
@@ -212,7 +234,7 @@ def spec_text(path: str | Path, spec_folder: str | Path | None = None) -> str:
         "  H: {side: human, description: operator}",
         "  R1: {side: robot, description: robot arm with a gripper}",
         "",
-        f"base_part: {data['base_part']}      # the largest part, placed first",
+        f"base_part: {data['base_part']}      # placed first: the lowest part, largest footprint",
         "gravity: -z                # direction of gravity in the file's frame",
         "gripper_approach: [+x, -x, +y, -y, +z, -z]   # directions a part may be inserted from",
         "constraints: {topological: true, stability: true, functional: true}",

@@ -45,6 +45,7 @@ from cad.offset import offset_vertices
 from cad.progress import progress_bar
 from cad.projection import box_pair_chunks, height_gap_range, overlap_share
 from cad.tolerances import resolve_tolerances
+from cad.unit_hints import unit_hint
 
 _PARALLEL = 1e-9
 """Faces whose normal component along the axis is below this are parallel to it."""
@@ -253,9 +254,11 @@ def check_interpenetration(
                 pa, pb = assembly.parts[a], assembly.parts[b]
                 ptol = tols.pair(a, b)
                 depth = _depth_estimate(pa.mesh, pb.mesh, ptol)
+                hint = unit_hint(assembly, a, b)
                 raise ValueError(
                     f"parts {pa.id!r} and {pb.id!r} interpenetrate by {depth} "
                     f"(penetration tolerance of this pair {ptol:.3g} mm)"
+                    + (f"; {hint}" if hint else "")
                 )
 
 
@@ -274,4 +277,6 @@ def _depth_estimate(a: trimesh.Trimesh, b: trimesh.Trimesh, ptol: float) -> str:
     for _ in range(14):
         mid = 0.5 * (lo + hi)
         lo, hi = (mid, hi) if still(mid) else (lo, mid)
+    if lo == 0.0:  # any erosion parts them: say the bound, never "about 0 mm"
+        return f"less than {2 * hi:.2g} mm"
     return f"about {2 * lo:.3g} mm"

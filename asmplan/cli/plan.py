@@ -12,13 +12,17 @@ from pathlib import Path
 
 import typer
 
-from asmplan.cli.app import app
+from asmplan.cli.app import app, choices
 from asmplan.cli.graph import say
-from asmplan.cli.options import SEED_MAX, TIME_LIMIT_MAX, CostModel, check_output
+from asmplan.cli.options import SEED_MAX, TIME_LIMIT_MAX, CostModel, check_output, finite_or_none
+from asmplan.pipeline import TURN_MODELS
+
+TurnModel = choices("TurnModel", TURN_MODELS, "Turn model of the game.")
 
 
 def plan_summary(result) -> list[str]:
     """The lines ``asmplan plan`` prints for an :class:`~asmplan.pipeline.AssemblyPlan`."""
+    from asp.numbers import cost_unit
     from asp.plan import plan_text, relations_text
 
     spec, graph, dag, solution = result.assembly.spec, result.graph, result.dag, result.solution
@@ -33,7 +37,18 @@ def plan_summary(result) -> list[str]:
         f"state graph: {graph.n_states:,} states, {graph.n_transitions:,} transitions, "
         f"{result.sequences:,} feasible sequences"
     )
-    unit = "" if dag.cost_model == "steps" else " s"
+    if result.concurrent is not None:
+        from asp.concurrent_plan import robustness_table, timeline_text
+
+        plan = result.concurrent
+        lines.append("concurrent game (the person and the robots working at once), makespan:")
+        lines.append(robustness_table(plan))
+        lines.append(f"robust plan (k = {plan.curve.k}), the person following it:")
+        lines.append(timeline_text(*plan.cooperative))
+        lines.append(f"robust plan (k = {plan.curve.k}) against the worst person:")
+        lines.append(timeline_text(*plan.worst))
+        return lines
+    unit = cost_unit(dag.cost_model)
     lines += [
         f"game DAG ({dag.cost_model}): {dag.n_nodes} nodes, {dag.n_edges} edges",
         f"TCT (cooperative) {solution.tct:g}{unit}, W* (robust) {solution.minimax:g}{unit}",
@@ -63,6 +78,24 @@ def plan_command(
         30.0, "--time-limit", min=0.001, max=TIME_LIMIT_MAX, help="CP-SAT time limit, seconds."
     ),
     seed: int = typer.Option(0, "--seed", min=0, max=SEED_MAX, help="CP-SAT random seed."),
+    turn_model: TurnModel | None = typer.Option(
+        None, "--turn-model", help="alternate (the paper's turns) or concurrent (default: spec's)."
+    ),
+    max_k: int | None = typer.Option(
+        None,
+        "--max-k",
+        min=0,
+        max=1000,
+        help="Concurrent: largest deviation budget k tried (default: DEFAULT_MAX_K of "
+        "asp.concurrent); the curve stops earlier once flat.",
+    ),
+    duration_step: float = typer.Option(
+        1.0,
+        "--duration-step",
+        min=0.0,
+        help="Concurrent: grid of a person's duration range (0: its two end points).",
+        callback=finite_or_none,
+    ),
     max_states: int | None = typer.Option(
         None, "--max-states", min=1, help="State graph limit (default: spec's, else 20,000,000)."
     ),
@@ -77,13 +110,16 @@ def plan_command(
         cost=None if cost is None else cost.value,
         time_limit=time_limit,
         seed=seed,
+        turn_model=None if turn_model is None else turn_model.value,
+        max_k=max_k,
+        duration_step=duration_step or None,
         on_step=say,
         max_states=max_states,
     )
     for line in plan_summary(result):
         typer.echo(line)
     if output is not None:
-        say("[5/5] writing plan.json and dag.png ...")
+        say("[5/5] writing plan.json and the figures ...")
         written = pipeline.write_plan(result, output, on_step=say)
         typer.echo("wrote " + " and ".join(str(p) for p in written))
     say(f"done in {time.perf_counter() - t0:.1f} s")

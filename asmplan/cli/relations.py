@@ -36,6 +36,13 @@ def relations_command(
         None, "--units", help="Unit of mesh files that declare none (default mm)."
     ),
     progress: bool = typer.Option(False, "--progress", help="Show progress on stderr."),
+    why: str | None = typer.Option(
+        None,
+        "--why",
+        metavar="PART",
+        help="Explain PART instead: per direction, the parts that block it and its depth "
+        "(layers of parts to take out first along that direction).",
+    ),
 ) -> None:
     """Compute TC (contact) and TT (translational freedom) for every pair of parts.
 
@@ -47,6 +54,8 @@ def relations_command(
         relations_json,
         relations_markdown,
         relations_text,
+        why_json,
+        why_text,
     )
 
     relations = part_relations(
@@ -56,6 +65,10 @@ def relations_command(
         penetration_tol=penetration_tol,
         progress=progress,
     )
+    if why is not None:
+        render_why = why_json if fmt is TableFormat.json else why_text
+        typer.echo(render_why(relations, why), nl=False)
+        return
     render = {
         TableFormat.text: relations_text,
         TableFormat.json: relations_json,

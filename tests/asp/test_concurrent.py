@@ -36,8 +36,11 @@ def job(ops: list[dict], agents: dict | None = None, tools: dict | None = None):
 
 
 def curve(model, max_k: int = 6) -> list[float]:
+    """W*(0), ... up to the first k where the curve is flat, then W*(inf)."""
     r = robustness(model, max_k=max_k)
-    return [*r.bounds, r.unbounded]
+    assert r.flat and r.bounds[-1] == r.unbounded
+    first = next(k for k, b in enumerate(r.bounds) if b == r.unbounded)
+    return [*r.bounds[: first + 1], r.unbounded]
 
 
 # Hand-checked jobs: (operations, W*(0), ..., W*(inf)) with the curve up to its flat point.

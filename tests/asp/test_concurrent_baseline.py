@@ -7,8 +7,8 @@ from pathlib import Path
 import pytest
 from hypothesis import HealthCheck, given, settings
 
-from asp.baseline import assembly_makespan, assembly_schedule, min_makespan, schedule_violation
-from asp.concurrent import build_game, concurrent_model, value
+from asp.baseline import assembly_schedule, min_makespan, schedule_violation
+from asp.concurrent import assembly_makespan, build_game, concurrent_model, value
 from asp.feasibility import load_relations
 from asp.solve import solve
 from asp.spec import load_spec, spec_from_dict

@@ -1,0 +1,130 @@
+"""Pictures of the concurrent game: the price-of-robustness curve and Gantt charts.
+
+matplotlib is imported lazily with the Agg backend; PNGs are written atomically.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+from collections.abc import Sequence
+from pathlib import Path
+
+from asp.atomic import write_bytes
+
+AGENT_COLOURS = {"H": "#9e9e9e", "R1": "#2e9d4a", "R2": "#f28c28"}
+"""The paper's Figure 9 colours: operator grey, R1 green, R2 orange."""
+OTHER_COLOURS = ("#3b6fb6", "#8e44ad", "#c0392b", "#16a085", "#7f8c8d")
+DEVIATION_COLOUR = "#d62728"
+
+
+def _pyplot():
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    return plt
+
+
+def _save(fig, path) -> Path:
+    plt = _pyplot()
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png")
+    plt.close(fig)
+    return write_bytes(path, buffer.getvalue())
+
+
+def plot_robustness(
+    rows: Sequence[dict],
+    path: str | os.PathLike[str],
+    *,
+    schedule: float | None = None,
+    schedule_rows: Sequence[dict] | None = None,
+    title: str = "",
+) -> Path:
+    """The curve ``k -> W*(k)`` with ``W*(inf)`` at the right and the CP-SAT makespan.
+
+    Parameters
+    ----------
+    rows : list of {"k": int or None, "bound": float}
+        The robustness list of the plan (``k`` None: the unbounded adversary).
+    schedule : float, optional
+        The CP-SAT makespan (a horizontal line).
+    schedule_rows : list of {"k", "bound"}, optional
+        The CP-SAT schedule's certified worst case under the same budgets.
+    """
+    plt = _pyplot()
+    xs = list(range(len(rows)))
+    labels = ["inf" if r["k"] is None else str(r["k"]) for r in rows]
+    fig, ax = plt.subplots(figsize=(6.4, 4.0), dpi=110)
+    ax.plot(xs, [r["bound"] for r in rows], "o-", color="#1f4e9c", label="robust plan W*(k)")
+    if schedule_rows:
+        ax.plot(
+            xs[: len(schedule_rows)],
+            [r["bound"] for r in schedule_rows],
+            "s--",
+            color=DEVIATION_COLOUR,
+            label="CP-SAT schedule, certified worst case",
+        )
+    if schedule is not None:
+        ax.axhline(schedule, color="#555555", lw=1, ls=":", label=f"CP-SAT makespan {schedule:g}")
+    ax.set_xticks(xs, labels)
+    ax.set_xlabel("deviations the person may make (k)")
+    ax.set_ylabel("guaranteed makespan")
+    ax.set_title(title or "price of robustness", fontsize=10)
+    ax.legend(fontsize=8, frameon=False, loc="lower right")
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def plot_gantt(
+    bars: Sequence,
+    path: str | os.PathLike[str],
+    *,
+    makespan: float | None = None,
+    title: str = "",
+) -> Path:
+    """Bars per agent on one time axis; deviations from the plan outlined in red and hatched.
+
+    Parameters
+    ----------
+    bars : sequence of :class:`asp.concurrent.Bar`
+    """
+    plt = _pyplot()
+    from matplotlib.patches import Patch
+
+    agents = sorted({b.agent for b in bars}, key=lambda a: (not a.startswith("H"), a))
+    row = {a: i for i, a in enumerate(agents)}
+    palette = dict(AGENT_COLOURS)
+    for a in agents:
+        palette.setdefault(a, OTHER_COLOURS[len(palette) % len(OTHER_COLOURS)])
+    end = max([makespan or 0.0, *(b.end for b in bars)])
+    fig, ax = plt.subplots(figsize=(max(7.0, min(18.0, 0.05 * end + 5)), 1.0 + 0.6 * len(agents)))
+    for b in bars:
+        y = row[b.agent]
+        ax.barh(
+            y,
+            b.end - b.start,
+            left=b.start,
+            height=0.6,
+            color=palette[b.agent],
+            edgecolor=DEVIATION_COLOUR if b.deviation else "black",
+            linewidth=2.0 if b.deviation else 0.6,
+            hatch="//" if b.deviation else None,
+        )
+        if b.end - b.start >= 0.03 * max(end, 1.0):
+            ax.text((b.start + b.end) / 2, y, b.operation, ha="center", va="center", fontsize=7)
+    if makespan is not None:
+        ax.axvline(makespan, color="black", lw=1, ls="--")
+    ax.set_yticks(range(len(agents)), agents)
+    ax.invert_yaxis()
+    ax.set_xlabel("time")
+    ax.set_xlim(0, end * 1.02 if end else 1)
+    handles = [Patch(facecolor="white", edgecolor=DEVIATION_COLOUR, hatch="//", label="deviation")]
+    if any(b.deviation for b in bars):
+        ax.legend(handles=handles, fontsize=8, frameon=False, loc="upper right")
+    ax.set_title(title, fontsize=10)
+    fig.tight_layout()
+    return _save(fig, path)

@@ -1,0 +1,105 @@
+"""``asmplan plan --turn-model concurrent`` as a user runs it: outputs, keys, bad input."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+import yaml
+
+PUMP = Path(__file__).resolve().parents[2] / "examples" / "vacuum_pump"
+FIGURES = ("robustness.png", "gantt_cooperative.png", "gantt_worst.png")
+
+
+def run(*args):
+    return subprocess.run(
+        [sys.executable, "-c", "from asmplan.cli import main; main()", *args],
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
+
+
+def test_pump_concurrent_plan(tmp_path):
+    out = tmp_path / "out"
+    r = run("plan", str(PUMP), "--turn-model", "concurrent", "-o", str(out))
+    assert r.returncode == 0, r.stderr
+    assert "robust plan W*(k)" in r.stdout and "(fully adversarial)" in r.stdout
+    for name in ("plan.json", *FIGURES):
+        assert (out / name).stat().st_size > 0, name
+    plan = json.loads((out / "plan.json").read_text())
+    assert plan["turn_model"] == "concurrent"
+    assert plan["schedule"]["objective"] == 215 and plan["schedule"]["status"] == "OPTIMAL"
+    rows = plan["robustness"]
+    assert rows[0] == {"k": 0, "bound": 215} and rows[-1]["k"] is None
+    assert [r["k"] for r in rows[:-1]] == list(range(len(rows) - 1))
+    bounds = [r["bound"] for r in rows]
+    assert bounds == sorted(bounds)
+    policy = plan["concurrent"]["policy"]
+    assert policy[0]["state"] == {
+        "done": [],
+        "tools": {"R1.bit": "hex"},
+        "running": [],
+        "budget": plan["concurrent"]["plan_budget"],
+        "turn": "robot",
+    }
+
+
+def small_spec(**changes) -> dict:
+    data = {
+        "name": "small",
+        "agents": {"H": {"side": "human"}, "R1": {"side": "robot"}},
+        "turn_model": "alternate",
+        "cost": "time",
+        "operations": [
+            {"id": "a", "agents": {"H": 3}},
+            {"id": "b", "agents": {"R1": 4}, "after": ["a"]},
+        ],
+    }
+    data.update(changes)
+    return data
+
+
+def with_op(**fields) -> dict:
+    ops = small_spec()["operations"]
+    ops[0] = {**ops[0], **fields}
+    return small_spec(operations=ops)
+
+
+BAD = [
+    (with_op(agents={"H": [5, 3]}), "operations[a]"),
+    (with_op(agents={"H": -1}), "operations[a]"),
+    (with_op(agents={"H": ".nan"}), "operations[a]"),
+    (with_op(agents={}), "operations[a]"),
+    (
+        small_spec(agents={"H": {"side": "human"}, "R1": {"side": "robot"}, "R2": "robot"}),
+        "R2",
+    ),
+]
+
+
+@pytest.mark.parametrize(("data", "where"), BAD)
+def test_bad_input_one_line_exit_2_nothing_written(tmp_path, data, where):
+    spec = tmp_path / "assembly.yaml"
+    text = yaml.safe_dump(data).replace("'.nan'", ".nan")
+    spec.write_text(text)
+    out = tmp_path / "out"
+    r = run("plan", str(spec), "--turn-model", "concurrent", "-o", str(out))
+    assert r.returncode == 2, r.stdout + r.stderr
+    # Progress lines may come first on stderr; the error is one line, the last.
+    errors = [x for x in r.stderr.strip().splitlines() if x.startswith("asmplan: error:")]
+    assert len(errors) == 1 and r.stderr.strip().endswith(errors[0]), r.stderr
+    assert where in errors[0]
+    assert not out.exists()
+
+
+def test_negative_k_is_a_usage_error(tmp_path):
+    out = tmp_path / "out"
+    r = run("plan", str(PUMP), "--turn-model", "concurrent", "--max-k", "-1", "-o", str(out))
+    assert r.returncode == 2
+    lines = r.stderr.strip().splitlines()
+    assert len(lines) == 1 and "--max-k" in lines[0]
+    assert not out.exists()
