@@ -233,7 +233,7 @@ def concurrent_model(
             raise SpecError(f"{where}: operations[{op.id}]: no agent may do this operation")
         for w, x in enumerate(workers):
             if x.agent in op.agents:
-                lo, hi = duration_range(op, x.agent)
+                lo, hi = op.duration_range(x.agent)
                 if not (math.isfinite(lo) and math.isfinite(hi)) or lo < 0 or lo > hi:
                     raise SpecError(
                         f"{where}: operations[{op.id}].agents.{x.agent}: expected a duration "
@@ -300,18 +300,6 @@ def concurrent_model(
         conflict=conflict,
         complete=graph.complete,
     )
-
-
-def duration_range(op, agent: str) -> tuple[float, float]:
-    """``(min, max)`` duration of ``agent`` for ``op`` (``min == max`` without a range)."""
-    ranged = getattr(op, "duration_range", None)
-    if ranged is not None:
-        lo, hi = ranged(agent)
-        return float(lo), float(hi)
-    d = op.duration(agent)
-    if isinstance(d, tuple | list):
-        return float(d[0]), float(d[-1])
-    return float(d), float(d)
 
 
 # --------------------------------------------------------------------------- the game
@@ -756,10 +744,11 @@ def schedule_rule(rows: list[dict]) -> RobotRule:
     """The robot policy of a fixed schedule (a plan that ignores what the person does).
 
     ``rows`` are ``{"task", "agent", "start"}`` (a CP-SAT schedule). Each worker keeps the
-    list of its operations in start order. At an event each free robot starts the first
-    operation of its list not yet done or running when it may start now, else waits; each
-    free human is told the first of its list the same way. When that leaves nothing to run,
-    the first valid commitment is taken (the schedule has no answer there).
+    list of its operations in start order and wants the first one not yet done or running
+    (the person is told it). At an event the rule takes the commitment in which every free
+    worker does what it wants, if that is valid; otherwise (a deviation made the wanted
+    operation impossible for now) the valid commitment with the most workers as wanted,
+    ties by edge order: the schedule has no answer there, it keeps as much of it as it can.
     """
     order: dict[str, list[str]] = {}
     for row in sorted(rows, key=lambda r: (r["start"], r["task"])):
