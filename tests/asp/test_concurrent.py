@@ -248,3 +248,19 @@ def test_pump_with_ranges_robust_plan_beats_the_schedule():
     assert plan.schedule.objective == 297
     worst = {r["k"]: r["bound"] for r in plan.schedule_worst}
     assert worst[0] == 297 and worst[1] == 333
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(random_jobs(), st.sampled_from([None, 0, 2]))
+def test_compiled_and_python_builders_make_the_same_game(data, budget):
+    ops, agents = data
+    model = job(ops, agents=agents)
+    a = build_game(model, budget, compiled=False)
+    b = build_game(model, budget, compiled=True)
+    assert (a.dag.n_nodes, a.dag.n_edges) == (b.dag.n_nodes, b.dag.n_edges)
+    sa, sb = solve(a.dag), solve(b.dag)
+    for k in a.budgets:
+        assert value(a, sa, k) == value(b, sb, k)
+        assert timeline(a, sa.robot_policy, "worst", budget=None if k == UNBOUNDED else k) == (
+            timeline(b, sb.robot_policy, "worst", budget=None if k == UNBOUNDED else k)
+        )
