@@ -30,6 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
+from asp.errors import SpecError
 from asp.numbers import json_number
 from asp.spec import SPEC_FILE, AssemblySpec, load_spec, spec_from_dict
 
@@ -59,21 +60,31 @@ def spec_geometry(spec: AssemblySpec):
 
     Raises
     ------
-    ValueError
+    SpecError
         The spec names no parts, or a part has no mesh file (named).
     """
     from cad.loading import load_parts
 
     if not spec.parts:
-        raise ValueError(f"{spec.source}: the spec names no parts (a 'parts:' list with files)")
+        raise SpecError(f"{spec.source}: the spec names no parts (a 'parts:' list with files)")
     return load_parts(spec.parts, spec.folder, spec.units)
 
 
 def cad_assembly(path: str | Path):
-    """The geometry of a CAD file or a folder of part meshes (``cad.load_assembly``)."""
-    from cad.loading import load_assembly
+    """The geometry of a CAD file or a folder of part meshes (``cad.load_assembly``).
 
-    return load_assembly(path)
+    A ``bom.csv``/``bom.yaml`` beside a scene file adds or overrides part data
+    (:func:`cad.loading.apply_bom`); in a folder of meshes it names the parts.
+    """
+    from cad.bom import read_bom
+    from cad.loading import BOM_NAMES, apply_bom, load_assembly
+
+    path = Path(path)
+    assembly = load_assembly(path)
+    bom = next((path.parent / n for n in BOM_NAMES if (path.parent / n).is_file()), None)
+    if path.is_file() and bom is not None:
+        assembly = apply_bom(assembly, read_bom(bom), path.parent)
+    return assembly
 
 
 def spec_data(path: str | Path, spec_folder: str | Path | None = None) -> tuple[dict, object]:

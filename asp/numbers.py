@@ -25,3 +25,8 @@ def cost_text(x, spec: str = "g") -> str:
     """A cost as text: ``3`` rather than ``3.0``; other values formatted with ``spec``."""
     x = float(x)
     return str(int(x)) if x.is_integer() else format(x, spec)
+
+
+def cost_unit(cost_model: str) -> str:
+    """The unit suffix of a cost in text: ``""`` under ``steps``, ``" s"`` under ``time``."""
+    return "" if cost_model == "steps" else " s"

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from cad.errors import AsmplanError
 from cad.yamlfile import read_yaml
 
 PART_KEYS = ("id", "name", "file", "quantity", "type", "shape")
@@ -63,11 +64,11 @@ def unknown_key_message(key: object, known: Iterable[str], word: str = "key") ->
 
 
 def refuse_unknown_keys(mapping: dict, known: Iterable[str], where: str, word="key") -> None:
-    """Raise ``ValueError`` ``where: unknown key ...`` for the first key not in ``known``."""
+    """Raise ``AsmplanError`` ``where: unknown key ...`` for the first key not in ``known``."""
     known = tuple(known)
     for key in mapping:
         if key not in known:
-            raise ValueError(f"{where}: {unknown_key_message(key, known, word)}")
+            raise AsmplanError(f"{where}: {unknown_key_message(key, known, word)}")
 
 
 def part_record(row: Any, where: str) -> PartRecord:
@@ -82,19 +83,19 @@ def part_record(row: Any, where: str) -> PartRecord:
 
     Raises
     ------
-    ValueError
+    AsmplanError
         ``where: ...`` naming the problem: not a mapping, no id, an unknown key (the nearest
         known one suggested), a quantity that is not a positive integer.
     """
     if isinstance(row, str | int) and not isinstance(row, bool):
         row = {"id": row}
     if not isinstance(row, dict):
-        raise ValueError(f"{where}: expected a mapping with an 'id' or a part id")
+        raise AsmplanError(f"{where}: expected a mapping with an 'id' or a part id")
     refuse_unknown_keys(row, PART_KEYS, where)
     raw_id = row.get("id")
     pid = "" if raw_id is None or isinstance(raw_id, dict | list) else str(raw_id).strip()
     if not pid:
-        raise ValueError(f"{where}: part has no id")
+        raise AsmplanError(f"{where}: part has no id")
     return PartRecord(
         id=pid,
         name=_text(row.get("name")) or pid,
@@ -108,12 +109,12 @@ def part_record(row: Any, where: str) -> PartRecord:
 def part_records(rows: Any, where: str) -> tuple[PartRecord, ...]:
     """Validate a list of rows (:func:`part_record`); duplicate ids are an error."""
     if not isinstance(rows, list):
-        raise ValueError(f"{where}: expected a list of parts {{id, name, file, quantity, type}}")
+        raise AsmplanError(f"{where}: expected a list of parts {{id, name, file, quantity, type}}")
     out, seen = [], set()
     for k, row in enumerate(rows):
         record = part_record(row, f"{where}[{k}]")
         if record.id in seen:
-            raise ValueError(f"{where}: duplicate part id {record.id!r}")
+            raise AsmplanError(f"{where}: duplicate part id {record.id!r}")
         seen.add(record.id)
         out.append(record)
     return tuple(out)
@@ -126,7 +127,7 @@ def read_bom(path: str | Path) -> tuple[PartRecord, ...]:
     ------
     FileNotFoundError
         No such file.
-    ValueError
+    AsmplanError
         Unreadable file or an invalid row (:func:`part_record`), naming the file and row.
     """
     path = Path(path)
@@ -140,12 +141,12 @@ def read_bom(path: str | Path) -> tuple[PartRecord, ...]:
                     for row in csv.DictReader(handle)
                 ]
         except (OSError, UnicodeDecodeError, csv.Error) as exc:
-            raise ValueError(f"unreadable BOM {path}: {exc}") from None
+            raise AsmplanError(f"unreadable BOM {path}: {exc}") from None
     else:
         data = read_yaml(path, what="BOM")
         rows = data.get("parts", []) if isinstance(data, dict) else data
     if not isinstance(rows, list):
-        raise ValueError(f"BOM {path} must be a list of parts")
+        raise AsmplanError(f"BOM {path} must be a list of parts")
     return part_records(rows, f"BOM {path}: row")
 
 
@@ -161,5 +162,5 @@ def _quantity(value: Any, where: str) -> int:
     if isinstance(value, str) and value.strip().isdigit():
         number = int(value.strip())
     if not isinstance(number, int) or isinstance(number, bool) or number < 1:
-        raise ValueError(f"{where}: quantity {value!r} is not a positive integer")
+        raise AsmplanError(f"{where}: quantity {value!r} is not a positive integer")
     return number

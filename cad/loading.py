@@ -22,12 +22,14 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Sequence
+from dataclasses import replace
 from pathlib import Path
 
 import trimesh
 
 from cad.assembly import Assembly, prepare_part
 from cad.bom import PartRecord, read_bom
+from cad.errors import GeometryError
 from cad.scene import SCENE_SUFFIXES, read_scene
 from cad.unit_hints import part_scale_hint
 from cad.units import unit_scale
@@ -63,7 +65,7 @@ def load_assembly(
     ------
     FileNotFoundError
         The path or a file the BOM names does not exist.
-    ValueError
+    GeometryError
         Unreadable or empty mesh, duplicate part ids, a BOM row without a mesh, unknown
         unit, STEP without the ``cascadio`` extra, an ``assembly.yaml`` (read it with
         ``asp.spec.load_spec``).
@@ -79,7 +81,7 @@ def load_assembly(
         records = read_bom(bom) if bom is not None else folder_records(path)
         return load_parts(records, path, units)
     if path.suffix.lower() in (".yaml", ".yml"):
-        raise ValueError(
+        raise GeometryError(
             f"{path}: an assembly spec is read by asp.spec.load_spec (cad.load_parts takes "
             "its parts)"
         )
@@ -95,7 +97,7 @@ def folder_records(folder: Path) -> tuple[PartRecord, ...]:
     """One record per mesh file of ``folder`` (sorted by name), id = the file's stem."""
     files = sorted(f for f in folder.iterdir() if f.is_file() and f.suffix.lower() in MESH_SUFFIXES)
     if not files:
-        raise ValueError(f"no mesh files ({', '.join(MESH_SUFFIXES)}) in folder {folder}")
+        raise GeometryError(f"no mesh files ({', '.join(MESH_SUFFIXES)}) in folder {folder}")
     return tuple(PartRecord(id=f.stem, name=f.stem, file=f.name) for f in files)
 
 
@@ -123,7 +125,7 @@ def load_parts(
     parts, used = [], []
     for row in records:
         if not row.file:
-            raise ValueError(f"BOM part {row.id!r} has no mesh file")
+            raise GeometryError(f"BOM part {row.id!r} has no mesh file")
         mesh, unit, source = _record_mesh(row, base, units)
         used.append(unit)
         parts.append(
@@ -160,13 +162,13 @@ def _record_mesh(row: PartRecord, base: Path, units: str | None):
     if node:
         k = scene.find(node)
         if k is None:
-            raise ValueError(
+            raise GeometryError(
                 f"part {row.id!r}: no part {node!r} in {file} (its parts: "
                 f"{', '.join(scene.ids[:12])}{', ...' if len(scene.ids) > 12 else ''})"
             )
         return scene.meshes[k], unit, f"{file}#{scene.ids[k]}"
     if not scene.meshes:
-        raise ValueError(f"unreadable mesh file {file}: no triangles could be read (empty mesh)")
+        raise GeometryError(f"unreadable mesh file {file}: no triangles could be read (empty mesh)")
     meshes = scene.meshes
     mesh = meshes[0] if len(meshes) == 1 else trimesh.util.concatenate(list(meshes))
     return mesh, unit, str(file)
@@ -175,7 +177,7 @@ def _record_mesh(row: PartRecord, base: Path, units: str | None):
 def _scene_assembly(path: Path, units: str | None) -> Assembly:
     scene = read_scene(path)
     if not scene.meshes:
-        raise ValueError(f"unreadable mesh file {path}: no triangles could be read (empty mesh)")
+        raise GeometryError(f"unreadable mesh file {path}: no triangles could be read (empty mesh)")
     unit = scene.units or units or "mm"
     scale = unit_scale(unit)
     parts = tuple(
@@ -186,9 +188,48 @@ def _scene_assembly(path: Path, units: str | None) -> Assembly:
     return Assembly(parts=parts, units=unit, source=str(path), groups=scene.groups)
 
 
+def apply_bom(assembly: Assembly, records: Sequence[PartRecord], base: Path) -> Assembly:
+    """A scene's parts with a BOM's data: a row naming a part (by id, or ``file`` naming
+    its node) overrides its id, name, quantity, type and shape; a row with a mesh file of
+    its own adds a part.
+    """
+    parts = list(assembly.parts)
+    renamed: dict[str, str] = {}
+    added: list[PartRecord] = []
+    for row in records:
+        node = str(row.file or "").rpartition("#")[2] or row.id
+        hits = [k for k, p in enumerate(parts) if node in (p.id, p.name) or row.id == p.id]
+        if not hits:
+            if not row.file or not (base / str(row.file).partition("#")[0]).is_file():
+                raise GeometryError(
+                    f"BOM part {row.id!r}: no part {node!r} in {assembly.source} and no mesh "
+                    "file of its own"
+                )
+            added.append(row)
+            continue
+        k = hits[0]
+        old = parts[k]
+        renamed[old.id] = row.id
+        parts[k] = replace(
+            old,
+            id=row.id,
+            name=row.name if row.name != row.id or old.name == old.id else old.name,
+            quantity=row.quantity,
+            type=row.type or old.type,
+            shape=row.shape or old.shape,
+        )
+    if added:
+        parts += load_parts(added, base).parts
+    _check_unique([p.id for p in parts], base)
+    groups = tuple(
+        (gid, tuple(renamed.get(m, m) for m in members)) for gid, members in assembly.groups
+    )
+    return replace(assembly, parts=tuple(parts), groups=groups)
+
+
 def _check_unique(ids: list[str], where: Path) -> None:
     seen: set[str] = set()
     for pid in ids:
         if pid in seen:
-            raise ValueError(f"duplicate part id {pid!r} in {where}")
+            raise GeometryError(f"duplicate part id {pid!r} in {where}")
         seen.add(pid)

@@ -22,6 +22,7 @@ from pathlib import Path
 
 import trimesh
 
+from cad.errors import GeometryError
 from cad.units import canonical_unit
 
 SCENE_SUFFIXES = (".glb", ".gltf", ".3mf", ".step", ".stp", ".3dxml")
@@ -55,6 +56,12 @@ def clean_name(raw: str) -> str:
     if name and name[0].isdigit() and not name.isdigit():
         name = "p_" + name
     return name
+
+
+def display_name(raw: str) -> str:
+    """A CAD name without its instance path or number (``Washer#1:8:6`` -> ``Washer``)."""
+    name = re.split(r"[#<]", str(raw), maxsplit=1)[0]
+    return re.sub(r"(:\d+|\(\d+\))$", "", name).strip() or str(raw)
 
 
 def is_generic(name: str) -> bool:
@@ -105,7 +112,7 @@ class SceneParts:
     ids : tuple of str
         Cleaned unique part ids, in the file's order.
     names : tuple of str
-        The node names as the file gives them.
+        The node names as the file gives them, without instance paths (``#1:2:3``).
     meshes : tuple of trimesh.Trimesh
         Each part's mesh in the scene frame, in the file's unit. Shared: copy to change.
     groups : tuple of (str, tuple of str)
@@ -137,16 +144,16 @@ def load_scene_file(path: Path) -> trimesh.Scene:
         try:
             import cascadio  # noqa: F401
         except ImportError:
-            raise ValueError(
+            raise GeometryError(
                 f"cannot read STEP file {path}: install the optional extra "
                 "'asmplan[step]' (cascadio)"
             ) from None
     if path.stat().st_size == 0:
-        raise ValueError(f"empty mesh file {path}")
+        raise GeometryError(f"empty mesh file {path}")
     try:
         scene = trimesh.load(str(path), force="scene")
     except Exception as exc:  # trimesh raises many types for bad files
-        raise ValueError(f"unreadable mesh file {path}: {type(exc).__name__}: {exc}") from None
+        raise GeometryError(f"unreadable mesh file {path}: {type(exc).__name__}: {exc}") from None
     if not isinstance(scene, trimesh.Scene):  # pragma: no cover - force="scene"
         scene = trimesh.Scene(scene)
     return scene
@@ -222,7 +229,7 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
     for node, _ in part_nodes:
         transform, geom_name = graph[node]
         meshes.append(scene.geometry[geom_name].copy().apply_transform(transform))
-        names.append(original(node))
+        names.append(display_name(original(node)))
     bases = [
         best_name([original(node), str(graph[node][1]), *[original(a) for a in anc]])
         for node, anc in part_nodes

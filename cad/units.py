@@ -6,6 +6,8 @@ factor a file's coordinates are multiplied by.
 
 from __future__ import annotations
 
+from cad.errors import GeometryError
+
 _UNIT_TO_MM = {
     "mm": 1.0,
     "millimeter": 1.0,
@@ -43,7 +45,7 @@ def unit_scale(units: str) -> float:
     """Millimetres per one ``units`` (``"m"`` -> 1000.0); ValueError for unknown units."""
     key = str(units).strip().lower()
     if key not in _UNIT_TO_MM:
-        raise ValueError(f"unknown length unit {units!r}; use e.g. mm, cm, m, in")
+        raise GeometryError(f"unknown length unit {units!r}; use e.g. mm, cm, m, in")
     return _UNIT_TO_MM[key]
 
 

@@ -13,6 +13,8 @@ from typing import Any
 
 import yaml
 
+from cad.errors import AsmplanError
+
 MAX_EXPANDED_VALUES = 1_000_000
 """Most values (scalars, lists, mappings, counted with aliases expanded) a file may hold."""
 
@@ -41,7 +43,7 @@ def read_yaml(path: str | Path, *, what: str, decimals_as_text: bool = False) ->
 
     Raises
     ------
-    ValueError
+    AsmplanError
         One line naming the file: malformed YAML, not UTF-8 text, or aliases that expand
         past :data:`MAX_EXPANDED_VALUES` values.
     """
@@ -49,17 +51,17 @@ def read_yaml(path: str | Path, *, what: str, decimals_as_text: bool = False) ->
     try:
         text = path.read_text(encoding="utf-8")
     except UnicodeDecodeError as exc:
-        raise ValueError(f"{path}: not a UTF-8 text file ({exc.reason})") from None
+        raise AsmplanError(f"{path}: not a UTF-8 text file ({exc.reason})") from None
     loader = DecimalsAsText if decimals_as_text else yaml.SafeLoader
     try:
         data = yaml.load(text, Loader=loader)  # noqa: S506 - a SafeLoader subclass
     except yaml.YAMLError as exc:
         first = " ".join(str(exc).split())
-        raise ValueError(f"{path}: malformed YAML in {what} ({first})") from None
+        raise AsmplanError(f"{path}: malformed YAML in {what} ({first})") from None
     except RecursionError:
-        raise ValueError(f"{path}: {what} is nested too deeply") from None
+        raise AsmplanError(f"{path}: {what} is nested too deeply") from None
     if expanded_size(data) > MAX_EXPANDED_VALUES:
-        raise ValueError(
+        raise AsmplanError(
             f"{path}: {what} expands to more than {MAX_EXPANDED_VALUES:,} values through "
             "YAML aliases (refused: an alias bomb or a runaway file)"
         )

@@ -22,6 +22,7 @@ TurnModel = choices("TurnModel", TURN_MODELS, "Turn model of the game.")
 
 def plan_summary(result) -> list[str]:
     """The lines ``asmplan plan`` prints for an :class:`~asmplan.pipeline.AssemblyPlan`."""
+    from asp.numbers import cost_unit
     from asp.plan import plan_text, relations_text
 
     spec, graph, dag, solution = result.assembly.spec, result.graph, result.dag, result.solution
@@ -47,7 +48,7 @@ def plan_summary(result) -> list[str]:
         lines.append(f"robust plan (k = {plan.curve.k}) against the worst person:")
         lines.append(timeline_text(*plan.worst))
         return lines
-    unit = "" if dag.cost_model == "steps" else " s"
+    unit = cost_unit(dag.cost_model)
     lines += [
         f"game DAG ({dag.cost_model}): {dag.n_nodes} nodes, {dag.n_edges} edges",
         f"TCT (cooperative) {solution.tct:g}{unit}, W* (robust) {solution.minimax:g}{unit}",

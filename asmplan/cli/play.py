@@ -14,6 +14,7 @@ import typer
 
 from asmplan.cli.app import app, choices
 from asmplan.cli.options import SEED_MAX, CostModel
+from asp.numbers import cost_unit
 from asp.rules import SIDE_NAMES, cost_at_most, costs_close
 
 HELP_TEXT = """\
@@ -60,7 +61,7 @@ def _parse_moves(text: str | None) -> list[int]:
 
 
 def _unit(dag) -> str:
-    return "" if dag.cost_model == "steps" else " s"
+    return cost_unit(dag.cost_model)
 
 
 def _state_lines(session, fmt) -> list[str]:

@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 from asmplan.cli import app
 from tests.cad import shapes
 from tests.cad.test_loading import write_folder
-from tests.cad.test_scene import write_named_glb
+from tests.cad.test_scene import write_3dxml, write_named_glb
 
 STEP = Path(__file__).resolve().parents[1] / "cad" / "data" / "table_frame_in.step"
 
@@ -35,10 +35,15 @@ def inputs(tmp_path: Path) -> dict[str, Path]:
     folder = write_folder(tmp_path / "meshes", shapes.boxed_container())
     made = {"folder": folder, "glb": write_named_glb(tmp_path / "pump.glb")}
     made["3mf"] = write_3mf(tmp_path / "box.3mf")
+    b = shapes.box_between
+    made["3dxml"] = write_3dxml(
+        tmp_path / "plate.3dxml",
+        {"Plate": b((0, 0, 0), (40, 40, 5)), "Block": b((5, 5, 5), (15, 15, 15))},
+    )
     return made
 
 
-@pytest.mark.parametrize("kind", ["folder", "glb", "3mf", "step"])
+@pytest.mark.parametrize("kind", ["folder", "glb", "3mf", "3dxml", "step"])
 def test_plan_a_cad_file_with_no_spec(tmp_path, kind):
     if kind == "step":
         pytest.importorskip("cascadio")
@@ -84,3 +89,25 @@ def test_relations_why_prints_blockers_and_depth(tmp_path):
     assert "+x  free (depth 0)" in result.stdout
     bad = CliRunner().invoke(app, ["relations", str(STEP), "--why", "pilar_1"])
     assert bad.exit_code == 2 and "did you mean pillar_1" in bad.stderr
+
+
+def test_a_bom_beside_the_scene_overrides_and_adds_parts(tmp_path):
+    pytest.importorskip("cascadio")
+    import shutil
+
+    from asp.generate import generated_spec
+
+    shutil.copy(STEP, tmp_path / "frame.step")
+    shapes.box_between((40, 40, 76.2), (60, 60, 86.2)).export(tmp_path / "knob.stl")
+    (tmp_path / "bom.csv").write_text(
+        "id,name,file,quantity,type\n"
+        "top,Top plate,frame.step#top_plate,1,panel\n"
+        "knob,Knob,knob.stl,1,handle\n"
+    )
+    spec = generated_spec(tmp_path / "frame.step")
+    parts = {p.id: p for p in spec.parts}
+    assert "top_plate" not in parts and parts["top"].name == "Top plate"
+    assert parts["top"].type == "panel" and parts["top"].file == "frame.step#top_plate"
+    assert parts["knob"].file == "knob.stl" and parts["knob"].type == "handle"
+    assert parts["cap_1"].shape == "cap"
+    assert spec.operations[-1].parts == ("knob",)  # the highest part goes last

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -102,6 +103,64 @@ def write_named_glb(path: Path) -> Path:
         )
     scene.export(path)
     return path
+
+
+def write_3dxml(path, parts):
+    """A minimal 3DXML (tessellated): one Reference3D per part under a root product."""
+    refs, files = [], {}
+    k = 2
+    for name, mesh in parts.items():
+        pid, rid, iid, irid = k, k + 1, k + 2, k + 3
+        k += 4
+        rep = f"part{pid}.3DRep"
+        pos = " ".join(f"{x:.6g},{y:.6g},{z:.6g}" for x, y, z in mesh.vertices)
+        nor = " ".join(f"{x:.6g},{y:.6g},{z:.6g}" for x, y, z in mesh.vertex_normals)
+        tri = " ".join(str(int(i)) for i in np.asarray(mesh.faces).ravel())
+        files[rep] = (
+            '<?xml version="1.0"?><XMLRepresentation xmlns="http://www.3ds.com/xsd/3DXML">'
+            f'<Root><Rep><Faces><Face triangles="{tri}"/></Faces><VertexBuffer>'
+            f"<Positions>{pos}</Positions><Normals>{nor}</Normals></VertexBuffer></Rep></Root>"
+            "</XMLRepresentation>"
+        )
+        refs.append(
+            f'<Reference3D id="{pid}" name="{name}"/>'
+            f'<ReferenceRep id="{rid}" name="{name}" format="TESSELLATED" '
+            f'associatedFile="urn:3DXML:{rep}"/>'
+            f'<InstanceRep id="{irid}"><IsAggregatedBy>{pid}</IsAggregatedBy>'
+            f"<IsInstanceOf>{rid}</IsInstanceOf></InstanceRep>"
+            f'<Instance3D id="{iid}" name="{name}.1"><IsAggregatedBy>1</IsAggregatedBy>'
+            f"<IsInstanceOf>{pid}</IsInstanceOf>"
+            "<RelativeMatrix>1 0 0 0 1 0 0 0 1 0 0 0</RelativeMatrix></Instance3D>"
+        )
+    files["Product.3dxml"] = (
+        '<?xml version="1.0"?><Model_3dxml xmlns="http://www.3ds.com/xsd/3DXML">'
+        '<ProductStructure root="1"><Reference3D id="1" name="Root Assembly"/>'
+        + "".join(refs)
+        + "</ProductStructure></Model_3dxml>"
+    )
+    files["Manifest.xml"] = '<?xml version="1.0"?><Manifest><Root>Product.3dxml</Root></Manifest>'
+    with zipfile.ZipFile(path, "w") as archive:
+        for name, text in files.items():
+            archive.writestr(name, text)
+    return Path(path)
+
+
+def test_3dxml_parts_and_names(tmp_path):
+    b = shapes.box_between
+    path = write_3dxml(
+        tmp_path / "plate.3dxml",
+        {
+            "Base Plate": b((0, 0, 0), (40, 40, 5)),
+            "Washer": b((5, 5, 5), (15, 15, 7)),
+            "Washer ": b((25, 25, 5), (35, 35, 7)),
+        },
+    )
+    assembly = load_assembly(path)
+    assert assembly.ids == ("base_plate", "washer_1", "washer_2")
+    assert assembly.parts[0].name == "Base Plate" and assembly.units == "mm"
+    corners = sorted(tuple(p.mesh.bounds[0].round(6)) for p in assembly.parts[1:])
+    assert corners == [(5, 5, 5), (25, 25, 5)]
+    assert shape_classes(assembly.parts)[1:] == ("washer", "washer")
 
 
 def test_gltf_names_and_hierarchy(tmp_path):
