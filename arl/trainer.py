@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 from stable_baselines3.common.logger import Logger, TensorBoardOutputFormat
-from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv
+from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecEnvWrapper
 
 from arl.config import TrainConfig, get_config
 from arl.envs import GameVecEnv, Observer, TurnEnv
@@ -97,6 +97,22 @@ class TrainResult:
     def robust_optimal(self) -> bool:
         """Whether the certified WCPL equals W*."""
         return is_robust_optimal(self.certified_wcpl, self.minimax)
+
+
+class _ScaledRewards(VecEnvWrapper):
+    """The rewards PPO learns from, divided by ``scale`` (``info["episode"]`` keeps the
+    game's units)."""
+
+    def __init__(self, venv: VecEnv, scale: float) -> None:
+        super().__init__(venv)
+        self.scale = scale
+
+    def reset(self):
+        return self.venv.reset()
+
+    def step_wait(self):
+        obs, rewards, dones, infos = self.venv.step_wait()
+        return obs, rewards / self.scale, dones, infos
 
 
 class _EpisodeRecorder(BaseCallback):
@@ -245,6 +261,7 @@ class _Run:
     minimax: float
     envs: dict[int, VecEnv]
     models: dict[int, Any]
+    reward_scale: float = 1.0
     cycles: list[dict] = field(default_factory=list)
     rewards: dict[str, list[float]] = field(default_factory=lambda: {"robot": [], "human": []})
     wall_before: float = 0.0
@@ -255,6 +272,11 @@ class _Run:
     def elapsed(self) -> float:
         """Training time so far, over all runs of a resumed training."""
         return self.wall_before + time.perf_counter() - self.started
+
+    def learning_env(self, player: int) -> VecEnv:
+        """The side's environment as PPO sees it (rewards scaled by ``reward_scale``)."""
+        env = self.envs[player]
+        return env if self.reward_scale == 1.0 else _ScaledRewards(env, self.reward_scale)
 
     def greedy(self, player: int) -> np.ndarray:
         """(n,) the side's greedy policy as edge indices (``NO_MOVE`` for a side without moves)."""
@@ -345,8 +367,15 @@ def _start_run(
     dag: GameDAG, cfg: TrainConfig, seed: int, folder: RunFolder | None, resume: bool
 ) -> _Run:
     """A new run, or the run saved in ``folder`` restored from its checkpoint in force."""
+    if cfg.reward == "paper" and dag.metadata.get("turn_model") == "concurrent":
+        raise ValueError(
+            "reward: the paper's rewards charge the robot its own moves only, and in the "
+            "concurrent game time passes on the human's replies; use the fast config "
+            "(zero-sum rewards)"
+        )
     tables = GameTables.from_dag(dag)
     learners = [p for p in (ROBOT, HUMAN) if tables.can_move_somewhere(p)]
+    solution = solve(dag)  # W* for the log only: training never reads it
     run = _Run(
         dag=dag,
         cfg=cfg,
@@ -354,9 +383,10 @@ def _start_run(
         tables=tables,
         observer=Observer(dag, cfg.obs),
         summary=graph_summary(dag),
-        minimax=solve(dag).minimax,  # for the log only: training never reads it
+        minimax=solution.minimax,
         envs={p: _make_env(dag, p, cfg, seed + p) for p in learners},
         models={},
+        reward_scale=reward_scale(dag, cfg, solution.tct),
     )
     if resume:
         folder.recover()
@@ -368,17 +398,26 @@ def _start_run(
         )
         for p in learners:
             path = folder.model_path(AGENTS[p])
-            run.models[p] = _algo_class(cfg).load(path, env=run.envs[p], device="cpu")
+            env = run.learning_env(p)
+            run.models[p] = _algo_class(cfg).load(path, env=env, device="cpu")
     else:
         if folder is not None:
             folder.start_fresh()
-        run.models = {p: _make_model(cfg, run.envs[p], seed + p) for p in learners}
+        run.models = {p: _make_model(cfg, run.learning_env(p), seed + p) for p in learners}
     for model in run.models.values():
         # No logging but the run folder's TensorBoard events (else SB3 writes to stdout or
         # makes an empty /tmp/SB3-<time> folder per learn()).
         model.set_logger(Logger(folder=None, output_formats=[]))
     run.converged = should_stop(run.cycles, cfg)
     return run
+
+
+def reward_scale(dag: GameDAG, cfg: TrainConfig, tct: float) -> float:
+    """What PPO's rewards are divided by: the cooperative cost TCT on a graph of ``time``
+    costs under ``reward_scale="tct"``, else 1 (:class:`arl.config.TrainConfig`)."""
+    if cfg.reward_scale == "tct" and dag.cost_model == "time" and tct > 0:
+        return float(tct)
+    return 1.0
 
 
 def _train_cycle(run: _Run, cycle: int, folder: RunFolder | None) -> dict:
@@ -421,7 +460,7 @@ def _train_phase(run: _Run, learner: int, cycle: int, folder: RunFolder | None) 
     """
     model = run.models[learner]
     _freeze_opponent(run, learner)
-    model.set_env(run.envs[learner], force_reset=True)
+    model.set_env(run.learning_env(learner), force_reset=True)
     model.set_random_seed(_phase_seed(run.seed, cycle, learner))
     logger = None
     if folder is not None:

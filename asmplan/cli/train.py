@@ -3,12 +3,58 @@
 from __future__ import annotations
 
 import json
+from enum import StrEnum
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import typer
 
 from asmplan.cli.app import OutputFormat, app
 from asmplan.cli.options import GAMES_MAX, SEED_MAX, check_output
+
+if TYPE_CHECKING:  # pragma: no cover - types only
+    from asp.dag import GameDAG
+
+
+class TurnModel(StrEnum):
+    """The game trained on: the paper's alternating turns, or the concurrent game."""
+
+    alternate = "alternate"
+    concurrent = "concurrent"
+
+
+SOURCE_HELP = (
+    "Game DAG (.json asmplan-dag/1 or .graphml), or an assembly (a folder with "
+    "assembly.yaml, the YAML, a .IN2 graph)."
+)
+TURN_MODEL_HELP = (
+    "Game of an assembly: alternate (the paper's turns) or concurrent (agents at once; the "
+    "robots learn against the unbounded adversary, W*(inf)). Default: the spec's."
+)
+
+
+def load_training_game(source: Path, turn_model: TurnModel | None = None) -> GameDAG:
+    """The game DAG that ``train`` and ``evaluate`` play: a game DAG file as it is, or an
+    assembly's alternating game or concurrent game (the latter compiled by
+    :func:`asp.concurrent.build_game` against the unbounded adversary)."""
+    from asmplan import pipeline
+
+    if source.is_file() and source.suffix.lower() in pipeline.GRAPH_SUFFIXES:
+        if turn_model is TurnModel.concurrent:
+            raise ValueError(
+                f"{source}: --turn-model concurrent needs an assembly (a game DAG file is "
+                "an alternating game)"
+            )
+        return pipeline.load_game(source).dag
+    assembly = pipeline.load(source)
+    graph = pipeline.state_graph(assembly)
+    chosen = turn_model or TurnModel(getattr(assembly.spec, "turn_model", "alternate"))
+    if chosen is TurnModel.alternate:
+        return pipeline.game(graph)
+    from asp.concurrent import build_game, concurrent_model
+
+    return build_game(concurrent_model(assembly.spec, graph), None).dag
+
 
 MAX_CYCLES = 100_000
 
@@ -30,7 +76,8 @@ EVALUATE_KEYS = (
 
 @app.command("train")
 def train_command(
-    graph: Path = typer.Argument(..., help="Game DAG (.json asmplan-dag/1 or .graphml)."),
+    graph: Path = typer.Argument(..., help=SOURCE_HELP),
+    turn_model: TurnModel | None = typer.Option(None, "--turn-model", help=TURN_MODEL_HELP),
     config: str = typer.Option("paper", "--config", help="Training configuration: paper|fast."),
     seed: int = typer.Option(
         0, "--seed", min=0, max=SEED_MAX, help="Seed of models, environments and torch."
@@ -45,11 +92,10 @@ def train_command(
     """Train a robust robot policy by alternating PPO against a learned adversarial human."""
     from arl.config import get_config
     from arl.trainer import train
-    from asp.io import load_dag
 
     check_output(output, folder=True)
-    dag = load_dag(graph)
     cfg = get_config(config)
+    dag = load_training_game(graph, turn_model)
     if max_cycles is not None:
         cfg = cfg.replace(max_cycles=max_cycles)
     result = train(dag, cfg, seed=seed, output=output, progress=progress, resume=resume)
@@ -64,7 +110,8 @@ def train_command(
 
 @app.command("evaluate")
 def evaluate_command(
-    graph: Path = typer.Argument(..., help="Game DAG the model was trained on."),
+    graph: Path = typer.Argument(..., help="Game DAG or assembly the model was trained on."),
+    turn_model: TurnModel | None = typer.Option(None, "--turn-model", help=TURN_MODEL_HELP),
     model: Path = typer.Option(..., "--model", help="Run folder written by 'asmplan train'."),
     fmt: OutputFormat = typer.Option(OutputFormat.text, "--format", help="Output format."),
     games: int = typer.Option(
@@ -74,9 +121,8 @@ def evaluate_command(
 ) -> None:
     """Score a trained robot policy exactly: WCPL, certified WCPL, random-human metrics, RR."""
     from arl.trainer import evaluate
-    from asp.io import load_dag
 
-    dag = load_dag(graph)
+    dag = load_training_game(graph, turn_model)
     if not model.is_dir():
         raise ValueError(f"{model}: not a run folder")
     metrics = evaluate(dag, model, n_games=games, seed=seed)

@@ -1,0 +1,85 @@
+"""Learning in the concurrent game (issue 13, part 5): the Gymnasium and PettingZoo forms
+and `asmplan train` / `evaluate` on the vacuum pump, certified by the exact best response."""
+
+import json
+
+import numpy as np
+import pytest
+
+from arl.envs import RobotEnv
+from arl.pettingzoo_env import GameAEC
+from arl.trainer import load_policies
+from asmplan import pipeline
+from asmplan.cli.app import main
+from asp.concurrent import build_game, certified_worst_case, concurrent_model, robustness
+from asp.io import save_dag
+from tests.conftest import REPO
+
+PUMP = REPO / "examples" / "vacuum_pump"
+
+
+@pytest.fixture(scope="module")
+def pump():
+    """The pump's concurrent game against the unbounded adversary, and its curve."""
+    assembly = pipeline.load(PUMP)
+    model = concurrent_model(assembly.spec, pipeline.state_graph(assembly))
+    return build_game(model, None), robustness(model)
+
+
+def test_envs_play_the_concurrent_game(pump):
+    game, curve = pump
+    dag = game.dag
+    rng = np.random.default_rng(0)
+    for _ in range(5):  # PettingZoo: both sides random; the makespan is the human's reward
+        env = GameAEC(dag)
+        env.reset(seed=int(rng.integers(1 << 30)))
+        total = 0.0
+        for _agent in env.agent_iter():
+            obs, _, terminated, truncated, _ = env.last()
+            if terminated or truncated:
+                env.step(None)
+                continue
+            env.step(int(rng.choice(np.flatnonzero(obs["action_mask"]))))
+            total += env.rewards["human"]
+        assert total >= curve.bounds[0] - 1e-9  # no schedule beats the cooperative optimum
+    env = RobotEnv(dag, reward="zero_sum")  # Gymnasium, against a random human
+    _, info = env.reset(seed=1)
+    done, makespan = False, 0.0
+    while not done:
+        action = int(rng.choice(np.flatnonzero(env.action_masks())))
+        _, reward, done, _, info = env.step(action)
+        makespan -= reward
+    assert makespan >= curve.bounds[0] - 1e-9
+
+
+@pytest.mark.usefixtures("deterministic_torch")
+def test_fast_training_on_the_pump_is_certified_robust_optimal(pump, tmp_path, capsys):
+    game, curve = pump
+    run = tmp_path / "run"
+    argv = f"train {PUMP} --turn-model concurrent --config fast --output {run} --no-progress"
+    with pytest.raises(SystemExit) as exit_info:
+        main(argv.split())
+    assert exit_info.value.code == 0
+    assert "(robust-optimal)" in capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        main(
+            ["evaluate", str(PUMP), "--turn-model", "concurrent", "--model", str(run)]
+            + ["--format", "json", "--games", "100"]
+        )
+    metrics = json.loads(capsys.readouterr().out)
+    robot, _ = load_policies(game.dag, run)
+    exact = certified_worst_case(game, robot)  # the exact best response of asp.concurrent
+    assert metrics["certified_wcpl"] == exact == metrics["minimax"] == curve.unbounded
+    assert metrics["robust_optimal"]
+
+
+def test_concurrent_needs_an_assembly_and_zero_sum_rewards(pump, tmp_path, capsys):
+    graph = save_dag(pump[0].dag, tmp_path / "g.json")
+    for argv, message in (
+        (f"train {graph} --turn-model concurrent", "needs an assembly"),
+        (f"train {PUMP} --turn-model concurrent --config paper", "fast config"),
+    ):
+        with pytest.raises(SystemExit) as exit_info:
+            main([*argv.split(), "--output", str(tmp_path / "run"), "--no-progress"])
+        assert exit_info.value.code == 2
+        assert message in capsys.readouterr().err
