@@ -19,6 +19,8 @@ An ``assembly.yaml`` names everything the planner needs besides the part geometr
     turn_model: alternate
     cost: steps                        # or time
     max_states: 20000000               # state graph limit (asmplan plan --max-states)
+    subassemblies:                     # built on their own, then inserted as one unit
+      motor_unit: [MT, PC]             # an operation "motor_unit" inserting it is added
     operations:
       - id: "1.2"                      # ids are strings (1.10 stays "1.10")
         description: Replace hex bit with cross bit on R1
@@ -67,7 +69,7 @@ CONSTRAINT_KEYS = ("topological", "stability", "functional")
 SPEC_FILE = "assembly.yaml"
 TOP_KEYS = (
     "name", "units", "parts", "agents", "tools", "base_part", "gravity", "gripper_approach",
-    "constraints", "turn_model", "cost", "operations", "credit", "max_states",
+    "constraints", "turn_model", "cost", "operations", "credit", "max_states", "subassemblies",
 )  # fmt: skip
 """The top-level keys of ``assembly.yaml``; any other is refused."""
 OPERATION_KEYS = (
@@ -115,6 +117,9 @@ class Operation:
         Explicit predecessor operation ids.
     held : bool
         An agent holds the placed part: the stability constraint does not apply.
+    unit : str
+        The subassembly this operation inserts as one rigid unit (its members were placed in
+        the unit's own workspace by earlier operations); empty for other operations.
     """
 
     id: str
@@ -125,6 +130,7 @@ class Operation:
     sets: tuple[tuple[str, str], ...] = ()
     after: tuple[str, ...] = ()
     held: bool = False
+    unit: str = ""
 
     @property
     def agents(self) -> tuple[str, ...]:
@@ -166,6 +172,8 @@ class AssemblySpec:
     credit: str = ""
     max_states: int | None = None
     generated: bool = False
+    subassemblies: tuple[tuple[str, tuple[str, ...]], ...] = ()
+    """Units built in their own workspace and inserted whole: (unit id, member part ids)."""
 
     @property
     def op_ids(self) -> tuple[str, ...]:
@@ -352,7 +360,7 @@ class _Parser:
             isinstance(max_states, bool) or not isinstance(max_states, int) or max_states < 1
         ):
             raise self.fail("max_states", f"expected a positive integer, got {max_states!r}")
-        return AssemblySpec(
+        spec = AssemblySpec(
             name=str(data.get("name") or Path(self.source).parent.name or "assembly"),
             operations=ops,
             agents=agents,
@@ -369,6 +377,17 @@ class _Parser:
             credit=str(data.get("credit", "")),
             max_states=max_states,
         )
+        raw_units = self.mapping(data.get("subassemblies"), "subassemblies")
+        if not raw_units:
+            return spec
+        from asp.units import with_subassemblies
+
+        units = []
+        for uid, members in raw_units.items():
+            if not isinstance(members, list):
+                raise self.fail(f"subassemblies.{uid}", "expected a list of part ids")
+            units.append((str(uid), tuple(self.text(m, f"subassemblies.{uid}") for m in members)))
+        return with_subassemblies(spec, units)
 
     def parts(self, raw) -> tuple[Part, ...]:
         if raw is None:
