@@ -31,6 +31,7 @@ import numpy as np
 
 from asp import rules
 from asp.dag import GameDAG
+from asp.errors import GameError
 from asp.numbers import plain
 from asp.rules import HUMAN, ROBOT
 from asp.solve import PolicyEvaluation, Solution, evaluate_policy, node_order, play, solve
@@ -67,7 +68,7 @@ def simulate_random_human(
     (n_games,) float64
     """
     if n_games < 1:
-        raise ValueError(f"n_games: expected a positive integer, got {n_games}")
+        raise GameError(f"n_games: expected a positive integer, got {n_games}")
     rng = np.random.default_rng(seed)
     h_indptr, h_edges = rules.move_table(dag, HUMAN)
     can_move = rules.has_move(dag)
@@ -93,7 +94,7 @@ def simulate_random_human(
         cost[moving] += move_cost[edge[moving]]
         node[moving] = dag.targets[edge[moving]]
         player[active] = rules.other(player[active])
-    raise ValueError("simulation did not reach the end node: is the graph acyclic?")
+    raise GameError("simulation did not reach the end node: is the graph acyclic?")
 
 
 def _random_moves(dag: GameDAG, robot_policy, h_indptr, h_edges, v: int, p: int) -> list[int]:
