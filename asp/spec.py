@@ -53,7 +53,8 @@ a limit are refused (:mod:`cad.yamlfile`). For a CAD file or a folder of part me
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field
+from collections.abc import Iterable
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import networkx as nx
@@ -380,8 +381,6 @@ class _Parser:
         raw_units = self.mapping(data.get("subassemblies"), "subassemblies")
         if not raw_units:
             return spec
-        from asp.units import with_subassemblies
-
         units = []
         for uid, members in raw_units.items():
             if not isinstance(members, list):
@@ -528,6 +527,64 @@ class _Parser:
                         f"operations[{op.id}].requires",
                         f"tool value {t} = {v!r} is needed but never set nor initial",
                     )
+
+
+def with_subassemblies(
+    spec: AssemblySpec, units: Iterable[tuple[str, Iterable[str]]]
+) -> AssemblySpec:
+    """``spec`` with the subassemblies ``units`` (unit id, member part ids) and their
+    insertion operations added.
+
+    Raises
+    ------
+    ValueError
+        One line naming the unit: an unknown or repeated member, the base part as a member,
+        fewer than two members, an id already used, or an operation placing members of the
+        unit and other parts.
+    """
+    units = [(str(u), tuple(dict.fromkeys(str(m) for m in ms))) for u, ms in units]
+    known = set(spec.part_ids) | set(spec.placed_parts)
+    taken = {m for _, ms in spec.subassemblies for m in ms}
+    ids = set(spec.op_ids) | known | {u for u, _ in spec.subassemblies}
+    ops = list(spec.operations)
+    for uid, members in units:
+        where = f"{spec.source}: subassemblies.{uid}"
+        if uid in ids:
+            raise ValueError(f"{where}: the id is already used by an operation or part")
+        if len(members) < 2:
+            raise ValueError(f"{where}: a subassembly needs at least two parts")
+        for m in members:
+            if m not in known:
+                raise ValueError(f"{where}: unknown part {m!r}")
+            if m in taken:
+                raise ValueError(f"{where}: part {m!r} is already in another subassembly")
+            if m == spec.base_part:
+                raise ValueError(f"{where}: the base part {m!r} cannot be in a subassembly")
+        member_ops = [op for op in ops if set(op.parts) & set(members)]
+        for op in member_ops:
+            if not set(op.parts) <= set(members):
+                raise ValueError(
+                    f"{where}: operation {op.id} places parts inside and outside the unit"
+                )
+        unplaced = set(members) - {p for op in member_ops for p in op.parts}
+        if unplaced:
+            raise ValueError(f"{where}: no operation places part {sorted(unplaced)[0]!r}")
+        longest: dict[str, float] = {}
+        for op in member_ops:
+            for agent, d in op.durations:
+                longest[agent] = max(longest.get(agent, 0.0), d)
+        ops.append(
+            Operation(
+                id=uid,
+                description=f"insert subassembly {uid} ({', '.join(members)})",
+                durations=tuple(longest.items()),
+                after=tuple(op.id for op in member_ops),
+                unit=uid,
+            )
+        )
+        taken |= set(members)
+        ids.add(uid)
+    return replace(spec, operations=tuple(ops), subassemblies=(*spec.subassemblies, *units))
 
 
 def check_predecessors(ops, source: str) -> None:
