@@ -12,7 +12,7 @@ from pathlib import Path
 import typer
 
 from asmplan.cli.app import choices
-from asp.spec import COST_MODELS
+from asp.rules import COST_MODELS
 
 SEED_MAX = 2**32 - 1
 """Seeds are 32-bit: numpy, torch and CP-SAT all accept them."""
