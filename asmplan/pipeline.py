@@ -51,7 +51,6 @@ PLAN_FILES = ("plan.json", "dag.png")
 """The files ``asmplan plan`` writes (besides ``manifest.json``)."""
 CONCURRENT_FILES = ("robustness.png", "gantt_cooperative.png", "gantt_worst.png")
 """The figures ``asmplan plan --turn-model concurrent`` adds (:mod:`asp.concurrent_plan`)."""
-TURN_MODELS = ("alternate", "concurrent")
 
 Progress = Callable[[str], None]
 """A callback that shows one line of progress (e.g. prints it on stderr)."""
@@ -505,6 +504,8 @@ def plan(
     sched = schedule(assembly, graph, time_limit=time_limit, seed=seed)
     turn = assembly.spec.turn_model if turn_model is None else turn_model
     concurrent = None
+    from asp.spec import TURN_MODELS
+
     if turn not in TURN_MODELS:
         from asp.errors import GraphError
 

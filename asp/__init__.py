@@ -1,7 +1,8 @@
 """asp: assembly sequence planning as a robot-vs-human game.
 
-The game DAG (:mod:`asp.dag`), its file formats (:mod:`asp.io`), the synthetic generator
-(:mod:`asp.synth`), the exact solver (:mod:`asp.solve`) and the metrics (:mod:`asp.metrics`).
+The game DAG (:mod:`asp.dag`), the rules of play on it (:mod:`asp.rules`), its file formats
+(:mod:`asp.io`), the synthetic generator (:mod:`asp.synth`), the exact solver
+(:mod:`asp.solve`) and the metrics (:mod:`asp.metrics`).
 This package never imports torch.
 """
 

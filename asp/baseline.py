@@ -29,6 +29,7 @@ import numpy as np
 
 from asp import rules
 from asp.dag import GameDAG
+from asp.errors import ScheduleError
 from asp.numbers import json_number, plain
 from asp.rules import HUMAN, ROBOT
 
@@ -161,9 +162,9 @@ def _solver(time_limit: float, workers: int, seed: int):
     from ortools.sat.python import cp_model
 
     if workers < 1:
-        raise ValueError(f"workers: expected a positive integer, got {workers}")
+        raise ScheduleError(f"workers: expected a positive integer, got {workers}")
     if not time_limit > 0:
-        raise ValueError(f"time_limit: expected a positive number of seconds, got {time_limit}")
+        raise ScheduleError(f"time_limit: expected a positive number of seconds, got {time_limit}")
     solver = cp_model.CpSolver()
     solver.parameters.max_time_in_seconds = float(time_limit)
     solver.parameters.num_workers = int(workers)
@@ -364,7 +365,7 @@ def min_makespan(
     dur = [[round(d * scale) for _, d in t.modes] for t in tasks]
     horizon = max(1, sum(max(d) for d in dur))
     if len(problem.resources) and any(len(t.demands) != len(problem.resources) for t in tasks):
-        raise ValueError(f"{problem.name}: every task needs one demand per resource")
+        raise ScheduleError(f"{problem.name}: every task needs one demand per resource")
 
     # Model.
     model = cp_model.CpModel()
@@ -501,7 +502,7 @@ def _tool_constraints(model, problem: ScheduleProblem, start, end) -> None:
         setters = {i: v for i, task in enumerate(tasks) for t, v in task.sets if t == tool}
         users = {i: v for i, task in enumerate(tasks) for t, v in task.requires if t == tool}
         if tool not in initial:
-            raise ValueError(f"{problem.name}: tool {tool!r} has no initial value")
+            raise ScheduleError(f"{problem.name}: tool {tool!r} has no initial value")
         # Variables: before[(s, u)] true iff setter s ends before task u starts (else u ends
         # before s starts). One boolean per unordered pair of setters.
         before: dict[tuple[int, int], object] = {}
@@ -525,7 +526,7 @@ def _tool_constraints(model, problem: ScheduleProblem, start, end) -> None:
             good = [s for s, w in setters.items() if w == v and s != u]
             if initial[tool] != v:
                 if not good:
-                    raise ValueError(
+                    raise ScheduleError(
                         f"{problem.name}: task {tasks[u].id} needs {tool} = {v} but no other "
                         "task sets it"
                     )

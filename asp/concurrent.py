@@ -52,7 +52,7 @@ from __future__ import annotations
 import math
 import sys
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -197,6 +197,34 @@ class ConcurrentModel:
         """A scaled time in the spec's units."""
         return scaled / self.scale
 
+    @property
+    def succ_change_max(self) -> int:
+        """The longest tool-change time (scaled) any transition adds."""
+        return max((c for _, c in self.succ.values()), default=0)
+
+    def kernel_arrays(self) -> tuple:
+        """The arrays :func:`asp.concurrent_kernel.build_kernel` takes (its docstring)."""
+        n_states, n = self.graph.n_states, self.n_ops
+        nxt = np.full((n_states, n), -1, dtype=np.int64)
+        chg = np.zeros((n_states, n), dtype=np.int64)
+        for (s, o), (t, c) in self.succ.items():
+            nxt[s, o] = t
+            chg[s, o] = c
+        nw = len(self.workers)
+        width = max((len(c) for row in self.choices for c in row), default=1)
+        dur = np.zeros((nw, n, max(1, width)), dtype=np.int64)
+        ndur = np.zeros((nw, n), dtype=np.int64)
+        for w, row in enumerate(self.choices):
+            for o, c in enumerate(row):
+                ndur[w, o] = len(c)
+                dur[w, o, : len(c)] = c
+        counts = np.array([len(e) for e in self.enabled], dtype=np.int64)
+        en_ptr = np.zeros(n_states + 1, dtype=np.int64)
+        np.cumsum(counts, out=en_ptr[1:])
+        en_ops = np.array([o for e in self.enabled for o in e], dtype=np.int64)
+        side = np.array([w.side for w in self.workers], dtype=np.int8)
+        return nxt, chg, dur, ndur, self.conflict, en_ptr, en_ops, self.complete, side
+
 
 def concurrent_model(
     spec: AssemblySpec, graph: StateGraph, *, step: float | None = 1.0
@@ -233,7 +261,7 @@ def concurrent_model(
             raise SpecError(f"{where}: operations[{op.id}]: no agent may do this operation")
         for w, x in enumerate(workers):
             if x.agent in op.agents:
-                lo, hi = duration_range(op, x.agent)
+                lo, hi = op.duration_range(x.agent)
                 if not (math.isfinite(lo) and math.isfinite(hi)) or lo < 0 or lo > hi:
                     raise SpecError(
                         f"{where}: operations[{op.id}].agents.{x.agent}: expected a duration "
@@ -302,18 +330,6 @@ def concurrent_model(
     )
 
 
-def duration_range(op, agent: str) -> tuple[float, float]:
-    """``(min, max)`` duration of ``agent`` for ``op`` (``min == max`` without a range)."""
-    ranged = getattr(op, "duration_range", None)
-    if ranged is not None:
-        lo, hi = ranged(agent)
-        return float(lo), float(hi)
-    d = op.duration(agent)
-    if isinstance(d, tuple | list):
-        return float(d[0]), float(d[-1])
-    return float(d), float(d)
-
-
 # --------------------------------------------------------------------------- the game
 
 
@@ -375,20 +391,33 @@ class ConcurrentGame:
         return self.budgets == (UNBOUNDED,)
 
 
+LABEL_LIMIT = 200_000
+"""Above this many edges the DAG's edge labels are left out (the actions hold the moves)."""
+
+
 def build_game(
     model: ConcurrentModel,
     budgets: int | None | list,
     *,
     max_nodes: int = DEFAULT_MAX_NODES,
     progress: bool = False,
+    compiled: bool | None = None,
 ) -> ConcurrentGame:
     """Build the concurrent game for the budgets ``0..K`` (``budgets=K``) or unbounded (``None``).
+
+    Parameters
+    ----------
+    compiled : bool, optional
+        Use the numba builder (:mod:`asp.concurrent_kernel`); default whenever its packed
+        state key fits. ``False``: the Python builder (the same game, slower).
 
     Raises
     ------
     ValueError
         A negative budget, or more than ``max_nodes`` nodes (the message names ``--max-k``).
     """
+    from asp import concurrent_kernel as kernel
+
     t0 = time.perf_counter()
     where = model.spec.source or model.spec.name
     if budgets is None:
@@ -398,6 +427,117 @@ def build_game(
         if k < 0:
             raise GameError(f"k: expected a deviation budget >= 0, got {k}")
         levels = list(range(k + 1))
+    too_big = GameError(
+        f"{where}: the concurrent game exceeds {max_nodes:,} nodes (budgets "
+        f"{'inf' if levels == [UNBOUNDED] else f'{levels[0]}..{levels[-1]}'}); bound the "
+        "deviation budget with --max-k, coarsen the human duration grid (--duration-step), "
+        "or add precedences"
+    )
+    longest = max(
+        (d + int(model.succ_change_max) for row in model.choices for c in row for d in c),
+        default=0,
+    )
+    fits = kernel.fits(len(model.workers), model.n_ops, longest, model.graph.n_states, levels[-1])
+    if compiled is None:
+        compiled = fits
+    if compiled:
+        if not fits:
+            raise GameError(f"{where}: the compiled builder's packed state key does not fit")
+        arrays = model.kernel_arrays()
+        out = kernel.build_kernel(*arrays, np.array(levels, dtype=np.int64), int(max_nodes))
+        overflow, rows, starts_a, src, dst, cost, side, e_ops, e_dur, e_dev = out
+        if overflow:
+            raise too_big
+        order = np.argsort(src, kind="stable")
+        src, dst, cost, side = src[order], dst[order], cost[order], side[order]
+        nodes = _NodeRows(rows, model.humans)
+        actions = _ActionRows(side, e_ops[order], e_dur[order], e_dev[order], cost)
+        starts = {b: int(starts_a[i]) for i, b in enumerate(levels)}
+        end = 0
+    else:
+        nodes, actions, starts, end, src, dst, cost, side = _build_python(
+            model, levels, max_nodes, too_big, progress
+        )
+    labels = len(actions) <= LABEL_LIMIT
+    dag = from_arrays(
+        list(range(len(nodes))),
+        src,
+        dst,
+        np.asarray(cost, dtype=np.float64) / model.scale,
+        np.asarray(side, dtype=np.int8),
+        start=starts[levels[-1]],
+        end=end,
+        operations=tuple(_edge_ops(model, a) for a in actions) if labels else None,
+        agents=tuple(_edge_agents(model, a) for a in actions) if labels else None,
+        cost_model="time",
+        metadata={
+            "generator": "asmplan.concurrent/1",
+            "assembly": model.spec.name,
+            "source": model.spec.source,
+            "turn_model": "concurrent",
+            "budgets": [None if b == UNBOUNDED else b for b in levels],
+            "workers": {w.name: ("robot" if w.side == ROBOT else "human") for w in model.workers},
+        },
+    )
+    return ConcurrentGame(
+        model=model,
+        dag=dag,
+        budgets=tuple(levels),
+        starts=starts,
+        nodes=nodes,
+        actions=actions,
+        seconds=time.perf_counter() - t0,
+    )
+
+
+class _NodeRows(Sequence):
+    """The compiled builder's node rows read as the Python builder's node tuples."""
+
+    def __init__(self, rows: np.ndarray, humans: list[int]):
+        self.rows = rows
+        self.humans = humans
+        self.nw = (rows.shape[1] - 3) // 3
+
+    def __len__(self) -> int:
+        return int(self.rows.shape[0])
+
+    def __getitem__(self, v):
+        row = self.rows[int(v)].tolist()
+        nw = self.nw
+        kind, state, budget = row[0], row[1], row[2]
+        if kind == 2:
+            return ("E", -1, (), 0, ())
+        ops, rem, instr = row[3 : 3 + nw], row[3 + nw : 3 + 2 * nw], row[3 + 2 * nw :]
+        running = tuple((o, r) if o >= 0 else (WAIT, 0) for o, r in zip(ops, rem, strict=True))
+        told = ()
+        if kind == 1 and budget != UNBOUNDED:
+            told = tuple(instr[w] for w in self.humans if ops[w] == WAIT)
+        return ("R" if kind == 0 else "H", state, running, budget, told)
+
+
+class _ActionRows(Sequence):
+    """The compiled builder's edge arrays read as :class:`Commit` and :class:`Reply`."""
+
+    def __init__(self, side, ops, durations, deviations, cost):
+        self.side, self.ops, self.durations = side, ops, durations
+        self.deviations, self.cost = deviations, cost
+
+    def __len__(self) -> int:
+        return int(self.side.shape[0])
+
+    def __getitem__(self, e):
+        e = int(e)
+        ops = tuple(None if o == -2 else o for o in self.ops[e].tolist())
+        if self.side[e] == ROBOT:
+            return Commit(ops=ops)
+        durs = tuple(None if d == -2 else d for d in self.durations[e].tolist())
+        return Reply(
+            ops=ops, durations=durs, deviations=int(self.deviations[e]), delta=int(self.cost[e])
+        )
+
+
+def _build_python(model: ConcurrentModel, levels, max_nodes, too_big, progress):
+    """The Python builder: a depth-first search over the game's nodes (dict of tuples)."""
     nw = len(model.workers)
     idle = tuple((WAIT, 0) for _ in range(nw))
     index: dict = {}
@@ -410,11 +550,7 @@ def build_game(
         if v is None:
             v = len(nodes)
             if v >= max_nodes:
-                raise GameError(
-                    f"{where}: the concurrent game exceeds {max_nodes:,} nodes (budgets "
-                    f"{levels[0]}..{levels[-1]}); bound the deviation budget with --max-k, "
-                    "coarsen the human duration grid (--duration-step), or add precedences"
-                )
+                raise too_big
             index[key] = v
             nodes.append(key)
             todo.append(v)
@@ -447,38 +583,18 @@ def build_game(
                 actions.append(reply)
         if progress and len(nodes) % 200_000 == 0:
             print(f"  concurrent game: {len(nodes):,} nodes ...", file=sys.stderr)
-    end = index[end_key]
     src_a = np.array(src, dtype=np.int64)
     order = np.argsort(src_a, kind="stable")
     acts = [actions[i] for i in order]
-    dag = from_arrays(
-        list(range(len(nodes))),
-        src_a,
-        np.array(dst, dtype=np.int64),
-        np.array(cost, dtype=np.float64) / model.scale,
-        np.array(side, dtype=np.int8),
-        start=starts[levels[-1]],
-        end=end,
-        operations=tuple(_edge_ops(model, a) for a in acts),
-        agents=tuple(_edge_agents(model, a) for a in acts),
-        cost_model="time",
-        metadata={
-            "generator": "asmplan.concurrent/1",
-            "assembly": model.spec.name,
-            "source": model.spec.source,
-            "turn_model": "concurrent",
-            "budgets": [None if b == UNBOUNDED else b for b in levels],
-            "workers": {w.name: ("robot" if w.side == ROBOT else "human") for w in model.workers},
-        },
-    )
-    return ConcurrentGame(
-        model=model,
-        dag=dag,
-        budgets=tuple(levels),
-        starts=starts,
-        nodes=nodes,
-        actions=acts,
-        seconds=time.perf_counter() - t0,
+    return (
+        nodes,
+        acts,
+        starts,
+        index[end_key],
+        src_a[order],
+        np.array(dst, dtype=np.int64)[order],
+        np.array(cost, dtype=np.int64)[order],
+        np.array(side, dtype=np.int8)[order],
     )
 
 
@@ -756,10 +872,11 @@ def schedule_rule(rows: list[dict]) -> RobotRule:
     """The robot policy of a fixed schedule (a plan that ignores what the person does).
 
     ``rows`` are ``{"task", "agent", "start"}`` (a CP-SAT schedule). Each worker keeps the
-    list of its operations in start order. At an event each free robot starts the first
-    operation of its list not yet done or running when it may start now, else waits; each
-    free human is told the first of its list the same way. When that leaves nothing to run,
-    the first valid commitment is taken (the schedule has no answer there).
+    list of its operations in start order and wants the first one not yet done or running
+    (the person is told it). At an event the rule takes the commitment in which every free
+    worker does what it wants, if that is valid; otherwise (a deviation made the wanted
+    operation impossible for now) the valid commitment with the most workers as wanted,
+    ties by edge order: the schedule has no answer there, it keeps as much of it as it can.
     """
     order: dict[str, list[str]] = {}
     for row in sorted(rows, key=lambda r: (r["start"], r["task"])):

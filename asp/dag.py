@@ -20,6 +20,7 @@ import networkx as nx
 import numpy as np
 
 from asp import rules
+from asp.errors import GraphError
 from asp.rules import ANY, HUMAN, PLAYERS, ROBOT, SIDE_NAMES, side_from_name
 
 MAX_COST = 1e12
@@ -118,7 +119,7 @@ class GameDAG:
         key = str(node_id)
         if key in lookup:
             return lookup[key]
-        raise ValueError(f"unknown node {node_id!r}")
+        raise GraphError(f"unknown node {node_id!r}")
 
     @cached_property
     def _lookup(self) -> dict:
@@ -192,11 +193,11 @@ def from_edges(
     """
     node_ids = tuple(node_ids)
     if not node_ids:
-        raise ValueError("empty graph: expected at least one node")
+        raise GraphError("empty graph: expected at least one node")
     index: dict = {}
     for i, nid in enumerate(node_ids):
         if nid in index:
-            raise ValueError(f"duplicate node {nid!r}")
+            raise GraphError(f"duplicate node {nid!r}")
         index[nid] = i
     edge_list = list(edges)
     m = len(edge_list)
@@ -205,18 +206,18 @@ def from_edges(
     for k, (u, v) in enumerate(edge_list):
         for x in (u, v):
             if x not in index:
-                raise ValueError(f"edge ({u!r}, {v!r}) names unknown node {x!r}")
+                raise GraphError(f"edge ({u!r}, {v!r}) names unknown node {x!r}")
         src[k], dst[k] = index[u], index[v]
     cost_arr = np.ones(m) if costs is None else np.asarray(costs, dtype=np.float64)
     side_arr = np.full(m, ANY, np.int8) if sides is None else np.asarray(sides, dtype=np.int8)
     for name, arr in (("costs", cost_arr), ("sides", side_arr)):
         if arr.shape != (m,):
-            raise ValueError(f"{name}: expected {m} values, got shape {arr.shape}")
+            raise GraphError(f"{name}: expected {m} values, got shape {arr.shape}")
     for name, labels in (("operations", operations), ("agents", agents)):
         if labels is not None and len(labels) != m:
-            raise ValueError(f"{name}: expected {m} labels, got {len(labels)}")
+            raise GraphError(f"{name}: expected {m} labels, got {len(labels)}")
     if node_labels is not None and len(node_labels) != len(node_ids):
-        raise ValueError(f"node_labels: expected {len(node_ids)} labels, got {len(node_labels)}")
+        raise GraphError(f"node_labels: expected {len(node_ids)} labels, got {len(node_labels)}")
     return from_arrays(
         node_ids,
         src,
@@ -239,7 +240,7 @@ def _resolve(index: dict, nid, what: str) -> int:
     for key, i in index.items():
         if str(key) == str(nid):
             return i
-    raise ValueError(f"{what} node {nid!r} is not in the graph")
+    raise GraphError(f"{what} node {nid!r} is not in the graph")
 
 
 def from_arrays(
@@ -270,16 +271,16 @@ def from_arrays(
     """
     n = len(node_ids)
     if n == 0:
-        raise ValueError("empty graph: expected at least one node")
+        raise GraphError("empty graph: expected at least one node")
     src = np.asarray(src, dtype=np.int64)
     dst = np.asarray(dst, dtype=np.int64)
     m = src.shape[0]
     if dst.shape != (m,):
-        raise ValueError(f"src and dst: expected equal lengths, got {m} and {dst.shape[0]}")
+        raise GraphError(f"src and dst: expected equal lengths, got {m} and {dst.shape[0]}")
     costs = np.ones(m) if costs is None else np.asarray(costs, dtype=np.float64)
     sides = np.full(m, ANY, np.int8) if sides is None else np.asarray(sides, dtype=np.int8)
     if m and (min(src.min(), dst.min()) < 0 or max(src.max(), dst.max()) >= n):
-        raise ValueError(f"edge endpoints: expected node indices in [0, {n}), got out of range")
+        raise GraphError(f"edge endpoints: expected node indices in [0, {n}), got out of range")
     order = np.argsort(src, kind="stable")
     if m and np.any(order != np.arange(m)):
         src, dst, costs, sides = src[order], dst[order], costs[order], sides[order]
@@ -315,7 +316,7 @@ def from_arrays(
 def _unique_node(candidates: np.ndarray, node_ids: Sequence, what: str, lacking: str) -> int:
     if candidates.size != 1:
         names = ", ".join(repr(node_ids[i]) for i in candidates[:5])
-        raise ValueError(
+        raise GraphError(
             f"cannot infer the {what} node: expected exactly one node without {lacking}, "
             f"found {candidates.size}" + (f" ({names})" if candidates.size else "")
         )
@@ -342,7 +343,7 @@ def topological_order(dag: GameDAG) -> np.ndarray:
         seen += frontier.size
         out.append(frontier)
     if seen != n:
-        raise ValueError(f"graph has a cycle: {_cycle_text(dag, dag.sources)}")
+        raise GraphError(f"graph has a cycle: {_cycle_text(dag, dag.sources)}")
     return np.concatenate(out).astype(np.int64)
 
 
@@ -367,36 +368,36 @@ def _cycle_text(dag: GameDAG, src: np.ndarray) -> str:
 def validate_dag(dag: GameDAG) -> None:
     """Check the invariants the solvers rely on; raise ``ValueError`` naming the fault."""
     if dag.n_nodes == 0:
-        raise ValueError("empty graph: expected at least one node")
+        raise GraphError("empty graph: expected at least one node")
     rules.check_cost_model(dag.cost_model)
     if dag.turn_model != "alternate":
-        raise ValueError(f"turn_model: expected 'alternate', got {dag.turn_model!r}")
+        raise GraphError(f"turn_model: expected 'alternate', got {dag.turn_model!r}")
     if dag.n_edges:
         bad = np.flatnonzero(~np.isfinite(dag.costs) | (dag.costs < 0) | (dag.costs > MAX_COST))
         if bad.size:
             e = int(bad[0])
             u, v = dag.node_ids[int(dag.sources[e])], dag.node_ids[int(dag.targets[e])]
-            raise ValueError(
+            raise GraphError(
                 f"edge ({u!r}, {v!r}) has negative, non-finite or too large cost "
                 f"{dag.costs[e]}: expected 0 to {MAX_COST:g}"
             )
         if np.any((dag.sides < 0) | (dag.sides > ANY)):
-            raise ValueError("sides: expected values 0 (robot), 1 (human) or 2 (any)")
+            raise GraphError("sides: expected values 0 (robot), 1 (human) or 2 (any)")
         loops = np.flatnonzero(dag.sources == dag.targets)
         if loops.size:
             nid = dag.node_ids[int(dag.targets[loops[0]])]
-            raise ValueError(f"graph has a cycle: self-loop at node {nid!r}")
+            raise GraphError(f"graph has a cycle: self-loop at node {nid!r}")
     topological_order(dag)  # raises on a cycle, naming one
     if dag.indptr[dag.end + 1] != dag.indptr[dag.end]:
-        raise ValueError(f"end node {dag.node_ids[dag.end]!r} has out-edges")
+        raise GraphError(f"end node {dag.node_ids[dag.end]!r} has out-edges")
     if not reachable(dag)[dag.end]:
-        raise ValueError(
+        raise GraphError(
             f"no path from start {dag.node_ids[dag.start]!r} to end {dag.node_ids[dag.end]!r}"
         )
     dead = np.flatnonzero(np.diff(dag.indptr) == 0)
     dead = dead[dead != dag.end]
     if dead.size:
-        raise ValueError(
+        raise GraphError(
             f"node {dag.node_ids[int(dead[0])]!r} has no out-edge but is not the end node "
             f"{dag.node_ids[dag.end]!r}"
         )
@@ -424,7 +425,7 @@ def from_networkx(g: nx.DiGraph, *, start=None, end=None, cost_model: str | None
     Parallel edges of a ``MultiDiGraph`` are distinct moves, as in ``asmplan-dag/1``.
     """
     if not isinstance(g, nx.DiGraph):
-        raise ValueError(f"expected a networkx DiGraph, got {type(g).__name__}")
+        raise GraphError(f"expected a networkx DiGraph, got {type(g).__name__}")
     nodes = list(g.nodes)
     start = g.graph.get("start") if start is None else start
     end = g.graph.get("end") if end is None else end
@@ -435,7 +436,7 @@ def from_networkx(g: nx.DiGraph, *, start=None, end=None, cost_model: str | None
     try:
         costs = [float(d.get("cost", 1.0)) for _, _, d in edges]
     except (TypeError, ValueError) as exc:
-        raise ValueError(f"edge cost: expected a number ({exc})") from None
+        raise GraphError(f"edge cost: expected a number ({exc})") from None
     return from_edges(
         nodes,
         [(u, v) for u, v, _ in edges],

@@ -38,6 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from asp.errors import SpecError
 from asp.spec import DIRECTIONS, AssemblySpec, tool_values
 
 WORD_BITS = 64
@@ -91,7 +92,7 @@ class InsertionOracle:
         try:
             return self.parts.index(part)
         except ValueError:
-            raise ValueError(f"unknown part {part!r}") from None
+            raise SpecError(f"unknown part {part!r}") from None
 
     def sets(self, assembled) -> np.ndarray:
         """(k, PW) uint64 part sets from ``(k, PW)``, ``(k,)`` (one word) or Python ints."""
@@ -239,14 +240,14 @@ def insertion_oracle(spec: AssemblySpec, relations=None) -> InsertionOracle:
         sp = tc if sp is None else np.asarray(sp, dtype=bool)
         m = len(rel_ids)
         if tc.shape != (m, m, 6) or tt.shape != (m, m, 6) or sp.shape != (m, m, 6):
-            raise ValueError(
+            raise SpecError(
                 f"relations: expected tc, tt and sp of shape ({m}, {m}, 6), got {tc.shape}, "
                 f"{tt.shape} and {sp.shape}"
             )
         needed = set(spec.placed_parts) | ({spec.base_part} if spec.base_part else set())
         missing = sorted(needed - set(rel_ids))
         if missing:
-            raise ValueError(
+            raise SpecError(
                 f"{spec.source}: parts: no geometry (relations) for part {missing[0]!r}"
             )
         g = DIRECTIONS.index(spec.gravity)
@@ -353,10 +354,10 @@ class OperationModel:
         keys = np.asarray(keys, dtype=np.uint64)
         if keys.ndim == 1:
             if self.n_words != 1:
-                raise ValueError(f"expected (k, {self.n_words}) state keys, got {keys.shape}")
+                raise SpecError(f"expected (k, {self.n_words}) state keys, got {keys.shape}")
             keys = keys[:, None]
         if keys.ndim != 2 or keys.shape[1] != self.n_words:
-            raise ValueError(f"expected (k, {self.n_words}) state keys, got {keys.shape}")
+            raise SpecError(f"expected (k, {self.n_words}) state keys, got {keys.shape}")
         return keys
 
     def has_op(self, keys: np.ndarray, i: int) -> np.ndarray:
@@ -518,7 +519,7 @@ def operation_model(spec: AssemblySpec, relations=None, *, _min_words: int = 1) 
     ops = spec.operations
     n_ops = len(ops)
     if n_ops > MAX_OPS:
-        raise ValueError(
+        raise SpecError(
             f"{spec.source}: operations: {n_ops} operations, at most {MAX_OPS:,} are supported; "
             f"split the assembly into subassemblies"
         )

@@ -15,6 +15,7 @@ import numpy as np
 
 from asp import rules
 from asp.dag import ANY, HUMAN, ROBOT, GameDAG, from_arrays
+from asp.errors import GameError
 from asp.state_graph import StateGraph
 
 LABEL_LIMIT = 100_000
@@ -53,7 +54,7 @@ def game_dag(
     model = graph.model
     cost = spec.cost if cost is None else cost
     if cost not in rules.COST_MODELS:
-        raise ValueError(f"cost: expected 'steps' or 'time', got {cost!r}")
+        raise GameError(f"cost: expected 'steps' or 'time', got {cost!r}")
     alive = graph.coreachable()
     done = graph.complete
     # New index: alive states in order, complete ones merged into the last index.

@@ -70,6 +70,32 @@ def spec_geometry(spec: AssemblySpec):
     return load_parts(spec.parts, spec.folder, spec.units)
 
 
+def spec_hierarchy(spec: AssemblySpec) -> tuple[tuple[str, tuple[str, ...]], ...]:
+    """The CAD file's hierarchy over ``spec``'s parts: group id -> the spec's part ids.
+
+    Parts named ``scene#node`` are looked up in their scene's tree (:mod:`cad.scene`);
+    groups keep the spec's parts among their members and count when two or more remain.
+    Outermost groups first; empty when no part comes from a scene with a hierarchy.
+    """
+    from cad.scene import read_scene
+
+    by_file: dict[str, dict[str, str]] = {}  # scene file -> scene part id -> spec part id
+    for part in spec.parts:
+        name, _, node = str(part.file or "").partition("#")
+        if node:
+            scene = read_scene(spec.folder / name)
+            k = scene.find(node)
+            if k is not None:
+                by_file.setdefault(name, {})[scene.ids[k]] = part.id
+    out = []
+    for name, spec_id in by_file.items():
+        for gid, members in read_scene(spec.folder / name).groups:
+            mapped = tuple(spec_id[m] for m in members if m in spec_id)
+            if len(mapped) >= 2:
+                out.append((gid, mapped))
+    return tuple(out)
+
+
 def cad_assembly(path: str | Path):
     """The geometry of a CAD file or a folder of part meshes (``cad.load_assembly``).
 

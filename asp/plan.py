@@ -13,6 +13,7 @@ import numpy as np
 
 from asp import rules
 from asp.dag import GameDAG
+from asp.errors import GameError
 from asp.numbers import cost_text, plain
 from asp.rules import HUMAN, ROBOT
 from asp.solve import Solution
@@ -92,7 +93,7 @@ def play_steps(
         else:
             e = int(robot_policy[v]) if player == ROBOT else int(human_choice(v, moves))
             if e not in moves:
-                raise ValueError(f"no valid {_side(player)} move at node {dag.node_ids[v]!r}")
+                raise GameError(f"no valid {_side(player)} move at node {dag.node_ids[v]!r}")
             op = dag.operations[e] if dag.operations else ""
             agent = dag.agents[e] if dag.agents else ""
             steps.append(
@@ -108,7 +109,7 @@ def play_steps(
                 )
             )
             v, player, _ = rules.step(dag, v, player, e)
-    raise ValueError("the game did not reach the end node")
+    raise GameError("the game did not reach the end node")
 
 
 def robust_plan(

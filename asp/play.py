@@ -22,6 +22,7 @@ import numpy as np
 
 from asp import rules
 from asp.dag import GameDAG
+from asp.errors import GameError
 from asp.numbers import cost_text
 from asp.rules import HUMAN, ROBOT, cost_at_most, costs_close
 from asp.solve import NO_MOVE, Solution, as_policy_array, evaluate_policy, solve
@@ -208,7 +209,7 @@ class GameSession:
         solution: Solution | None = None,
     ) -> None:
         if person not in (ROBOT, HUMAN):
-            raise ValueError(f"person: expected {ROBOT} (robot) or {HUMAN} (human), got {person}")
+            raise GameError(f"person: expected {ROBOT} (robot) or {HUMAN} (human), got {person}")
         self.dag = dag
         self.person = person
         self.solution = solution if solution is not None else solve(dag)
@@ -220,7 +221,7 @@ class GameSession:
             elif robot == "fast-greedy":
                 policy = fast_greedy_policy(dag, self.solution)
             else:
-                raise ValueError(
+                raise GameError(
                     f"robot: expected one of {', '.join(ROBOT_KINDS)} or a policy, got {robot!r}"
                 )
             self.robot_name = robot
@@ -305,19 +306,19 @@ class GameSession:
     def play(self, number: int) -> Turn:
         """The person takes move ``number`` (1-based, as listed by :meth:`moves`)."""
         if not self.persons_turn:
-            raise ValueError("it is not the person's turn")
+            raise GameError("it is not the person's turn")
         moves = self.moves()
         if not 1 <= number <= len(moves):
-            raise ValueError(f"move: expected a number from 1 to {len(moves)}, got {number}")
+            raise GameError(f"move: expected a number from 1 to {len(moves)}, got {number}")
         move = moves[number - 1]
         return self._apply(move, by="person", reason="")
 
     def step(self) -> Turn:
         """The computer's turn: a pass (either side) or the computer side's move."""
         if self.finished:
-            raise ValueError("the game is over")
+            raise GameError("the game is over")
         if self.persons_turn:
-            raise ValueError("it is the person's turn: call play()")
+            raise GameError("it is the person's turn: call play()")
         moves = self.moves()
         if not moves:
             return self._pass()
@@ -373,7 +374,7 @@ class GameSession:
         if self.player == ROBOT:
             edge = int(self.robot_policy[self.node])
             if edge not in {m.edge for m in moves}:
-                raise ValueError(
+                raise GameError(
                     f"robot policy has no valid move at node {self.node_id!r} (got edge {edge})"
                 )
             return edge

@@ -42,6 +42,8 @@ from dataclasses import dataclass
 import numba
 import numpy as np
 
+from asp.errors import GameError
+
 ROBOT = 0
 HUMAN = 1
 ANY = 2
@@ -69,9 +71,7 @@ def side_from_name(name: str) -> int:
     try:
         return SIDE_NAMES.index(str(name).lower())
     except ValueError:
-        raise ValueError(
-            f"unknown side {name!r}: expected one of {', '.join(SIDE_NAMES)}"
-        ) from None
+        raise GameError(f"unknown side {name!r}: expected one of {', '.join(SIDE_NAMES)}") from None
 
 
 def player_name(player: int) -> str:
@@ -82,7 +82,7 @@ def player_name(player: int) -> str:
 def check_cost_model(name: str) -> str:
     """Return ``name`` if it is a cost model, else raise a one-line ``ValueError``."""
     if name not in COST_MODELS:
-        raise ValueError(f"cost_model: expected 'steps' or 'time', got {name!r}")
+        raise GameError(f"cost_model: expected 'steps' or 'time', got {name!r}")
     return name
 
 
@@ -185,17 +185,17 @@ def step(dag, node: int, player: int, edge: int = PASS) -> tuple[int, int, float
         player passes although it has a move.
     """
     if node == dag.end:
-        raise ValueError("the game is over")
+        raise GameError("the game is over")
     if edge == PASS:
         if moves(dag, node, player):
-            raise ValueError(
+            raise GameError(
                 f"the {player_name(player)} has a move at node {dag.node_ids[node]!r}: "
                 "it may not pass"
             )
         return node, other(player), PASS_COST
     lo, hi = int(dag.indptr[node]), int(dag.indptr[node + 1])
     if not (lo <= edge < hi and may_take(int(dag.sides[edge]), player)):
-        raise ValueError(
+        raise GameError(
             f"edge {edge} is not a move of the {player_name(player)} at node "
             f"{dag.node_ids[node]!r}: expected one of {moves(dag, node, player)}"
         )

@@ -27,6 +27,7 @@ import numpy as np
 
 from asp import rules
 from asp.dag import GameDAG, topological_order
+from asp.errors import GameError
 from asp.rules import HUMAN, ROBOT
 from asp.rules import close_kernel as _close
 
@@ -130,7 +131,7 @@ def evaluate_policy(dag: GameDAG, robot_policy: np.ndarray | Mapping) -> PolicyE
     )
     bad = _first_invalid_state(dag, policy, worst)
     if bad >= 0:
-        raise ValueError(
+        raise GameError(
             f"robot policy has no valid move at node {dag.node_ids[bad]!r}: expected one of "
             f"the robot's out-edges {dag.moves(bad, ROBOT)}, got {int(policy[bad])}"
         )
@@ -170,12 +171,12 @@ def as_policy_array(dag: GameDAG, policy: np.ndarray | Mapping) -> np.ndarray:
             w = dag.index_of(succ)
             hits = [e for e in dag.out_edges(v) if dag.targets[e] == w]
             if not hits:
-                raise ValueError(f"robot policy: no edge from node {node!r} to node {succ!r}")
+                raise GameError(f"robot policy: no edge from node {node!r} to node {succ!r}")
             out[v] = hits[0]
         return out
     arr = np.asarray(policy, dtype=np.int64)
     if arr.shape != (dag.n_nodes,):
-        raise ValueError(f"robot policy: expected shape ({dag.n_nodes},), got {arr.shape}")
+        raise GameError(f"robot policy: expected shape ({dag.n_nodes},), got {arr.shape}")
     return arr
 
 
@@ -194,12 +195,12 @@ def play(
             e = int((robot_policy if player == ROBOT else human_policy)[v])
             if e not in moves:
                 who = rules.player_name(player)
-                raise ValueError(f"{who} policy has no valid move at node {dag.node_ids[v]!r}")
+                raise GameError(f"{who} policy has no valid move at node {dag.node_ids[v]!r}")
         v, player, c = rules.step(dag, v, player, e)
         cost += c
         if e != rules.PASS:
             path.append(v)
-    raise ValueError("play did not reach the end node: is the graph acyclic?")
+    raise GameError("play did not reach the end node: is the graph acyclic?")
 
 
 def robust_path(dag: GameDAG, solution: Solution) -> list:

@@ -16,13 +16,14 @@ An ``assembly.yaml`` names everything the planner needs besides the part geometr
     gravity: -z                        # one of +x -x +y -y +z -z
     gripper_approach: [+z, -z]         # directions d a part may leave along (inserted along -d)
     constraints: {topological: true, stability: true, functional: true}
-    turn_model: alternate
+    turn_model: alternate              # or concurrent (asp/concurrent.py)
     cost: steps                        # or time
     max_states: 20000000               # state graph limit (asmplan plan --max-states)
     operations:
       - id: "1.2"                      # ids are strings (1.10 stays "1.10")
         description: Replace hex bit with cross bit on R1
-        agents: {H: 15}                # allowed agents and their durations
+        agents: {H: 15}                # allowed agents and their durations; a person's
+                                       # may be a range [min, max] (turn_model concurrent)
         requires: {R1.bit: hex}        # tool state needed (optional)
         sets: {R1.bit: cross}          # tool state after the operation (optional)
         after: ["1.1"]                 # explicit predecessors (optional)
@@ -63,6 +64,7 @@ from cad.units import unit_scale
 from cad.yamlfile import read_yaml
 
 SIDES = ("human", "robot", "any")
+TURN_MODELS = ("alternate", "concurrent")
 CONSTRAINT_KEYS = ("topological", "stability", "functional")
 SPEC_FILE = "assembly.yaml"
 TOP_KEYS = (
@@ -106,7 +108,11 @@ class Operation:
     ----------
     id, description : str
     durations : tuple of (agent, duration)
-        The agents allowed to do it and how long each takes.
+        The agents allowed to do it and how long each takes (for a range, its ``max``: the
+        alternating game and the CP-SAT schedule use it).
+    ranges : tuple of (agent, min, max)
+        Durations given as a range ``[min, max]`` (the concurrent game's adversary picks
+        within it, :func:`asp.concurrent.concurrent_model`).
     parts : tuple of str
         Parts placed, in order (may be empty).
     requires, sets : tuple of (tool, value)
@@ -125,10 +131,19 @@ class Operation:
     sets: tuple[tuple[str, str], ...] = ()
     after: tuple[str, ...] = ()
     held: bool = False
+    ranges: tuple[tuple[str, float, float], ...] = ()
 
     @property
     def agents(self) -> tuple[str, ...]:
         return tuple(a for a, _ in self.durations)
+
+    def duration_range(self, agent: str) -> tuple[float, float]:
+        """``(min, max)`` duration of ``agent`` (``min == max`` unless a range is given)."""
+        for a, lo, hi in self.ranges:
+            if a == agent:
+                return lo, hi
+        d = self.duration(agent)
+        return d, d
 
     def duration(self, agent: str) -> float:
         for a, d in self.durations:
@@ -342,8 +357,8 @@ class _Parser:
                 raise self.fail(f"constraints.{key}", f"expected true or false, got {value!r}")
             flags[key] = value
         turn = str(data.get("turn_model", "alternate"))
-        if turn != "alternate":
-            raise self.fail("turn_model", f"expected 'alternate', got {turn!r}")
+        if turn not in TURN_MODELS:
+            raise self.fail("turn_model", f"expected 'alternate' or 'concurrent', got {turn!r}")
         cost = str(data.get("cost", "steps"))
         if cost not in COST_MODELS:
             raise self.fail("cost", f"expected 'steps' or 'time', got {cost!r}")
@@ -442,12 +457,22 @@ class _Parser:
             agents_raw = self.mapping(item.get("agents"), f"{where}.agents")
             if not agents_raw:
                 raise self.fail(f"{where}.agents", "no agent may do this operation")
-            durations = []
+            durations, ranges = [], []
             for a, d in agents_raw.items():
                 a = str(a)
                 if a not in agent_names:
                     raise self.fail(f"{where}.agents", f"unknown agent {a!r}")
-                durations.append((a, self.number(d, f"{where}.agents.{a}")))
+                key = f"{where}.agents.{a}"
+                if isinstance(d, list):
+                    if len(d) != 2:
+                        raise self.fail(key, f"expected a duration or [min, max], got {d!r}")
+                    lo, hi = self.number(d[0], key), self.number(d[1], key)
+                    if lo > hi:
+                        raise self.fail(key, f"range [min, max] with min > max: {d!r}")
+                    ranges.append((a, lo, hi))
+                    durations.append((a, hi))
+                else:
+                    durations.append((a, self.number(d, key)))
             placed = item.get("part", item.get("parts"))
             if placed is None:
                 placed = []
@@ -488,6 +513,7 @@ class _Parser:
                     sets=tool_pairs["sets"],
                     after=tuple(dict.fromkeys(self.text(a, f"{where}.after") for a in after_raw)),
                     held=held,
+                    ranges=tuple(ranges),
                 )
             )
         self.check_predecessors(ops)

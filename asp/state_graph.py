@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from asp.errors import SpecError
 from asp.feasibility import (
     OperationModel,
     blocked_text,
@@ -265,7 +266,7 @@ def build_state_graph(
         op=_join(op_l, np.int16),
     )
     if check and not graph.complete.any():
-        raise ValueError(infeasibility_report(graph))
+        raise SpecError(infeasibility_report(graph))
     return graph
 
 
@@ -437,7 +438,7 @@ def _too_many(model: OperationModel, keys: np.ndarray, limit: int, reached: str,
     names = list(dict.fromkeys(names))
     shown = ", ".join(names[:8]) + (f" and {len(names) - 8} more" if len(names) > 8 else "")
     per_state = 8 * model.n_words + 8 * model.oracle.n_words + 8
-    return ValueError(
+    return SpecError(
         f"{spec.source}: the state graph exceeds the limit of {limit:,} states: {reached} "
         f"states after layer {layer + 1} of {n_ops}; the free order of {len(names)} parts or "
         f"operations multiplies them ({shown or 'none'}); raise max_states (the command line's "

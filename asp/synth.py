@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from asp.dag import GameDAG, from_arrays
+from asp.errors import GraphError
 
 NEXT_LAYER_PROBABILITY = 0.9
 """Chance that an edge goes to the adjacent layer rather than a later one."""
@@ -49,9 +50,9 @@ def synthetic_dag(layers: int, max_nodes: int, max_actions: int, seed: int = 0) 
     """
     for name, value in (("layers", layers), ("max_nodes", max_nodes), ("max_actions", max_actions)):
         if int(value) != value or value < 1:
-            raise ValueError(f"{name}: expected a positive integer, got {value!r}")
+            raise GraphError(f"{name}: expected a positive integer, got {value!r}")
     if int(seed) != seed or seed < 0:
-        raise ValueError(f"seed: expected a non-negative integer, got {seed!r}")
+        raise GraphError(f"seed: expected a non-negative integer, got {seed!r}")
     rng = np.random.Generator(np.random.PCG64(int(seed)))
 
     # Candidate nodes per layer: 1 start, 1..M per inner layer, 1 end.

@@ -30,13 +30,15 @@ def job(n_ops: int = 20, robots: int = 2, chains: int = 4, spread: int = 4) -> A
         pos = i // chains
         after = (f"o{i - chains}",) if pos > 0 else ()
         base = 4 + (7 * i) % 9
+        ranges = ()
         if i % 3 == 0:
-            durations = (("H", (base, base + spread) if spread else base),)
+            durations = (("H", base + spread),)
+            ranges = (("H", base, base + spread),) if spread else ()
         elif i % 3 == 1:
             durations = ((f"R{1 + i % robots}", base),)
         else:
             durations = ((f"R{1 + (i + 1) % robots}", base), ("H", base + 2))
-        ops.append(Operation(id=f"o{i}", description="", durations=durations, after=after))
+        ops.append(Operation(f"o{i}", "", durations=durations, after=after, ranges=ranges))
     # R1 screws o5 with the cross bit and o13 with the hex bit; the person changes the bit.
     if n_ops >= 16:
         ops[5] = Operation(

@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from cad.errors import GeometryError
+
 DIRECTIONS: tuple[str, ...] = ("+x", "-x", "+y", "-y", "+z", "-z")
 """Direction labels, in table order."""
 
@@ -31,7 +33,7 @@ def direction_index(label: str) -> int:
     try:
         return DIRECTIONS.index(label)
     except ValueError:
-        raise ValueError(f"unknown direction {label!r}; expected one of {DIRECTIONS}") from None
+        raise GeometryError(f"unknown direction {label!r}; expected one of {DIRECTIONS}") from None
 
 
 def opposite(d: int) -> int:

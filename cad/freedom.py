@@ -40,6 +40,7 @@ import numpy as np
 import trimesh
 
 from cad.assembly import Assembly
+from cad.errors import GeometryError
 from cad.faces import FaceSet, axis_face_sets, bounds_overlap, crop_pair, unit_normals
 from cad.offset import offset_vertices
 from cad.progress import progress_bar
@@ -255,7 +256,7 @@ def check_interpenetration(
                 ptol = tols.pair(a, b)
                 depth = _depth_estimate(pa.mesh, pb.mesh, ptol)
                 hint = unit_hint(assembly, a, b)
-                raise ValueError(
+                raise GeometryError(
                     f"parts {pa.id!r} and {pb.id!r} interpenetrate by {depth} "
                     f"(penetration tolerance of this pair {ptol:.3g} mm)"
                     + (f"; {hint}" if hint else "")

@@ -10,6 +10,7 @@ import numpy as np
 from cad.assembly import Assembly
 from cad.contact import contact_relation
 from cad.directions import DIRECTIONS
+from cad.errors import GeometryError
 from cad.freedom import check_interpenetration, eroded_meshes
 from cad.freedom import translational_freedom as _freedom
 from cad.support import support_relation
@@ -61,7 +62,7 @@ class Relations:
                 continue
             table = np.asarray(getattr(self, name), dtype=bool)
             if table.shape != (n, n, 6):
-                raise ValueError(f"{name} must have shape ({n}, {n}, 6), got {table.shape}")
+                raise GeometryError(f"{name} must have shape ({n}, {n}, 6), got {table.shape}")
             table = table.copy()
             table.setflags(write=False)
             object.__setattr__(self, name, table)
@@ -70,12 +71,12 @@ class Relations:
         """Table index of a part id (an int is returned as is, after a range check)."""
         if isinstance(part, (int, np.integer)):
             if not 0 <= int(part) < len(self.parts):
-                raise ValueError(f"part index {part} out of range")
+                raise GeometryError(f"part index {part} out of range")
             return int(part)
         try:
             return self.parts.index(part)
         except ValueError:
-            raise ValueError(f"unknown part {part!r}") from None
+            raise GeometryError(f"unknown part {part!r}") from None
 
     def to_dict(self) -> dict:
         """JSON-ready dict: ``parts``, ``directions``, ``tc``, ``tt`` ([i][j][d]), tolerances."""
@@ -149,9 +150,9 @@ def _indices(
     ip = relations.index(p)
     members = sorted({relations.index(j) for j in subset})
     if not members:
-        raise ValueError("the subassembly S must not be empty")
+        raise GeometryError("the subassembly S must not be empty")
     if ip in members:
-        raise ValueError(f"part {relations.parts[ip]!r} is already in S")
+        raise GeometryError(f"part {relations.parts[ip]!r} is already in S")
     return ip, members
 
 

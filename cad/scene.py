@@ -222,6 +222,8 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
         return below
 
     walk(graph.base_frame, [])
+    if file.suffix.lower() == ".3dxml":  # trimesh flattens the tree into the node names
+        group_nodes = _3dxml_groups(file, [node for node, _ in part_nodes])
     # the node holding every part (the product itself) is not a group
     group_nodes = [(g, b) for g, b in group_nodes if len(b) < len(part_nodes)]
 
@@ -250,6 +252,41 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
         groups=groups,
         units=declared_units(file, scene),
     )
+
+
+def _3dxml_groups(file: Path, nodes: list[str]) -> list[tuple[str, list[str]]]:
+    """The sub-assemblies of a 3DXML from its part nodes' paths (``name#1:3:2:9:8:...``).
+
+    A path alternates Reference3D and Instance3D ids from the root (``1``) down to the
+    part's own reference (third from last); every reference in between is a
+    sub-assembly, named from the file's ``Reference3D`` elements.
+    """
+    import zipfile
+    from xml.etree import ElementTree
+
+    names: dict[str, str] = {}
+    try:
+        with zipfile.ZipFile(file) as archive:
+            for member in archive.namelist():
+                if not member.lower().endswith(".3dxml"):
+                    continue
+                root = ElementTree.fromstring(archive.read(member))
+                for element in root.iter():
+                    if element.tag.rsplit("}", 1)[-1] == "Reference3D":
+                        names[element.get("id", "")] = element.get("name", "")
+    except (OSError, zipfile.BadZipFile, ElementTree.ParseError):
+        return []
+    below: dict[tuple[str, ...], list[str]] = {}
+    for node in nodes:
+        path = node.rpartition("#")[2].split(":")
+        for j in range(2, len(path) - 3, 2):
+            below.setdefault(tuple(path[: j + 1]), []).append(node)
+    groups, seen = [], set()
+    for prefix, members in below.items():  # outermost first; a chain of wrappers counts once
+        if len(members) >= 2 and frozenset(members) not in seen:
+            seen.add(frozenset(members))
+            groups.append((names.get(prefix[-1], "group"), members))
+    return groups
 
 
 def _natural(name: str) -> list:

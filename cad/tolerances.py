@@ -62,6 +62,8 @@ from dataclasses import dataclass
 import numpy as np
 import trimesh
 
+from cad.errors import GeometryError
+
 DEFAULT_CONTACT_TOL_MM = 0.01
 DEFAULT_PENETRATION_TOL_MM = 0.05
 """Smallest default pair tolerance (two parts at the shrink floor)."""
@@ -174,12 +176,12 @@ def resolve_tolerances(
         explicit_shrink = None
     ctol = DEFAULT_CONTACT_TOL_MM if contact_tol is None else float(contact_tol)
     if not np.isfinite(ctol) or ctol < 0:
-        raise ValueError(f"contact tolerance must be >= 0 mm, got {contact_tol}")
+        raise GeometryError(f"contact tolerance must be >= 0 mm, got {contact_tol}")
     if explicit_shrink is not None:
         return Tolerances(ctol, explicit_shrink, base.explicit)
     if penetration_tol is None:
         return Tolerances(ctol, default_shrinks(meshes), False)
     ptol = float(penetration_tol)
     if not np.isfinite(ptol) or ptol <= 0:
-        raise ValueError(f"penetration tolerance must be > 0 mm, got {penetration_tol}")
+        raise GeometryError(f"penetration tolerance must be > 0 mm, got {penetration_tol}")
     return Tolerances(ctol, np.full(len(meshes), ptol / 2.0), True)

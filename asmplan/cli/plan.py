@@ -15,7 +15,7 @@ import typer
 from asmplan.cli.app import app, choices
 from asmplan.cli.graph import say
 from asmplan.cli.options import SEED_MAX, TIME_LIMIT_MAX, CostModel, check_output, finite_or_none
-from asmplan.pipeline import TURN_MODELS
+from asp.spec import TURN_MODELS
 
 TurnModel = choices("TurnModel", TURN_MODELS, "Turn model of the game.")
 

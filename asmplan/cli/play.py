@@ -14,9 +14,8 @@ import typer
 
 from asmplan.cli.app import app, choices
 from asmplan.cli.options import SEED_MAX, CostModel
-from asp.dag import SIDE_NAMES
 from asp.numbers import cost_unit
-from asp.rules import cost_at_most, costs_close
+from asp.rules import SIDE_NAMES, cost_at_most, costs_close
 
 HELP_TEXT = """\
 How to play

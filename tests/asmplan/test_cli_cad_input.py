@@ -111,3 +111,14 @@ def test_a_bom_beside_the_scene_overrides_and_adds_parts(tmp_path):
     assert parts["knob"].file == "knob.stl" and parts["knob"].type == "handle"
     assert parts["cap_1"].shape == "cap"
     assert spec.operations[-1].parts == ("knob",)  # the highest part goes last
+
+
+def test_the_cad_hierarchy_of_a_spec(tmp_path):
+    pytest.importorskip("cascadio")
+    from asp.generate import generated_spec, spec_hierarchy
+
+    spec = generated_spec(STEP)
+    assert spec_hierarchy(spec) == (
+        ("pillar_unit_1", ("cap_1", "pillar_1")),
+        ("pillar_unit_2", ("cap_2", "pillar_2")),
+    )

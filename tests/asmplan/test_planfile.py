@@ -15,6 +15,7 @@ from asmplan.planfile import (
     validate_plan,
     write_plan,
 )
+from asp.checker import check_line, plan_operations
 from asp.dag import HUMAN, ROBOT
 from asp.solve import evaluate_policy
 from tests.asmplan.plans import cell_game, cell_plan
@@ -29,6 +30,7 @@ def test_cell_plan_validates_and_round_trips(tmp_path, cost):
     assert back == json.loads(path.read_text())
     assert back["format"] == FORMAT
     assert back["cost"] == cost
+    check_line(cell_game(cost)[0], None, plan_operations(back))
 
 
 def test_schema_rejects_a_broken_plan():

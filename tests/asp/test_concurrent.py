@@ -199,3 +199,68 @@ def test_curve_is_monotone_up_to_the_unbounded_bound(data):
     # W*(k) for k >= the number of operations is the unbounded bound.
     if len(ops) <= 3:
         assert bounds[3] == pytest.approx(top)
+
+
+def test_spec_ranges_and_turn_model():
+    spec = spec_from_dict(
+        {
+            "name": "r",
+            "turn_model": "concurrent",
+            "agents": {"H": {"side": "human"}, "R": {"side": "robot"}},
+            "operations": [{"id": "a", "agents": {"H": [2, 6], "R": 4}}],
+        }
+    )
+    op = spec.operations[0]
+    assert spec.turn_model == "concurrent"
+    assert op.duration_range("H") == (2, 6) and op.duration("H") == 6
+    assert op.duration_range("R") == (4, 4)
+    for bad, message in (([6, 2], "min > max"), ([1, 2, 3], "expected a duration")):
+        with pytest.raises(ValueError, match=message):
+            spec_from_dict(
+                {
+                    "agents": {"H": {"side": "human"}},
+                    "operations": [{"id": "a", "agents": {"H": bad}}],
+                }
+            )
+
+
+def test_robot_range_is_an_error():
+    with pytest.raises(ValueError, match="a robot's duration is one number"):
+        job([{"id": "a", "agents": {"R": [1, 2], "H": 1}}])
+
+
+def test_pump_with_ranges_robust_plan_beats_the_schedule():
+    from pathlib import Path
+
+    from asp.concurrent_plan import plan_concurrent
+    from asp.feasibility import load_relations
+    from asp.spec import load_spec
+
+    spec = load_spec(Path(__file__).resolve().parents[2] / "examples" / "vacuum_pump_ranges")
+    graph = build_state_graph(spec, load_relations(spec))
+    plan = plan_concurrent(spec, graph, step=None)
+    assert plan.curve.to_list() == [
+        {"k": 0, "bound": 297},
+        {"k": 1, "bound": 297},
+        {"k": 2, "bound": 297},
+        {"k": None, "bound": 297},
+    ]
+    assert plan.schedule.objective == 297
+    worst = {r["k"]: r["bound"] for r in plan.schedule_worst}
+    assert worst[0] == 297 and worst[1] == 333
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(random_jobs(), st.sampled_from([None, 0, 2]))
+def test_compiled_and_python_builders_make_the_same_game(data, budget):
+    ops, agents = data
+    model = job(ops, agents=agents)
+    a = build_game(model, budget, compiled=False)
+    b = build_game(model, budget, compiled=True)
+    assert (a.dag.n_nodes, a.dag.n_edges) == (b.dag.n_nodes, b.dag.n_edges)
+    sa, sb = solve(a.dag), solve(b.dag)
+    for k in a.budgets:
+        assert value(a, sa, k) == value(b, sb, k)
+        assert timeline(a, sa.robot_policy, "worst", budget=None if k == UNBOUNDED else k) == (
+            timeline(b, sb.robot_policy, "worst", budget=None if k == UNBOUNDED else k)
+        )

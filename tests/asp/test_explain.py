@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from asp.checker import check_line
 from asp.feasibility import insertion_oracle
 from asp.spec import spec_from_dict
 from asp.state_graph import build_state_graph
@@ -42,6 +43,7 @@ def test_more_than_64_parts(n):
     assert graph.count_sequences() == 1
     assert graph.n_states == n
     assert graph.sequences() == [list(parts[1:])]
+    check_line(graph.spec, rel, graph.sequences()[0])
 
 
 def test_wide_part_sets_agree_with_python_ints():

@@ -10,6 +10,7 @@ from typer.testing import CliRunner
 
 from asmplan.cli import app, main
 from asp.baseline import assembly_schedule, min_cost_path, min_makespan
+from asp.checker import check_line, plan_operations
 from asp.feasibility import load_relations
 from asp.game import game_dag
 from asp.plan import play_steps, relations_summary
@@ -52,6 +53,7 @@ def test_geometry_orders_what_the_spec_leaves_open(pump):
     assert "5.2" not in spec.operation("5.4").after
     for seq in graph.sequences(limit=200):
         assert seq.index("5.2") < seq.index("5.4")
+        check_line(spec, rel, seq)
     assert graph.count_sequences() < build_state_graph(spec).count_sequences()
 
 
@@ -83,6 +85,7 @@ def test_forgetful_human_story(pump):
     steps = play_steps(dag, sol.robot_policy, forgetful)
     done = [s.operation for s in steps if s.operation]
     assert sorted(done) == sorted(spec.op_ids)  # the plan completes
+    check_line(spec, load_relations(spec), done)
     assert done.index("2.2") < done.index("1.2")  # BC placed with the hex bit on
     assert done.index("2.5") < done.index("1.2")  # the robot screws VT2 with hex first
     assert done.index("1.2") < done.index("1.6") < done.index("2.1")
@@ -102,7 +105,7 @@ def test_makespan_beats_the_serial_time(pump):
     assert rows["1.2"]["end"] <= rows["1.6"]["start"]
 
 
-def test_plan_command_writes_plan_and_picture(tmp_path):
+def test_plan_command_writes_plan_and_picture(tmp_path, pump):
     out = CliRunner().invoke(app, ["plan", str(PUMP), "--output", str(tmp_path)])
     assert out.exit_code == 0, out.output
     for text in ("states", "TCT", "W*", "robust plan", "CP-SAT makespan", "touches"):
@@ -114,6 +117,8 @@ def test_plan_command_writes_plan_and_picture(tmp_path):
         load_spec(PUMP).op_ids
     )
     assert plan["schedule"]["status"] == "OPTIMAL"
+    spec, rel, _ = pump
+    check_line(spec, rel, plan_operations(plan))
     assert (tmp_path / "dag.png").read_bytes()[:4] == b"\x89PNG"
 
 

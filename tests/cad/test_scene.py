@@ -145,6 +145,21 @@ def write_3dxml(path, parts):
     return Path(path)
 
 
+def test_3dxml_sub_assemblies_from_the_instance_paths(tmp_path):
+    from cad.scene import _3dxml_groups
+
+    path = write_3dxml(tmp_path / "a.3dxml", {"Plate": shapes.box_between((0, 0, 0), (1, 1, 1))})
+    with zipfile.ZipFile(path, "a") as archive:
+        archive.writestr(
+            "Sub.3dxml",
+            '<Model_3dxml><Reference3D id="8" name="Cam Stack"/>'
+            '<Reference3D id="2" name="Drive"/></Model_3dxml>',
+        )
+    nodes = ["nut#1:3:2:9:8:15:14:16:4", "bolt#1:3:2:9:8:17:12:16:4", "ring#1:3:2:19:18:16:4"]
+    groups = _3dxml_groups(path, nodes)
+    assert groups == [("Drive", nodes), ("Cam Stack", nodes[:2])]
+
+
 def test_3dxml_parts_and_names(tmp_path):
     b = shapes.box_between
     path = write_3dxml(

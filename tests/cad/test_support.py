@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 import trimesh
 
+from asp.checker import check_line
 from asp.spec import spec_from_dict
 from asp.state_graph import build_state_graph
 from cad import Assembly, compute_relations
@@ -75,6 +76,7 @@ def test_nut_waits_for_its_bolt():
     seqs = graph.sequences(limit=200)
     assert seqs
     for seq in seqs:
+        check_line(graph.spec, rel, seq)
         assert seq.index("bolt_1") < seq.index("nut_1")
         assert seq.index("bolt_2") < seq.index("nut_2")
 
@@ -83,7 +85,9 @@ def test_finger_jointed_side_stands_in_the_base_without_held():
     rel = compute_relations(Assembly.from_meshes(finger_side()))
     assert resting_on(rel, "side") == set()  # no face lies on the base (0.05 mm gap)
     assert supported_by(rel, "side") == {"base"}
-    assert build_state_graph(spec_for(rel, "base"), rel).count_sequences() == 1
+    graph = build_state_graph(spec_for(rel, "base"), rel)
+    assert graph.count_sequences() == 1
+    check_line(graph.spec, rel, graph.sequences()[0])
     # 3 mm above the base it would fall: the support travel is a few tolerances.
     far = compute_relations(Assembly.from_meshes(finger_side(gap=3.0, kerf=0.0)))
     assert supported_by(far, "side") == set()
@@ -103,7 +107,9 @@ def test_shaft_in_bearing_with_clearance(horizontal, shoulder, clearance, suppor
     assert supported_by(rel, "shaft") == ({"block"} if supported else set())
     spec = spec_for(rel, "block")
     if supported:
-        assert build_state_graph(spec, rel).count_sequences() == 1
+        graph = build_state_graph(spec, rel)
+        assert graph.count_sequences() == 1
+        check_line(spec, rel, graph.sequences()[0])
     else:
         with pytest.raises(ValueError, match="shaft.*nothing to rest on"):
             build_state_graph(spec, rel)
