@@ -12,37 +12,40 @@ For a robot policy (by default the robust one):
   :func:`probability_within`, a forward dynamic program over "the budget left" that only
   follows the budgets that can still matter (a budget at least the state's worst case is
   won, one below its best case lost). Against the certified WCPL it is 1 at once. Where
-  more than :data:`MAX_DISTRIBUTION_ENTRIES` (state, budget) pairs would be needed (long
-  games with fractional costs) RR is taken from the seeded simulation instead and
+  more than :data:`MAX_RR_ARRIVALS` (state, budget) arrivals would be needed (long games
+  with fractional costs) RR is taken from the seeded simulation instead and
   ``exact_distribution`` is false;
 - the paper's seeded simulation of 1,000 games stays beside them, vectorised over games.
 
 The whole exact distribution (:func:`random_cost_distribution`) is kept for small games
-(tests, reports) under the same cap. The rules of play come from :mod:`asp.rules`.
+(tests, reports) under its own cap (:data:`MAX_DISTRIBUTION_ENTRIES`). The rules of play
+come from :mod:`asp.rules`.
 """
 
 from __future__ import annotations
 
-import heapq
 import math
 from dataclasses import asdict, dataclass
 
+import numba
 import numpy as np
 
 from asp import rules
 from asp.dag import GameDAG
 from asp.errors import GameError
 from asp.numbers import plain
-from asp.rules import HUMAN, ROBOT
+from asp.rules import HUMAN, ROBOT, close_kernel
 from asp.solve import PolicyEvaluation, Solution, evaluate_policy, node_order, play, solve
 
 DEFAULT_GAMES = 1000
 MAX_DISTRIBUTION_STATES = 200_000
 """Above this many reachable game states the whole distribution is not computed."""
 MAX_DISTRIBUTION_ENTRIES = 250_000
-"""Cap on the (game state, cost or budget) pairs an exact dynamic program may hold; past it
-:func:`random_cost_distribution` and :func:`probability_within` answer ``None``, which bounds
-their time and memory (about 2 s and 100 MB in the worst case on one core;
+"""Cap on the (game state, cost) pairs of :func:`random_cost_distribution` (Python dicts);
+past it the answer is ``None`` (about 2 s and 100 MB at most)."""
+MAX_RR_ARRIVALS = 1_000_000
+"""Cap on the (game state, budget) arrivals of :func:`probability_within` (compiled); past it
+the answer is ``None`` and RR is sampled (about 1 s and 100 MB at most on one core,
 ``benchmarks/fractional_costs.py``)."""
 
 
@@ -157,7 +160,7 @@ def probability_within(
     bound: float,
     *,
     evaluation: PolicyEvaluation | None = None,
-    max_entries: int = MAX_DISTRIBUTION_ENTRIES,
+    max_entries: int = MAX_RR_ARRIVALS,
 ) -> float | None:
     """Exact P(cost <= ``bound``) of ``robot_policy`` against a uniformly random human.
 
@@ -166,66 +169,156 @@ def probability_within(
     at least the state's worst case (:attr:`PolicyEvaluation.worst`) is won whatever
     happens, one below its best case is lost: only budgets in between are followed, so RR
     against the certified WCPL costs nothing and RR against a lower bound follows only the
-    lines that can still decide it.
+    lines that can still decide it. Arrivals at a state with the same budget (within the
+    cost tolerance) are merged (compiled: a heap ordered by state, then budget).
 
     Returns
     -------
     float or None
         The probability rounded to 12 decimals, or ``None`` when more than ``max_entries``
-        (state, budget) pairs would be needed (the caller then samples).
+        (state, budget) arrivals would be needed (the caller then samples).
     """
     ev = evaluate_policy(dag, robot_policy) if evaluation is None else evaluation
-    worst, best = ev.worst, ev.best
-    h_indptr, h_edges = rules.move_table(dag, HUMAN)
-    can_move = rules.has_move(dag)
-    move_cost = rules.move_costs(dag)
+    t = rules.kernel_tables(dag)
     order = node_order(dag)
     position = np.empty(dag.n_nodes, dtype=np.int64)
     position[order] = np.arange(dag.n_nodes)
-    won: list[float] = []
-    pending: dict[tuple[int, int], dict[float, float]] = {}
-    heap: list[tuple[int, int, int, int]] = []
-    entries = 0
+    prob = _within_kernel(
+        t.indptr,
+        t.targets,
+        t.cost,
+        t.may,
+        np.asarray(robot_policy, dtype=np.int64),
+        order,
+        position,
+        ev.worst,
+        ev.best,
+        dag.start,
+        float(bound),
+        t.tol,
+        int(max_entries),
+    )
+    return None if prob < 0 else round(prob, 12)
 
-    def send(v: int, p: int, budget: float, prob: float) -> bool:
-        """Move ``prob`` to state ``(v, p)`` with ``budget`` left; False past the cap."""
-        nonlocal entries
-        if rules.cost_at_most(worst[v, p], budget):
-            won.append(prob)
-            return True
-        if budget < best[v, p] and not rules.costs_close(budget, best[v, p]):
-            return True  # lost whatever happens
-        state = pending.get((v, p))
-        if state is None:
-            state = pending[v, p] = {}
-            # At a node the side that passes goes first: its mass flows to the other side.
-            heapq.heappush(heap, (int(position[v]), int(can_move[p, v]), v, p))
-        key = round(budget, 9)
-        if key not in state:
-            entries += 1
-            if entries > max_entries:
-                return False
-        state[key] = state.get(key, 0.0) + prob
-        return True
 
-    if not send(dag.start, rules.FIRST_PLAYER, float(bound), 1.0):
-        return None
-    while heap:
-        _, _, v, p = heapq.heappop(heap)
-        masses = pending.pop((v, p))
-        moves = _random_moves(dag, robot_policy, h_indptr, h_edges, v, p)
-        for budget, prob in masses.items():
-            if not moves:  # a pass: same budget, the other side on turn
-                ok = send(v, rules.other(p), budget, prob)
-            else:
-                share = prob / len(moves)
-                ok = all(
-                    send(int(dag.targets[e]), rules.other(p), budget - float(move_cost[e]), share)
-                    for e in moves
-                )
-            if not ok:
-                return None
-    return round(math.fsum(won), 12)
+@numba.njit(cache=True)
+def _heap_push(hs, hb, hp, size, skey, budget, prob):  # pragma: no cover - compiled
+    """Push ``(skey, budget) -> prob`` on the min-heap of ``size`` entries; return the arrays
+    (grown when full) and the new size."""
+    if size == hs.shape[0]:
+        hs = np.concatenate((hs, np.empty_like(hs)))
+        hb = np.concatenate((hb, np.empty_like(hb)))
+        hp = np.concatenate((hp, np.empty_like(hp)))
+    i = size
+    while i > 0:
+        parent = (i - 1) // 2
+        if hs[parent] < skey or (hs[parent] == skey and hb[parent] <= budget):
+            break
+        hs[i], hb[i], hp[i] = hs[parent], hb[parent], hp[parent]
+        i = parent
+    hs[i], hb[i], hp[i] = skey, budget, prob
+    return hs, hb, hp, size + 1
+
+
+@numba.njit(cache=True)
+def _heap_pop(hs, hb, hp, size):  # pragma: no cover - compiled
+    """Remove the smallest entry; return it and the new size."""
+    skey, budget, prob = hs[0], hb[0], hp[0]
+    size -= 1
+    ls, lb, lp = hs[size], hb[size], hp[size]
+    i = 0
+    while True:
+        child = 2 * i + 1
+        if child >= size:
+            break
+        right = child + 1
+        if right < size and (
+            hs[right] < hs[child] or (hs[right] == hs[child] and hb[right] < hb[child])
+        ):
+            child = right
+        if ls < hs[child] or (ls == hs[child] and lb <= hb[child]):
+            break
+        hs[i], hb[i], hp[i] = hs[child], hb[child], hp[child]
+        i = child
+    if size > 0:
+        hs[i], hb[i], hp[i] = ls, lb, lp
+    return skey, budget, prob, size
+
+
+@numba.njit(cache=True)
+def _arrive(
+    heap, size, sums, v, p, budget, prob, indptr, may, position, worst, best, tol
+):  # pragma: no cover
+    """Mass ``prob`` arrives at state ``(v, p)`` with ``budget`` left: won (added to
+    ``sums``, a Neumaier-compensated ``[sum, carry, arrivals]``), lost, or pushed on the heap.
+    Returns the heap arrays and size."""
+    hs, hb, hp = heap
+    w, b = worst[v, p], best[v, p]
+    if w <= budget or close_kernel(w, budget, tol):  # won whatever happens
+        total = sums[0] + prob
+        if abs(sums[0]) >= abs(prob):
+            sums[1] += (sums[0] - total) + prob
+        else:
+            sums[1] += (prob - total) + sums[0]
+        sums[0] = total
+    elif budget >= b or close_kernel(budget, b, tol):  # still open: follow it
+        sums[2] += 1.0
+        phase = 0
+        for e in range(indptr[v], indptr[v + 1]):
+            if may[p, e]:
+                phase = 1
+                break
+        hs, hb, hp, size = _heap_push(
+            hs, hb, hp, size, 4 * position[v] + 2 * phase + p, budget, prob
+        )
+    return (hs, hb, hp), size
+
+
+@numba.njit(cache=True)
+def _within_kernel(
+    indptr, targets, cost, may, policy, order, position, worst, best, start, bound, tol, cap
+):  # pragma: no cover - compiled
+    """P(cost <= bound) by the forward budget program (see :func:`probability_within`);
+    -1 past ``cap`` arrivals.
+
+    A state's heap key is ``4 * position + 2 * phase + player``: states in topological
+    order, and at one node the side that passes (phase 0) before the side that moves, so
+    that a pass's mass arrives before the other side's state is expanded.
+    """
+    heap = (np.empty(64, np.int64), np.empty(64, np.float64), np.empty(64, np.float64))
+    sums = np.zeros(3)
+    tables = (indptr, may, position, worst, best, tol)
+    heap, size = _arrive(heap, 0, sums, start, ROBOT, bound, 1.0, *tables)
+    while size > 0:
+        if sums[2] > cap:
+            return -1.0
+        # Pop a state's smallest budget and merge every arrival with the same budget.
+        hs, hb, hp = heap
+        skey, budget, prob, size = _heap_pop(hs, hb, hp, size)
+        while size > 0 and hs[0] == skey and close_kernel(hb[0], budget, tol):
+            _, _, more, size = _heap_pop(hs, hb, hp, size)
+            prob += more
+        v, p = order[skey // 4], skey % 2
+        # The robot's policy move, each human move alike, or a pass (same node and budget).
+        if p == ROBOT and policy[v] >= 0 and may[ROBOT, policy[v]]:
+            e = policy[v]
+            heap, size = _arrive(
+                heap, size, sums, targets[e], HUMAN, budget - cost[e], prob, *tables
+            )
+            continue
+        count = 0
+        if p == HUMAN:
+            for e in range(indptr[v], indptr[v + 1]):
+                if may[HUMAN, e]:
+                    count += 1
+        if count == 0:
+            heap, size = _arrive(heap, size, sums, v, 1 - p, budget, prob, *tables)  # a pass
+            continue
+        for e in range(indptr[v], indptr[v + 1]):
+            if may[HUMAN, e]:
+                t, left = targets[e], budget - cost[e]
+                heap, size = _arrive(heap, size, sums, t, ROBOT, left, prob / count, *tables)
+    return sums[0] + sums[1]
 
 
 def resilience_ratio(costs: np.ndarray | dict, wcpl: float) -> float:

@@ -10,40 +10,26 @@ from pathlib import Path
 
 import typer
 
-from asmplan.cli.app import app, fail
+from asmplan.cli.app import app, choices, fail
 from asmplan.cli.options import GAMES_MAX, SEED_MAX, WORKERS_MAX
+from asmplan.experiments.backends import BACKENDS
+from asmplan.experiments.tasks import EXPERIMENT_KEYS, Solver
 
 TRIALS_MAX = 10_000
 
 
-class SolverChoice(StrEnum):
-    """Planner(s) each task runs."""
-
-    exact = "exact"
-    arl = "arl"
-    both = "both"
-
-
 class ConfigChoice(StrEnum):
-    """ARL trainer configuration."""
+    """ARL trainer configuration: the names of :data:`arl.config.CONFIGS` (importing it here
+    would load the RL stack for every command; ``tests/asmplan/test_cli_errors.py`` checks
+    that the two agree)."""
 
     paper = "paper"
     fast = "fast"
 
 
-class BackendChoice(StrEnum):
-    """Where tasks run."""
-
-    local = "local"
-    ray = "ray"
-
-
-class TableChoice(StrEnum):
-    """Which of the paper's experiments to reproduce."""
-
-    table3 = "table3"
-    table4 = "table4"
-
+SolverChoice = Solver
+BackendChoice = choices("BackendChoice", BACKENDS, "Where tasks run.")
+TableChoice = choices("TableChoice", tuple(EXPERIMENT_KEYS), "Which of the paper's experiments.")
 
 DEFAULT_TRIALS = {TableChoice.table3: 1, TableChoice.table4: 10}
 

@@ -16,8 +16,8 @@ from asp.rules import COST_MODELS
 
 SEED_MAX = 2**32 - 1
 """Seeds are 32-bit: numpy, torch and CP-SAT all accept them."""
-GAMES_MAX = 10_000_000
-"""Simulated random-human games per evaluation (memory grows with the count)."""
+GAMES_MAX = 1_000_000
+"""Simulated random-human games per evaluation (about 100 bytes each: 1,000,000 is 100 MB)."""
 TIME_LIMIT_MAX = 86_400.0
 """CP-SAT time limit: at most a day."""
 WORKERS_MAX = 1_024

@@ -211,6 +211,10 @@ def _project_modules() -> list[str]:
     return [str(Path(m.__file__).parent) for m in (cad, asp, arl, asmplan)]
 
 
+BACKENDS = ("local", "ray")
+"""Where tasks run: a local process pool (serial with one worker) or a Ray cluster."""
+
+
 def make_backend(name: str, *, workers: int | None = None, address: str = "auto"):
     """The backend called ``name``: ``"local"`` (a pool, or serial with one worker) or ``"ray"``."""
     if workers is not None and workers < 1:

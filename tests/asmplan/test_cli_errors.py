@@ -124,3 +124,15 @@ def test_library_warnings_are_one_line(capsys, graph, monkeypatch):
     code, err = run(capsys, "solve", graph, "--games", "10")
     assert code == 0
     assert err == "asmplan: warning: part X is not watertight: volume may be wrong\n"
+
+
+def test_cli_choices_are_the_domain_names():
+    from arl.config import CONFIGS
+    from asmplan.cli.experiment import ConfigChoice, TableChoice
+    from asmplan.cli.options import CostModel
+    from asmplan.experiments.tasks import EXPERIMENT_KEYS
+    from asp.rules import COST_MODELS
+
+    assert tuple(ConfigChoice) == tuple(CONFIGS)
+    assert tuple(TableChoice) == tuple(EXPERIMENT_KEYS)
+    assert tuple(CostModel) == COST_MODELS
