@@ -12,6 +12,11 @@ Reproducibility: every phase reseeds numpy, torch, the model's action space and 
 environments from ``(seed, cycle, side)`` and starts fresh games, so the same seed gives
 the same cycle log (with deterministic torch settings), and a resumed run continues exactly
 as the uninterrupted run would have.
+
+Layout: :func:`train` reads as the loop (a :class:`_Run` holds the run's state between
+cycles; :func:`_train_cycle` and :func:`_train_phase` are one cycle and one side's phase);
+the stop rule is :func:`should_stop`; the run folder, whose checkpoints are committed as one
+unit after every cycle, is :mod:`arl.runfolder`.
 """
 
 from __future__ import annotations
