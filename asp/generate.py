@@ -18,7 +18,7 @@ rule, fixed so that a generated spec plans the same as the file it writes:
   the part's bounding-box diagonal, at most 60 s, in whole seconds; the robot takes 1.5
   times as long (rounded to whole seconds); the cost model is ``time``;
 - gravity ``-z``, every gripper approach direction, every constraint on; the units are
-  the file's (meshes in other units are read as millimetres unless the spec says).
+  those the files declare (STEP, glTF, 3MF), ``units: mm`` for the others.
 """
 
 from __future__ import annotations
@@ -167,7 +167,7 @@ def spec_data(path: str | Path, spec_folder: str | Path | None = None) -> tuple[
         )
     data = {
         "name": path.stem if path.is_file() else path.name,
-        "units": assembly.units if assembly.units != "mixed" else "mm",
+        "units": "mm",  # for files without a declared unit (the generated ones are read so)
         "parts": parts,
         "agents": {
             "H": {"side": "human", "description": "operator"},
@@ -236,8 +236,8 @@ def spec_text(path: str | Path, spec_folder: str | Path | None = None) -> str:
         "#   - `held: true` for a part an agent must hold until a later part fixes it;",
         "#   - `after:` for precedences the geometry cannot see (glue, screws to tighten).",
         f"name: {_scalar(data['name'])}",
-        f"units: {data['units']}   # for mesh files that declare no unit "
-        "(STEP, glTF: metres; 3MF: its own)",
+        f"units: {data['units']}   # of mesh files that declare none (STL, OBJ, PLY); "
+        "STEP, glTF, 3MF declare their own",
         "",
         "parts:   # id: used in operations; file: the mesh (file#part: one part of a scene);",
         "         # shape: shared by identical parts (the same shape up to a rigid motion)",
