@@ -327,6 +327,9 @@ def state_graph(
 ) -> StateGraph:
     """The assembly state graph: every feasible partial assembly and operation.
 
+    When a part can never be inserted alone, subassemblies are added automatically
+    (:func:`asp.units.build_with_units`); the graph's ``spec`` then holds them.
+
     Parameters
     ----------
     assembly : Assembly
@@ -339,9 +342,9 @@ def state_graph(
     -------
     asp.state_graph.StateGraph
     """
-    from asp.state_graph import build_state_graph
+    from asp.units import build_with_units
 
-    return build_state_graph(
+    return build_with_units(
         assembly.spec, assembly.relations, progress=progress, max_states=max_states
     )
 
@@ -495,6 +498,8 @@ def plan(
     summary = relations_summary(assembly.relations) if assembly.relations is not None else []
     say("[2/5] building the assembly state graph ...")
     graph = state_graph(assembly, max_states=max_states)
+    if graph.spec is not assembly.spec:  # subassemblies found: their insertions are operations
+        assembly = Assembly(graph.spec, assembly.relations)
     sequences = graph.count_sequences()
     say("[3/5] solving the robot-vs-human game ...")
     the_game = Game(game(graph, cost=cost), assembly.descriptions)

@@ -397,7 +397,7 @@ def plan_document(
         op.id: {
             "description": op.description,
             "agents": dict(op.durations),
-            "parts": list(op.parts),
+            "parts": [op.unit] if op.unit else list(op.parts),
         }
         for op in spec.operations
     }
@@ -429,6 +429,7 @@ def plan_document(
             {"id": p.id, "name": p.name, "file": p.file, "quantity": p.quantity} for p in spec.parts
         ],
         "operations": operations,
+        "subassemblies": {u: list(ms) for u, ms in spec.subassemblies},
         "robust_plan": principal,
         "worst_line": worst,
         "policy": policy,

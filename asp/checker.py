@@ -15,9 +15,12 @@ from the start when no operation places it):
   no support table), unless the operation is ``held``;
 - at the end every operation is done.
 
-A unit (a subassembly inserted as one rigid body, ``units={op id: parts}``) is checked as
-one body: free along ``d`` iff each member is free from each part of ``S``, touching iff
-some member touches, supported iff some member is supported.
+A unit (a subassembly inserted as one rigid body: the spec's ``subassemblies``, whose
+insertion operation has ``unit`` set, or ``units={op id: parts}``) is checked as one body:
+free along ``d`` iff each member is free from each part of ``S``, touching iff some member
+touches, supported iff some member is supported. The operations placing a spec unit's
+members are checked against the members already in the unit's own workspace (the first
+stands on the fixture), not against the main assembly.
 """
 
 from __future__ import annotations
@@ -70,6 +73,10 @@ def check_line(
         The first step that is not allowed, and why.
     """
     units = {str(k): tuple(v) for k, v in dict(units).items()}
+    members = dict(spec.subassemblies)
+    units.update({op.id: members[op.unit] for op in spec.operations if op.unit})
+    owner = {m: u for u, ms in members.items() for m in ms}
+    workspaces: dict[str, list[str]] = {u: [] for u in members}
     ids = [str(o) for o in operations]
     c = spec.constraints
     placed_by_ops = {p for op in spec.operations for p in op.parts}
@@ -89,11 +96,13 @@ def check_line(
                 raise PlanCheckError(f"{where}: its predecessor {missing[0]} is not done")
         bodies = [units[op_id]] if op_id in units else [(p,) for p in op.parts]
         for body in bodies:
+            unit = owner.get(body[0], "") if op_id not in units else ""
+            there = workspaces[unit] if unit else assembled
             direction = ""
             if relations is not None:
-                direction = _check_body(spec, relations, body, assembled, op.held, where)
+                direction = _check_body(spec, relations, body, there, op.held, where, unit)
             out.append(CheckedStep(op_id, body, direction))
-            assembled.extend(body)
+            there.extend(body)
         done.add(op_id)
     left = [op.id for op in spec.operations if op.id not in done]
     if left:
@@ -101,14 +110,14 @@ def check_line(
     return out
 
 
-def _check_body(spec, relations, body, assembled, held, where) -> str:
+def _check_body(spec, relations, body, assembled, held, where, unit="") -> str:
     """The direction a body leaves along, after checking it may go into ``assembled``."""
     rel_ids = [str(p) for p in relations.parts]
     idx = {p: k for k, p in enumerate(rel_ids)}
     c = spec.constraints
     names = ", ".join(body)
     base = spec.base_part
-    if c.topological and base and base not in body and base not in assembled:
+    if c.topological and base and not unit and base not in body and base not in assembled:
         raise PlanCheckError(f"{where}: {names} placed before the base part {spec.base_part}")
     if not assembled:
         return ""

@@ -106,7 +106,9 @@ class InsertionOracle:
         """(PW,) uint64: the set holding part ``p`` alone."""
         return pack_words([1 << int(p)], self.n_words)[0]
 
-    def feasible(self, p: int, assembled, held: bool = False) -> np.ndarray:
+    def feasible(
+        self, p: int, assembled, held: bool = False, workspace: bool = False
+    ) -> np.ndarray:
         """Whether part ``p`` may be inserted into each set.
 
         Parameters
@@ -117,6 +119,8 @@ class InsertionOracle:
             Sets of assembled parts.
         held : bool
             Skip the stability check.
+        workspace : bool
+            The sets are a subassembly's own workspace (no base part there).
 
         Returns
         -------
@@ -124,7 +128,7 @@ class InsertionOracle:
         """
         s = self.sets(assembled)
         ok = np.ones(s.shape[0], dtype=bool)
-        if self.topological and self.base >= 0 and p != self.base:
+        if self.topological and self.base >= 0 and p != self.base and not workspace:
             ok &= _meets(s, self.bit(self.base))
         if self.geometric:
             geo = _meets(s, self.contact[p])
@@ -150,11 +154,14 @@ class InsertionOracle:
             out[name] = [self.parts[j] for j in range(len(self.parts)) if m >> j & 1]
         return out
 
-    def reasons(self, p: int, assembled: int, held: bool = False) -> list[str]:
+    def reasons(
+        self, p: int, assembled: int, held: bool = False, workspace: bool = False
+    ) -> list[str]:
         """Why part ``p`` cannot be inserted into the set ``assembled`` (empty if it can)."""
         s = int(assembled)
         out = []
-        if self.topological and self.base >= 0 and p != self.base and not s >> self.base & 1:
+        base_missing = self.base >= 0 and p != self.base and not s >> self.base & 1
+        if self.topological and base_missing and not workspace:
             out.append(f"the base part {self.parts[self.base]} is not placed yet")
         if not self.geometric or s == 0:
             return out
@@ -221,7 +228,8 @@ def insertion_oracle(spec: AssemblySpec, relations=None) -> InsertionOracle:
         (support, same shape; contact along gravity when absent). Its parts must include
         every part an operation places and the base part.
     """
-    parts = spec.part_ids or tuple(dict.fromkeys(spec.placed_parts))
+    real = spec.part_ids or tuple(dict.fromkeys(spec.placed_parts))
+    parts = real + tuple(u for u, _ in spec.subassemblies)
     n = len(parts)
     n_words = max(1, math.ceil(n / WORD_BITS))
     contact = np.zeros((n, n), dtype=bool)
@@ -262,6 +270,12 @@ def insertion_oracle(spec: AssemblySpec, relations=None) -> InsertionOracle:
         for table in (contact, support):
             table[diagonal, diagonal] = False
         blocked[diagonal, :, diagonal] = False
+    for k, (_, members) in enumerate(spec.subassemblies):
+        # a unit is one rigid body: the pairwise relations ORed over its members
+        u, idx = len(real) + k, [parts.index(m) for m in members]
+        for table in (contact, support, blocked):
+            table[u] = table[idx].any(axis=0)
+            table[u, ..., idx] = False
     base = parts.index(spec.base_part) if spec.base_part in parts else -1
     return InsertionOracle(
         parts=parts,
@@ -305,6 +319,13 @@ class OperationModel:
         The base part when no operation places it (it is on the fixture from the start).
     n_bits : int
         Key bits used (operations, tool fields and the padding that keeps fields in one word).
+    op_workspace : tuple of int
+        Per operation, the subassembly whose workspace it builds in (index into
+        ``spec.subassemblies``), or -1 for the main assembly.
+    unit_ops : tuple of int
+        Per subassembly, the operation that inserts it.
+    unit_masks : (U, PW) uint64
+        Per subassembly, its member parts.
     """
 
     spec: AssemblySpec
@@ -324,6 +345,9 @@ class OperationModel:
     start_key: int
     initial_parts: int
     n_bits: int
+    op_workspace: tuple[int, ...] = ()
+    unit_ops: tuple[int, ...] = ()
+    unit_masks: np.ndarray | None = None
 
     @property
     def n_ops(self) -> int:
@@ -439,6 +463,7 @@ class OperationModel:
                     else:
                         ok[:, cols] &= (col & masks[cols, w]) == values[cols, w]
         parts = self.oracle.sets(parts)
+        pending = self.pending_units(keys)
         for i, plist in enumerate(self.part_lists):
             if not plist:
                 continue
@@ -446,14 +471,39 @@ class OperationModel:
             rows = np.flatnonzero(column)
             if rows.size == 0:
                 continue
-            s = parts[rows]
+            s, workspace = self.assembled_for(i, parts[rows], pending, rows)
             good = np.ones(rows.size, dtype=bool)
             held = self.spec.operations[i].held
             for p in plist:
-                good &= self.oracle.feasible(p, s, held=held)
+                good &= self.oracle.feasible(p, s, held=held, workspace=workspace)
                 s = s | self.oracle.bit(p)
             column[rows] = good
         return ok
+
+    def pending_units(self, keys: np.ndarray) -> np.ndarray | None:
+        """(k, PW) uint64: members of the subassemblies not yet inserted, per state."""
+        if not self.unit_ops:
+            return None
+        keys = self._keys(keys)
+        pending = np.zeros((keys.shape[0], self.oracle.n_words), dtype=np.uint64)
+        for u, i in enumerate(self.unit_ops):
+            pending[~self.has_op(keys, i)] |= self.unit_masks[u]
+        return pending
+
+    def assembled_for(self, i: int, parts: np.ndarray, pending, rows=None):
+        """The parts operation ``i`` is tested against, and whether that is a unit's workspace.
+
+        ``parts`` are the placed parts of the states (every workspace); a unit's member
+        operation sees the members placed in its workspace, any other operation the main
+        assembly (``pending``, from :meth:`pending_units`, removed; ``rows`` selects its rows).
+        """
+        parts = self.oracle.sets(parts)
+        w = self.op_workspace[i] if self.op_workspace else -1
+        if w >= 0:
+            return parts & self.unit_masks[w], True
+        if pending is None:
+            return parts, False
+        return parts & ~(pending if rows is None else pending[rows]), False
 
     def successor_keys(self, keys: np.ndarray, ops: np.ndarray) -> np.ndarray:
         """(k, W) uint64: the state after doing operation ``ops[k]`` in state ``keys[k]``."""
@@ -538,7 +588,17 @@ def operation_model(spec: AssemblySpec, relations=None, *, _min_words: int = 1) 
     pidx = {p: k for k, p in enumerate(oracle.parts)}
     topo = spec.constraints.topological
     pred = [sum(1 << index[a] for a in op.after) if topo else 0 for op in ops]
-    part_lists = tuple(tuple(pidx[p] for p in op.parts) for op in ops)
+    part_lists = tuple(
+        (pidx[op.unit],) if op.unit else tuple(pidx[p] for p in op.parts) for op in ops
+    )
+    units = [u for u, _ in spec.subassemblies]
+    owner = {m: k for k, (_, ms) in enumerate(spec.subassemblies) for m in ms}
+    op_workspace = tuple(
+        owner[op.parts[0]] if op.parts and op.parts[0] in owner else -1 for op in ops
+    )
+    unit_masks = pack_words(
+        [sum(1 << pidx[m] for m in ms) for _, ms in spec.subassemblies], oracle.n_words
+    )
     req_m, req_v, set_m, set_v = [], [], [], []
     tindex = {t: k for k, t in enumerate(names)}
     for op in ops:
@@ -564,7 +624,7 @@ def operation_model(spec: AssemblySpec, relations=None, *, _min_words: int = 1) 
         oracle=oracle,
         op_bits=table([1 << i for i in range(n_ops)]),
         pred_masks=table(pred),
-        op_parts=pack_words([sum(1 << p for p in pl) for pl in part_lists], oracle.n_words),
+        op_parts=pack_words([sum(1 << pidx[p] for p in op.parts) for op in ops], oracle.n_words),
         part_lists=part_lists,
         requires_mask=table(req_m),
         requires_value=table(req_v),
@@ -577,6 +637,9 @@ def operation_model(spec: AssemblySpec, relations=None, *, _min_words: int = 1) 
         start_key=0,
         initial_parts=initial_parts,
         n_bits=pos,
+        op_workspace=op_workspace,
+        unit_ops=tuple(index[u] for u in units),
+        unit_masks=unit_masks,
     )
 
 

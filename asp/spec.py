@@ -19,6 +19,8 @@ An ``assembly.yaml`` names everything the planner needs besides the part geometr
     turn_model: alternate              # or concurrent (asp/concurrent.py)
     cost: steps                        # or time
     max_states: 20000000               # state graph limit (asmplan plan --max-states)
+    subassemblies:                     # built on their own, then inserted as one unit
+      motor_unit: [MT, PC]             # an operation "motor_unit" inserting it is added
     operations:
       - id: "1.2"                      # ids are strings (1.10 stays "1.10")
         description: Replace hex bit with cross bit on R1
@@ -52,7 +54,8 @@ a limit are refused (:mod:`cad.yamlfile`). For a CAD file or a folder of part me
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field
+from collections.abc import Iterable
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import networkx as nx
@@ -69,7 +72,7 @@ CONSTRAINT_KEYS = ("topological", "stability", "functional")
 SPEC_FILE = "assembly.yaml"
 TOP_KEYS = (
     "name", "units", "parts", "agents", "tools", "base_part", "gravity", "gripper_approach",
-    "constraints", "turn_model", "cost", "operations", "credit", "max_states",
+    "constraints", "turn_model", "cost", "operations", "credit", "max_states", "subassemblies",
 )  # fmt: skip
 """The top-level keys of ``assembly.yaml``; any other is refused."""
 OPERATION_KEYS = (
@@ -121,6 +124,9 @@ class Operation:
         Explicit predecessor operation ids.
     held : bool
         An agent holds the placed part: the stability constraint does not apply.
+    unit : str
+        The subassembly this operation inserts as one rigid unit (its members were placed in
+        the unit's own workspace by earlier operations); empty for other operations.
     """
 
     id: str
@@ -132,6 +138,7 @@ class Operation:
     after: tuple[str, ...] = ()
     held: bool = False
     ranges: tuple[tuple[str, float, float], ...] = ()
+    unit: str = ""
 
     @property
     def agents(self) -> tuple[str, ...]:
@@ -181,6 +188,8 @@ class AssemblySpec:
     credit: str = ""
     max_states: int | None = None
     generated: bool = False
+    subassemblies: tuple[tuple[str, tuple[str, ...]], ...] = ()
+    """Units built in their own workspace and inserted whole: (unit id, member part ids)."""
 
     @property
     def op_ids(self) -> tuple[str, ...]:
@@ -367,7 +376,7 @@ class _Parser:
             isinstance(max_states, bool) or not isinstance(max_states, int) or max_states < 1
         ):
             raise self.fail("max_states", f"expected a positive integer, got {max_states!r}")
-        return AssemblySpec(
+        spec = AssemblySpec(
             name=str(data.get("name") or Path(self.source).parent.name or "assembly"),
             operations=ops,
             agents=agents,
@@ -384,6 +393,15 @@ class _Parser:
             credit=str(data.get("credit", "")),
             max_states=max_states,
         )
+        raw_units = self.mapping(data.get("subassemblies"), "subassemblies")
+        if not raw_units:
+            return spec
+        units = []
+        for uid, members in raw_units.items():
+            if not isinstance(members, list):
+                raise self.fail(f"subassemblies.{uid}", "expected a list of part ids")
+            units.append((str(uid), tuple(self.text(m, f"subassemblies.{uid}") for m in members)))
+        return with_subassemblies(spec, units)
 
     def parts(self, raw) -> tuple[Part, ...]:
         if raw is None:
@@ -535,6 +553,64 @@ class _Parser:
                         f"operations[{op.id}].requires",
                         f"tool value {t} = {v!r} is needed but never set nor initial",
                     )
+
+
+def with_subassemblies(
+    spec: AssemblySpec, units: Iterable[tuple[str, Iterable[str]]]
+) -> AssemblySpec:
+    """``spec`` with the subassemblies ``units`` (unit id, member part ids) and their
+    insertion operations added.
+
+    Raises
+    ------
+    ValueError
+        One line naming the unit: an unknown or repeated member, the base part as a member,
+        fewer than two members, an id already used, or an operation placing members of the
+        unit and other parts.
+    """
+    units = [(str(u), tuple(dict.fromkeys(str(m) for m in ms))) for u, ms in units]
+    known = set(spec.part_ids) | set(spec.placed_parts)
+    taken = {m for _, ms in spec.subassemblies for m in ms}
+    ids = set(spec.op_ids) | known | {u for u, _ in spec.subassemblies}
+    ops = list(spec.operations)
+    for uid, members in units:
+        where = f"{spec.source}: subassemblies.{uid}"
+        if uid in ids:
+            raise ValueError(f"{where}: the id is already used by an operation or part")
+        if len(members) < 2:
+            raise ValueError(f"{where}: a subassembly needs at least two parts")
+        for m in members:
+            if m not in known:
+                raise ValueError(f"{where}: unknown part {m!r}")
+            if m in taken:
+                raise ValueError(f"{where}: part {m!r} is already in another subassembly")
+            if m == spec.base_part:
+                raise ValueError(f"{where}: the base part {m!r} cannot be in a subassembly")
+        member_ops = [op for op in ops if set(op.parts) & set(members)]
+        for op in member_ops:
+            if not set(op.parts) <= set(members):
+                raise ValueError(
+                    f"{where}: operation {op.id} places parts inside and outside the unit"
+                )
+        unplaced = set(members) - {p for op in member_ops for p in op.parts}
+        if unplaced:
+            raise ValueError(f"{where}: no operation places part {sorted(unplaced)[0]!r}")
+        longest: dict[str, float] = {}
+        for op in member_ops:
+            for agent, d in op.durations:
+                longest[agent] = max(longest.get(agent, 0.0), d)
+        ops.append(
+            Operation(
+                id=uid,
+                description=f"insert subassembly {uid} ({', '.join(members)})",
+                durations=tuple(longest.items()),
+                after=tuple(op.id for op in member_ops),
+                unit=uid,
+            )
+        )
+        taken |= set(members)
+        ids.add(uid)
+    return replace(spec, operations=tuple(ops), subassemblies=(*spec.subassemblies, *units))
 
 
 def check_predecessors(ops, source: str) -> None:

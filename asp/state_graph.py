@@ -325,16 +325,31 @@ def infeasibility_report(graph: StateGraph) -> str:
     return head + text
 
 
+def never_done(graph: StateGraph) -> list[int]:
+    """Operations that place parts, are ready in some state and are done in none."""
+    model = graph.model
+    ever = model.unpack(np.bitwise_or.reduce(graph.keys, axis=0)) if graph.n_states else 0
+    return [
+        i
+        for i in range(model.n_ops)
+        if not ever >> i & 1 and model.part_lists[i] and model.ready(graph.keys, i).any()
+    ]
+
+
 def _why_not(graph: StateGraph, i: int, state: int, placed_ever: int) -> tuple[bool, str]:
     """Whether operation ``i``'s failure in ``state`` is a root cause, and why it fails."""
     model = graph.model
     spec, oracle = model.spec, model.oracle
     op = spec.operations[i]
-    s = unpack_words(graph.parts[state])
+    keys = graph.keys[state : state + 1]
+    assembled, workspace = model.assembled_for(
+        i, graph.parts[state : state + 1], model.pending_units(keys)
+    )
+    s = unpack_words(assembled[0])
     missing = ((1 << len(oracle.parts)) - 1) & ~placed_ever
     why, root = [], False
     for p in model.part_lists[i]:
-        for reason in oracle.reasons(p, s, held=op.held):
+        for reason in oracle.reasons(p, s, held=op.held, workspace=workspace):
             name = oracle.parts[p]
             if reason == "no free direction":
                 by = oracle.blockers(p, s)
