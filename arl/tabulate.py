@@ -29,16 +29,34 @@ def action_probabilities(model, tables: GameTables, player: int, observer: Obser
     observer : Observer
         Maps nodes to the model's observations.
     """
-    obs = observer.batch(np.arange(tables.n))
     policy = model.policy
+    rows = tabulation_chunk(tables.n, observer)
+    parts = []
     with torch.no_grad():
-        obs_tensor, _ = policy.obs_to_tensor(obs)
-        probs = policy.get_distribution(obs_tensor).distribution.probs.cpu().numpy()
+        for lo in range(0, tables.n, rows):
+            obs = observer.batch(np.arange(lo, min(lo + rows, tables.n)))
+            obs_tensor, _ = policy.obs_to_tensor(obs)
+            parts.append(policy.get_distribution(obs_tensor).distribution.probs.cpu().numpy())
+    probs = np.concatenate(parts) if parts else np.zeros((0, tables.max_moves))
     mask = tables.masks(player)
     probs = np.where(mask, probs.astype(np.float64), 0.0)
     total = probs.sum(axis=1, keepdims=True)
     uniform = mask / np.maximum(mask.sum(axis=1, keepdims=True), 1)
     return np.where(total > 0, probs / np.where(total > 0, total, 1.0), uniform)
+
+
+CHUNK_CELLS = 1 << 26
+"""Observation cells (floats) fed to the network at once: 256 MB of float32."""
+
+
+def tabulation_chunk(n: int, observer: Observer) -> int:
+    """Nodes per forward pass, so the batch of observations stays within :data:`CHUNK_CELLS`.
+
+    A ``node`` observation is one-hot over all ``n`` nodes inside the network, so a pass
+    over every node at once would need ``n * n`` floats (40 GB at 100,000 nodes).
+    """
+    width = n if observer.features is None else observer.features.shape[1]
+    return max(1, min(n, CHUNK_CELLS // max(width, 1)))
 
 
 def greedy_policy(probs: np.ndarray, tables: GameTables, player: int) -> np.ndarray:
