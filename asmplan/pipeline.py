@@ -564,7 +564,7 @@ def write_plan(
             f"in red, TCT {solution.tct:g}, W* {solution.minimax:g}",
         )
         if result.concurrent is not None:
-            from asp.concurrent_plan import write_figures
+            from asmplan.report.gantt import write_figures
 
             write_figures(result.concurrent, out.path)
         if on_step is not None:

@@ -376,7 +376,11 @@ def min_makespan(
     model = cp_model.CpModel()
 
     # Variables: start[i], end[i] of task i; present[i][m] true iff task i is done in mode m
-    # (by that mode's agent); interval[i][m] the (optional) interval of that mode.
+    # (by that mode's agent); interval[i][m] the (optional) fixed-size interval of that mode,
+    # starting at start[i]. A task of several modes also has one interval of variable size
+    # (the chosen mode's duration) that ties end[i] to start[i]. The optional intervals must
+    # not share end[i]: OR-Tools 9.15 then proves a wrong optimum (a 3-task job at 4 where 3
+    # exists; tests/asp/test_baseline.py::test_modes_of_different_lengths_share_no_end).
     start = [model.new_int_var(0, horizon, f"start_{t.id}") for t in tasks]
     end = [model.new_int_var(0, horizon, f"end_{t.id}") for t in tasks]
     present: list[list] = []
@@ -388,9 +392,12 @@ def min_makespan(
         else:
             lits = [model.new_bool_var(f"mode_{t.id}_{a}") for a, _ in t.modes]
             ivs = [
-                model.new_optional_interval_var(start[i], d, end[i], lit, f"iv_{t.id}_{a}")
+                model.new_optional_fixed_size_interval_var(start[i], d, lit, f"iv_{t.id}_{a}")
                 for (a, _), d, lit in zip(t.modes, dur[i], lits, strict=True)
             ]
+            size = model.new_int_var(min(dur[i]), max(dur[i]), f"size_{t.id}")
+            model.add(size == sum(d * lit for d, lit in zip(dur[i], lits, strict=True)))
+            model.new_interval_var(start[i], size, end[i], f"iv_{t.id}")
             # Constraint: exactly one mode (agent) does the task.
             model.add_exactly_one(lits)
         present.append(lits)

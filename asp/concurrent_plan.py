@@ -10,17 +10,15 @@
   does not plan for them;
 - the robust plan played when the person follows it and against the worst person.
 
-:func:`robustness_table`, :func:`plan_entries` and :func:`write_figures` turn it into text,
-``plan.json`` keys and the PNGs ``robustness.png``, ``gantt_cooperative.png``,
-``gantt_worst.png``. :func:`policy_table` is the robust policy state by state.
+:func:`robustness_table` and :func:`plan_entries` turn it into text and ``plan.json``
+keys; :func:`asmplan.report.gantt.write_figures` draws the PNGs ``robustness.png``,
+``gantt_cooperative.png`` and ``gantt_worst.png``. :func:`policy_table` is the robust policy
+state by state.
 """
 
 from __future__ import annotations
 
-import os
-from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
@@ -273,44 +271,3 @@ def policy_table(game: ConcurrentGame, solution: Solution, *, limit: int = 20_00
                 stack.append(w)
     out.sort(key=lambda r: r["node"])
     return out
-
-
-def write_figures(plan: ConcurrentPlan, folder: str | os.PathLike[str] | Callable) -> list[Path]:
-    """Write ``robustness.png``, ``gantt_cooperative.png`` and ``gantt_worst.png``.
-
-    ``folder`` is a folder, or a function from a file name to its path (an
-    :class:`asp.atomic.OutputSet`'s ``path``).
-    """
-    from asp.gantt import plot_gantt, plot_robustness
-
-    path_of = folder if callable(folder) else Path(folder).joinpath
-    name = plan.spec.name
-    k = plan.curve.k
-    written = [
-        plot_robustness(
-            plan.curve.to_list(),
-            path_of("robustness.png"),
-            schedule=plan.schedule.objective,
-            schedule_rows=plan.schedule_worst,
-            title=f"{name}\nguaranteed makespan against a person who may deviate k times",
-        )
-    ]
-    bars, makespan = plan.cooperative
-    written.append(
-        plot_gantt(
-            bars,
-            path_of("gantt_cooperative.png"),
-            makespan=makespan,
-            title=f"{name}: robust plan (k = {k}), the person follows it: {makespan:g}",
-        )
-    )
-    bars, makespan = plan.worst
-    written.append(
-        plot_gantt(
-            bars,
-            path_of("gantt_worst.png"),
-            makespan=makespan,
-            title=f"{name}: robust plan (k = {k}) against the worst person: {makespan:g}",
-        )
-    )
-    return written

@@ -1,8 +1,9 @@
-"""Readable plans: the relations summary and the robust plan as a list of steps.
+"""Plans as data: the relations summary and the robust plan as a list of steps.
 
 The robust plan is the game played by the robust robot policy against the maximising human
 (both minimax, :func:`asp.solve.solve`), step by step, with passes shown, and at each human
-turn the operations the human could choose from.
+turn the operations the human could choose from. Their text renderings are in
+:mod:`asmplan.report.plan`.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ import numpy as np
 from asp import rules
 from asp.dag import GameDAG
 from asp.errors import GameError
-from asp.numbers import cost_text, plain
+from asp.numbers import plain
 from asp.rules import HUMAN, ROBOT
 from asp.solve import Solution
 from cad.directions import DIRECTIONS
@@ -123,22 +124,6 @@ def _side(player: int) -> str:
     return rules.player_name(player)
 
 
-def plan_text(steps: list[PlanStep]) -> str:
-    """The step list as aligned text lines."""
-    lines = []
-    for s in steps:
-        if not s.operation:
-            what = "passes (nothing it may do)"
-        else:
-            what = f"{s.operation:5s} {s.agent:3s} {s.description}  [{cost_text(s.cost)}]"
-        line = f"{s.step:3d}. {s.player:5s} {what}"
-        others = [o for o in s.human_options if not o.startswith(f"{s.operation} ")]
-        if s.player == "human" and others:
-            line += f"   (human may instead: {', '.join(others)})"
-        lines.append(line)
-    return "\n".join(lines)
-
-
 def relations_summary(relations) -> list[dict]:
     """Per part: the parts it touches (with directions) and its free directions.
 
@@ -160,13 +145,3 @@ def relations_summary(relations) -> list[dict]:
         free = [DIRECTIONS[d] for d in range(6) if all(tt[i, j, d] for j in others)]
         out.append({"part": p, "contacts": contacts, "free": free})
     return out
-
-
-def relations_text(summary: list[dict]) -> str:
-    width = max((len(r["part"]) for r in summary), default=4)
-    lines = []
-    for r in summary:
-        touches = " ".join(f"{q}({','.join(ds)})" for q, ds in r["contacts"].items()) or "-"
-        free = " ".join(r["free"]) or "none"
-        lines.append(f"  {r['part'].ljust(width)}  touches {touches}; free: {free}")
-    return "\n".join(lines)

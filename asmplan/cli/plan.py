@@ -22,8 +22,8 @@ TurnModel = choices("TurnModel", TURN_MODELS, "Turn model of the game.")
 
 def plan_summary(result) -> list[str]:
     """The lines ``asmplan plan`` prints for an :class:`~asmplan.pipeline.AssemblyPlan`."""
+    from asmplan.report.plan import plan_text, relations_summary_text
     from asp.numbers import cost_unit
-    from asp.plan import plan_text, relations_text
 
     spec, graph, dag, solution = result.assembly.spec, result.graph, result.dag, result.solution
     lines = [
@@ -32,7 +32,7 @@ def plan_summary(result) -> list[str]:
     ]
     if result.relations_summary:
         lines.append("part relations (contacts with directions; free directions in the assembly):")
-        lines.append(relations_text(result.relations_summary))
+        lines.append(relations_summary_text(result.relations_summary))
     lines.append(
         f"state graph: {graph.n_states:,} states, {graph.n_transitions:,} transitions, "
         f"{result.sequences:,} feasible sequences"

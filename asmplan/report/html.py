@@ -1,7 +1,7 @@
 """``report.html``: one self-contained page a person reads (no network: pictures are PNG data URIs).
 
 It shows the metrics, the price-of-robustness curve and the Gantt charts of the concurrent
-game (when it could be solved; drawn by :mod:`asp.gantt`), the CP-SAT schedule's Gantt
+game (when it could be solved; drawn by :mod:`asmplan.report.gantt`), the CP-SAT schedule's Gantt
 chart, the relations table, the principal line as pictures of the assembly growing step by
 step (rendered from the part meshes, the parts of each step highlighted) and the game DAG
 picture.
@@ -88,7 +88,7 @@ def assembly_steps(plan: dict, *, max_pictures: int = 40) -> list[tuple[dict, st
 
 
 def report_figures(doc: dict, concurrent_plan=None, *, spec=None, graph=None) -> dict[str, bytes]:
-    """The curve and Gantt PNGs of the report (:mod:`asp.gantt`), by name.
+    """The curve and Gantt PNGs of the report (:mod:`asmplan.report.gantt`), by name.
 
     ``concurrent_plan`` (:class:`asp.concurrent_plan.ConcurrentPlan`) gives the curve and
     the two timelines; without it they are computed here from ``spec`` and ``graph`` when
@@ -97,8 +97,8 @@ def report_figures(doc: dict, concurrent_plan=None, *, spec=None, graph=None) ->
     """
     import tempfile
 
+    from asmplan.report.gantt import plot_gantt, plot_robustness
     from asp.concurrent import Bar
-    from asp.gantt import plot_gantt, plot_robustness
 
     out: dict[str, bytes] = {}
     with tempfile.TemporaryDirectory() as tmp:

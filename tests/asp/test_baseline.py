@@ -118,6 +118,24 @@ def test_schedule_agents_and_precedence():
     assert rows["b"]["agent"] == "R" or rows["b"]["end"] <= 7
 
 
+def test_modes_of_different_lengths_share_no_end():
+    # R1 does a (1), then H does b and c (1 each): makespan 3. With the modes' optional
+    # intervals sharing one end variable, OR-Tools 9.15 proved 4 "OPTIMAL".
+    problem = ScheduleProblem(
+        name="modes",
+        tasks=(
+            Task("a", (("R1", 1), ("H", 2))),
+            Task("b", (("H", 1), ("R1", 3))),
+            Task("c", (("H", 1), ("R1", 3))),
+        ),
+        precedences=((0, 1), (0, 2)),
+    )
+    result = min_makespan(problem)
+    assert result.status == "OPTIMAL" and result.objective == 3
+    rows = {r["task"]: r for r in result.detail["schedule"]}
+    assert rows["a"]["agent"] == "R1" and rows["a"]["end"] == 1
+
+
 def test_schedule_respects_tool_states():
     spec = toggle_spec()
     graph = build_state_graph(spec)

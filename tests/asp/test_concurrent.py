@@ -247,7 +247,9 @@ def test_pump_with_ranges_robust_plan_beats_the_schedule():
     ]
     assert plan.schedule.objective == 297
     worst = {r["k"]: r["bound"] for r in plan.schedule_worst}
-    assert worst[0] == 297 and worst[1] == 333
+    # Which of CP-SAT's 297 s optima it returns decides how much one deviation costs that
+    # schedule (333 s or 330 s seen); any of them loses to the robust plan's 297 s.
+    assert worst[0] == 297 and worst[1] > 297 and worst[None] > 297
 
 
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])

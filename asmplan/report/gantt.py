@@ -1,16 +1,18 @@
 """Pictures of the concurrent game: the price-of-robustness curve and Gantt charts.
 
-matplotlib is imported lazily with the Agg backend; PNGs are written atomically.
+Figures are drawn on :class:`matplotlib.figure.Figure` (no pyplot, no global backend);
+PNGs are written atomically.
 """
 
 from __future__ import annotations
 
 import io
 import os
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from asp.atomic import write_bytes
+from asp.concurrent_plan import ConcurrentPlan
 
 AGENT_COLOURS = {"H": "#9e9e9e", "R1": "#2e9d4a", "R2": "#f28c28"}
 """The paper's Figure 9 colours: operator grey, R1 green, R2 orange."""
@@ -18,20 +20,16 @@ OTHER_COLOURS = ("#3b6fb6", "#8e44ad", "#c0392b", "#16a085", "#7f8c8d")
 DEVIATION_COLOUR = "#d62728"
 
 
-def _pyplot():
-    import matplotlib
+def _figure(figsize: tuple[float, float], dpi: int):
+    from matplotlib.figure import Figure
 
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
+    fig = Figure(figsize=figsize, dpi=dpi)
+    return fig, fig.subplots()
 
 
 def _save(fig, path) -> Path:
-    plt = _pyplot()
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png")
-    plt.close(fig)
     return write_bytes(path, buffer.getvalue())
 
 
@@ -54,10 +52,9 @@ def plot_robustness(
     schedule_rows : list of {"k", "bound"}, optional
         The CP-SAT schedule's certified worst case under the same budgets.
     """
-    plt = _pyplot()
     xs = list(range(len(rows)))
     labels = ["inf" if r["k"] is None else str(r["k"]) for r in rows]
-    fig, ax = plt.subplots(figsize=(6.4, 4.0), dpi=110)
+    fig, ax = _figure((6.4, 4.0), 110)
     ax.plot(xs, [r["bound"] for r in rows], "o-", color="#1f4e9c", label="robust plan W*(k)")
     if schedule_rows:
         ax.plot(
@@ -92,7 +89,6 @@ def plot_gantt(
     ----------
     bars : sequence of :class:`asp.concurrent.Bar`
     """
-    plt = _pyplot()
     from matplotlib.patches import Patch
 
     agents = sorted({b.agent for b in bars}, key=lambda a: (not a.startswith("H"), a))
@@ -101,7 +97,7 @@ def plot_gantt(
     for a in agents:
         palette.setdefault(a, OTHER_COLOURS[len(palette) % len(OTHER_COLOURS)])
     end = max([makespan or 0.0, *(b.end for b in bars)])
-    fig, ax = plt.subplots(figsize=(max(7.0, min(18.0, 0.05 * end + 5)), 1.0 + 0.6 * len(agents)))
+    fig, ax = _figure((max(7.0, min(18.0, 0.05 * end + 5)), 1.0 + 0.6 * len(agents)), 100)
     for b in bars:
         y = row[b.agent]
         ax.barh(
@@ -128,3 +124,42 @@ def plot_gantt(
     ax.set_title(title, fontsize=10)
     fig.tight_layout()
     return _save(fig, path)
+
+
+def write_figures(plan: ConcurrentPlan, folder: str | os.PathLike[str] | Callable) -> list[Path]:
+    """Write ``robustness.png``, ``gantt_cooperative.png`` and ``gantt_worst.png``.
+
+    ``folder`` is a folder, or a function from a file name to its path (an
+    :class:`asp.atomic.OutputSet`'s ``path``).
+    """
+    path_of = folder if callable(folder) else Path(folder).joinpath
+    name = plan.spec.name
+    k = plan.curve.k
+    written = [
+        plot_robustness(
+            plan.curve.to_list(),
+            path_of("robustness.png"),
+            schedule=plan.schedule.objective,
+            schedule_rows=plan.schedule_worst,
+            title=f"{name}\nguaranteed makespan against a person who may deviate k times",
+        )
+    ]
+    bars, makespan = plan.cooperative
+    written.append(
+        plot_gantt(
+            bars,
+            path_of("gantt_cooperative.png"),
+            makespan=makespan,
+            title=f"{name}: robust plan (k = {k}), the person follows it: {makespan:g}",
+        )
+    )
+    bars, makespan = plan.worst
+    written.append(
+        plot_gantt(
+            bars,
+            path_of("gantt_worst.png"),
+            makespan=makespan,
+            title=f"{name}: robust plan (k = {k}) against the worst person: {makespan:g}",
+        )
+    )
+    return written
