@@ -147,6 +147,12 @@ class RunFolder:
         if self.current_index() > 0:
             self._publish()
 
+    def discard_uncommitted(self) -> None:
+        """Remove what the cycle being trained wrote (after an error: a full disk, ...)."""
+        staged = self._checkpoint(self.current_index() + 1)
+        if staged.exists():
+            _remove_tree(staged)
+
     def staging_tb(self, agent: str) -> Path:
         """Where the cycle being trained writes ``agent``'s TensorBoard events."""
         return self._checkpoint(self.current_index() + 1) / TB / f"{agent}_0"

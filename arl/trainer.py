@@ -362,6 +362,10 @@ def train(
             from arl.plots import rewards_png
 
             folder.write_rewards_png(rewards_png(run.rewards))
+    except Exception:
+        if folder is not None:  # an error, not a kill: leave no half-written cycle behind
+            folder.discard_uncommitted()
+        raise
     finally:
         for env in run.envs.values():
             env.close()

@@ -77,7 +77,7 @@ UNBOUNDED = -1
 """Budget of the fully adversarial human (no instructions, every reply allowed)."""
 WAIT = -1
 """Operation index of a worker that waits (or has nothing to do)."""
-DEFAULT_MAX_NODES = 5_000_000
+DEFAULT_MAX_NODES = 3_000_000
 """Above this many game nodes the build stops with a ``ValueError``."""
 DEFAULT_MAX_K = 12
 """Largest deviation budget tried when looking for the flat part of the curve."""
@@ -789,7 +789,10 @@ def robustness(
     """Solve the concurrent game exactly for ``k = 0, 1, ...`` until ``W*(k) == W*(inf)``.
 
     The curve is non-decreasing and bounded by ``W*(inf)``, which it reaches once the budget
-    covers every human decision; ``max_k`` bounds the search (then ``flat`` is False).
+    covers every human decision. Budgets double (2, 4, 8, ...) until the curve is flat;
+    ``max_k`` bounds the search, and so does ``max_nodes``: a doubled game over the limit
+    leaves the curve as it was (``flat`` False). The first game over the limit is an error
+    naming ``--max-k``.
     """
     if max_k < 0:
         raise GameError(f"max_k: expected a deviation budget >= 0, got {max_k}")
@@ -804,8 +807,15 @@ def robustness(
             file=sys.stderr,
         )
     k = min(2, max_k)
+    game = None
     while True:
-        game = build_game(model, k, max_nodes=max_nodes, progress=progress)
+        try:
+            bigger = build_game(model, k, max_nodes=max_nodes, progress=progress)
+        except GameError:
+            if game is None:
+                raise
+            break  # the curve so far stands; ``flat`` stays False and the report says so
+        game = bigger
         sol = solve(game.dag)
         bounds = [value(game, sol, b) for b in range(k + 1)]
         if progress:

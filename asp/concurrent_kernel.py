@@ -9,8 +9,9 @@ Python one for states that do not fit the packed key), written over arrays:
 - ``conflict[a, b]``: a tool conflict; ``en_ptr``/``en_ops``: the enabled operations per
   state, in the state graph's order; ``complete[s]``; ``side[w]`` (0 robot, 1 human).
 
-A node is a row ``[kind, state, budget, op[0..W), rem[0..W), instr[0..W)]`` (``kind`` 0 robot,
-1 human, 2 end; ``op`` -1 for a free worker; ``instr`` -2 where there is none), found again
+A node is an int32 row ``[kind, state, budget, op[0..W), rem[0..W), instr[0..W)]``
+(``kind`` 0 robot, 1 human, 2 end; ``op`` -1 for a free worker; ``instr`` -2 where there is
+none; edges are int32 with int16 operations), found again
 through a hash map on a packed key of four words (:func:`fits` says when it fits). The
 enumeration order of moves is the Python builder's, so both give the same game.
 """
@@ -45,14 +46,14 @@ def fits(n_workers: int, n_ops: int, longest: int, n_states: int, budget: int) -
 
 @numba.njit(cache=True)
 def _key(row, nw):  # pragma: no cover - compiled
-    w0 = row[0] | (row[1] << 2) | ((row[2] + 1) << 36)
-    w1 = 0
-    w2 = 0
-    w3 = 0
+    w0 = np.int64(row[0]) | (np.int64(row[1]) << 2) | ((np.int64(row[2]) + 1) << 36)
+    w1 = np.int64(0)
+    w2 = np.int64(0)
+    w3 = np.int64(0)
     for w in range(nw):
-        w1 |= (row[3 + w] + 2) << (8 * w)
-        w2 |= row[3 + nw + w] << (16 * w)
-        w3 |= (row[3 + 2 * nw + w] + 2) << (8 * w)
+        w1 |= (np.int64(row[3 + w]) + 2) << (8 * w)
+        w2 |= np.int64(row[3 + nw + w]) << (16 * w)
+        w3 |= (np.int64(row[3 + 2 * nw + w]) + 2) << (8 * w)
     return (w0, w1, w2, w3)
 
 
@@ -134,19 +135,19 @@ def build_kernel(
     nw = side.shape[0]
     width = 3 + 3 * nw
     cap = 1024
-    rows = np.empty((cap, width), np.int64)
+    rows = np.empty((cap, width), np.int32)
     index = Dict.empty(key_type=KEY, value_type=types.int64)
     memo = Dict.empty(key_type=MEMO_KEY, value_type=types.boolean)
     n = 0
     stack = np.empty(cap, np.int64)
     top = 0
-    e_src = np.empty(cap, np.int64)
-    e_dst = np.empty(cap, np.int64)
-    e_cost = np.empty(cap, np.int64)
+    e_src = np.empty(cap, np.int32)
+    e_dst = np.empty(cap, np.int32)
+    e_cost = np.empty(cap, np.int32)
     e_side = np.empty(cap, np.int8)
-    e_ops = np.empty((cap, nw), np.int64)
-    e_dur = np.empty((cap, nw), np.int64)
-    e_dev = np.empty(cap, np.int64)
+    e_ops = np.empty((cap, nw), np.int16)
+    e_dur = np.empty((cap, nw), np.int32)
+    e_dev = np.empty(cap, np.int8)
     m_edges = 0
     row = np.empty(width, np.int64)
     # The end node first (index 0), then one start per budget.
@@ -282,7 +283,7 @@ def build_kernel(
                             overflow = True
                             break
                         if n >= rows.shape[0]:
-                            grown = np.empty((2 * rows.shape[0], width), np.int64)
+                            grown = np.empty((2 * rows.shape[0], width), np.int32)
                             grown[:n] = rows[:n]
                             rows = grown
                             gs = np.empty(2 * stack.shape[0], np.int64)
@@ -385,7 +386,7 @@ def build_kernel(
                                     overflow = True
                                     break
                                 if n >= rows.shape[0]:
-                                    grown = np.empty((2 * rows.shape[0], width), np.int64)
+                                    grown = np.empty((2 * rows.shape[0], width), np.int32)
                                     grown[:n] = rows[:n]
                                     rows = grown
                                     gs = np.empty(2 * stack.shape[0], np.int64)

@@ -154,8 +154,9 @@ def robustness_table(plan: ConcurrentPlan) -> str:
         lines.append(f"{name:>12} | {_fmt(row['bound']):>17} | {_fmt(worst.get(k)):>8}{note}")
     if not plan.curve.flat:
         lines.append(
-            f"the curve is not flat at k = {plan.curve.k} (--max-k): W*(k) may still rise to "
-            f"W*(inf) = {plan.curve.unbounded:g}"
+            f"the curve is not flat at k = {plan.curve.k} (--max-k, or the next budget's game "
+            f"was over the node limit): W*(k) may still rise to W*(inf) = "
+            f"{plan.curve.unbounded:g}"
         )
     game = plan.curve.game
     lines.append(

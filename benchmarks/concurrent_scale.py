@@ -35,9 +35,9 @@ def job(n_ops: int = 20, robots: int = 2, chains: int = 4, spread: int = 4) -> A
             durations = (("H", base + spread),)
             ranges = (("H", base, base + spread),) if spread else ()
         elif i % 3 == 1:
-            durations = ((f"R{1 + i % robots}", base),)
+            durations = ((f"R{1 + (i // 3) % robots}", base),)
         else:
-            durations = ((f"R{1 + (i + 1) % robots}", base), ("H", base + 2))
+            durations = ((f"R{1 + (i // 3 + 1) % robots}", base), ("H", base + 2))
         ops.append(Operation(f"o{i}", "", durations=durations, after=after, ranges=ranges))
     # R1 screws o5 with the cross bit and o13 with the hex bit; the person changes the bit.
     if n_ops >= 16:

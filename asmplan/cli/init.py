@@ -7,6 +7,7 @@ from pathlib import Path
 import typer
 
 from asmplan.cli.app import app
+from asmplan.cli.options import check_output
 
 
 @app.command("init")
@@ -29,6 +30,7 @@ def init_command(
 
     if not source.exists():
         raise FileNotFoundError(f"{source}: no such file or folder")
+    check_output(output, folder=False)
     if output.exists() and not force:
         raise ValueError(f"{output} exists (use --force to overwrite it)")
     text = spec_text(source, spec_folder=output.parent)

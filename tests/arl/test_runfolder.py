@@ -100,6 +100,18 @@ def test_a_kill_at_every_write_resumes_to_the_uninterrupted_run(tmp_path, monkey
         assert not list(run.rglob("*.tmp")), where
 
 
+def test_a_write_error_leaves_no_half_cycle(tmp_path, monkeypatch):
+    run = tmp_path / "run"
+
+    def full_disk(path, data):
+        raise OSError(28, "No space left on device", str(path))
+
+    monkeypatch.setattr(runfolder, "write_bytes", full_disk)
+    with pytest.raises(OSError, match="No space left"):
+        train(figure4(), CFG, seed=0, output=run)
+    assert sorted(p.name for p in run.iterdir()) == []  # no tb/, no checkpoint folder
+
+
 @pytest.mark.parametrize(
     "text, problem",
     [

@@ -122,3 +122,33 @@ def test_the_cad_hierarchy_of_a_spec(tmp_path):
         ("pillar_unit_1", ("cap_1", "pillar_1")),
         ("pillar_unit_2", ("cap_2", "pillar_2")),
     )
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["nothing.step"], "no such file or folder"),
+        (["{folder}", "-o", "{file}/assembly.yaml"], "lies under"),
+        (["{folder}", "-o", "{folder}"], "is a folder"),
+    ],
+)
+def test_init_bad_input_is_one_line_exit_2(tmp_path, args, message):
+    folder = write_folder(tmp_path / "meshes", shapes.boxed_container())
+    (tmp_path / "file").write_text("x")
+    args = [a.format(folder=folder, file=tmp_path / "file") for a in args]
+    result = CliRunner().invoke(app, ["init", *args])
+    assert result.exit_code == 2 and message in result.stderr
+    assert result.stderr.count("\n") == 1
+
+
+def test_a_fabrica_folder_of_meshes_plans_with_no_spec(shared_data):
+    # Fabrica benchmark (MIT, Yunsheng Tian): plumber's block, one OBJ per part
+    from asmplan import pipeline
+
+    folder = shared_data / "cad" / "fabrica" / "plumbers_block"
+    if not folder.is_dir():
+        pytest.skip("fabrica data not found")
+    assembly = pipeline.load(folder)
+    assert assembly.spec.generated and assembly.spec.base_part == "2"  # the block at z = 0
+    graph = pipeline.state_graph(assembly)
+    assert graph.count_sequences() > 0
