@@ -47,7 +47,7 @@ if TYPE_CHECKING:  # pragma: no cover - types only
 PLAN_FORMAT = "asmplan-plan/2"
 GRAPH_SUFFIXES = (".json", ".graphml", ".xml")
 """Suffixes read as a game DAG file rather than an assembly."""
-PLAN_FILES = ("plan.json", "dag.png")
+PLAN_FILES = ("plan.json", "dag.png", "report.html")
 """The files ``asmplan plan`` writes (besides ``manifest.json``)."""
 CONCURRENT_FILES = ("robustness.png", "gantt_cooperative.png", "gantt_worst.png")
 """The figures ``asmplan plan --turn-model concurrent`` adds (:mod:`asp.concurrent_plan`)."""
@@ -535,7 +535,7 @@ def plan(
 def write_plan(
     result: AssemblyPlan, output: str | os.PathLike[str], *, on_step: Progress | None = None
 ) -> tuple[Path, ...]:
-    """Write ``plan.json`` and (small enough games) ``dag.png`` into ``output`` as one unit.
+    """Write ``plan.json``, ``dag.png`` and ``report.html`` into ``output`` as one unit.
 
     The files of one run are named by ``manifest.json``, written last; the previous run's
     files are removed first, so the folder never mixes two runs (see
@@ -566,7 +566,21 @@ def write_plan(
             from asp.concurrent_plan import write_figures
 
             write_figures(result.concurrent, out.path)
+        if on_step is not None:
+            on_step("  writing report.html ...")
+        out.write_text("report.html", plan_report(result, doc, out.path("dag.png").read_bytes()))
     return out.written
+
+
+def plan_report(result: AssemblyPlan, doc: dict, dag_png: bytes | None = None) -> str:
+    """``report.html`` of a plan (:mod:`asmplan.report.html`), with the concurrent game's
+    curve and Gantt charts (solved for the report when the plan has none and is small)."""
+    from asmplan.report.html import report_figures, report_html
+
+    figures = report_figures(doc, result.concurrent, spec=result.assembly.spec, graph=result.graph)
+    if dag_png:
+        figures["dag"] = dag_png
+    return report_html(doc, figures)
 
 
 def path_edges(dag: GameDAG, path: list[int]) -> list[int]:

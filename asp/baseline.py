@@ -364,6 +364,11 @@ def min_makespan(
     scale = integer_scale(all_durations) if all_durations else 1
     dur = [[round(d * scale) for _, d in t.modes] for t in tasks]
     horizon = max(1, sum(max(d) for d in dur))
+    if horizon > EXACT_HEADROOM:
+        raise ScheduleError(
+            f"{problem.name}: durations too large for CP-SAT: their sum {horizon / scale:g} "
+            f"(in units of 1/{scale}) exceeds 2**53 units"
+        )
     if len(problem.resources) and any(len(t.demands) != len(problem.resources) for t in tasks):
         raise ScheduleError(f"{problem.name}: every task needs one demand per resource")
 

@@ -19,8 +19,9 @@ Semantics (``../shared/DESIGN.md``, "The concurrent game"):
 - Two operations run at the same time only if each is feasible whichever finishes first:
   with ``D`` done and the set ``A`` running, every ``D + T`` (``T`` a subset of ``A``) is a
   state of the state graph from which each operation of ``A - T`` is an edge
-  (:meth:`ConcurrentModel.compatible`, the rule of :func:`asp.rules`' concurrent twin,
-  written once here), and no operation changes a tool another one needs or changes. Every
+  (:meth:`ConcurrentModel.compatible`, the one place this rule is written; the compiled
+  builder and the schedule replay repeat it over arrays and are tested against it), and no
+  operation changes a tool another one needs or changes. Every
   state entered must still be completable (the state graph's co-reachable states).
 - The human's duration may be a range ``[min, max]``. The adversary picks it on the grid
   ``min, min + step, ..., max`` (``max`` always included; ``step`` defaults to the time
@@ -226,6 +227,69 @@ class ConcurrentModel:
         return nxt, chg, dur, ndur, self.conflict, en_ptr, en_ops, self.complete, side
 
 
+def spec_workers(spec: AssemblySpec) -> tuple[Worker, ...]:
+    """The workers of the concurrent game: robots first, then humans; an agent of side
+    ``any`` is one worker of each side (``A:robot``, ``A:human``), as in the CP-SAT schedule."""
+    workers = []
+    for side in (ROBOT, HUMAN):
+        for a in spec.agents:
+            if a.side == "any":
+                name = f"{a.name}:{'robot' if side == ROBOT else 'human'}"
+                workers.append(Worker(name=name, agent=a.name, side=side))
+            elif (a.side == "robot") == (side == ROBOT):
+                workers.append(Worker(name=a.name, agent=a.name, side=side))
+    return tuple(workers)
+
+
+def tool_conflicts(spec: AssemblySpec) -> np.ndarray:
+    """(n_ops, n_ops) bool: one operation changes a tool the other needs or changes."""
+    ops = spec.operations
+    n = len(ops)
+    tools_set = [{t for t, _ in o.sets} for o in ops]
+    tools_used = [{t for t, _ in (*o.sets, *o.requires)} for o in ops]
+    conflict = np.zeros((n, n), dtype=bool)
+    for a in range(n):
+        for b in range(n):
+            if a != b and (tools_set[a] & tools_used[b] or tools_set[b] & tools_used[a]):
+                conflict[a, b] = True
+    return conflict
+
+
+class GraphSteps:
+    """``succ``-style lookups straight on the state graph (no dictionary of every transition).
+
+    ``get((state, op))`` is ``(next state, 0)`` when ``op`` is a transition of ``state`` into a
+    co-reachable state, else None: what :func:`asp.baseline.schedule_violation` asks, for a
+    state graph of any size.
+    """
+
+    def __init__(self, graph: StateGraph):
+        self.indptr = graph.indptr
+        self.dst = graph.dst
+        self.op = graph.op
+        self.alive = graph.coreachable()
+
+    def get(self, key):
+        s, o = key
+        lo, hi = int(self.indptr[s]), int(self.indptr[s + 1])
+        hit = np.flatnonzero(self.op[lo:hi] == o)
+        if hit.size == 0:
+            return None
+        t = int(self.dst[lo + int(hit[0])])
+        return (t, 0) if self.alive[t] else None
+
+
+@dataclass(frozen=True, eq=False)
+class ReplayModel:
+    """What a schedule replay needs of the concurrent rules: the spec, the workers, the
+    state graph's transitions and the tool conflicts (built in time linear in the spec)."""
+
+    spec: AssemblySpec
+    workers: tuple[Worker, ...]
+    succ: GraphSteps
+    conflict: np.ndarray
+
+
 def concurrent_model(
     spec: AssemblySpec, graph: StateGraph, *, step: float | None = 1.0
 ) -> ConcurrentModel:
@@ -246,14 +310,7 @@ def concurrent_model(
     where = spec.source or spec.name
     if step is not None and not (math.isfinite(step) and step > 0):
         raise SpecError(f"{where}: duration step: expected a positive number, got {step}")
-    workers = []
-    for side in (ROBOT, HUMAN):
-        for a in spec.agents:
-            if a.side == "any":
-                name = f"{a.name}:{'robot' if side == ROBOT else 'human'}"
-                workers.append(Worker(name=name, agent=a.name, side=side))
-            elif (a.side == "robot") == (side == ROBOT):
-                workers.append(Worker(name=a.name, agent=a.name, side=side))
+    workers = spec_workers(spec)
     ops = spec.operations
     ranges = [[None] * len(ops) for _ in workers]
     for i, op in enumerate(ops):
@@ -309,14 +366,7 @@ def concurrent_model(
     for s, d, o, c in zip(src.tolist(), dst.tolist(), op.tolist(), extra.tolist(), strict=True):
         succ[(s, o)] = (d, int(c))
         enabled[s].append(o)
-    n = len(ops)
-    tools_set = [{t for t, _ in o.sets} for o in ops]
-    tools_used = [{t for t, _ in (*o.sets, *o.requires)} for o in ops]
-    conflict = np.zeros((n, n), dtype=bool)
-    for a in range(n):
-        for b in range(n):
-            if a != b and (tools_set[a] & tools_used[b] or tools_set[b] & tools_used[a]):
-                conflict[a, b] = True
+    conflict = tool_conflicts(spec)
     return ConcurrentModel(
         spec=spec,
         graph=graph,
@@ -1079,7 +1129,7 @@ def assembly_makespan(
     time limit, else ``UNKNOWN`` with no schedule. ``detail`` holds ``cuts`` and ``replay``.
     """
     sched = assembly_schedule(spec, graph)
-    model = concurrent_model(spec, graph, step=None)
+    model = ReplayModel(spec, spec_workers(spec), GraphSteps(graph), tool_conflicts(spec))
 
     def replay(rows):
         found = schedule_violation(model, rows)

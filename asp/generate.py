@@ -251,7 +251,11 @@ def spec_text(path: str | Path, spec_folder: str | Path | None = None) -> str:
             "# identical parts: " + ", ".join(f"{n} x {s}" for s, n in sorted(counts.items()))
         )
     if assembly.groups:
-        lines.append("# hierarchy in the file (sub-assemblies):")
+        lines += [
+            "# The file's sub-assemblies: uncomment to build them on their own and insert each",
+            "# as one unit (asp/units.py; a part belongs to one unit: keep one level).",
+            "# subassemblies:",
+        ]
         for gid, members in assembly.groups:
             lines.append(f"#   {gid}: [{', '.join(members)}]")
     lines += [

@@ -60,6 +60,7 @@ from pathlib import Path
 
 import networkx as nx
 
+from asp.dag import MAX_COST
 from asp.rules import COST_MODELS
 from cad.bom import PartRecord, part_records, refuse_unknown_keys
 from cad.directions import DIRECTIONS
@@ -299,6 +300,8 @@ class _Parser:
             raise self.fail(key, f"expected a number, got {value!r}") from None
         if not x >= minimum or x == float("inf"):
             raise self.fail(key, f"expected a finite number >= {minimum:g}, got {value!r}")
+        if x > MAX_COST:
+            raise self.fail(key, f"expected a number up to {MAX_COST:g}, got {value!r}")
         return x
 
     def text(self, value, key: str) -> str:

@@ -70,7 +70,7 @@ def test_init_writes_a_spec_that_plans_the_same(tmp_path):
         'table_frame_in.step#cap_1", shape: cap}' in text
         and "# identical parts: 2 x cap, 2 x pillar" in text
     )
-    assert "#   pillar_unit_1: [cap_1, pillar_1]" in text
+    assert "# subassemblies:\n#   pillar_unit_1: [cap_1, pillar_1]\n" in text
     from_file, _ = plan(STEP, tmp_path / "a")
     from_spec, err = plan(spec, tmp_path / "b")
     assert "generated" not in err
@@ -148,7 +148,31 @@ def test_a_fabrica_folder_of_meshes_plans_with_no_spec(shared_data):
     folder = shared_data / "cad" / "fabrica" / "plumbers_block"
     if not folder.is_dir():
         pytest.skip("fabrica data not found")
-    assembly = pipeline.load(folder)
+    with pytest.warns(UserWarning, match="no assembly.yaml: generated a spec"):
+        assembly = pipeline.load(folder)
     assert assembly.spec.generated and assembly.spec.base_part == "2"  # the block at z = 0
     graph = pipeline.state_graph(assembly)
     assert graph.count_sequences() > 0
+
+
+def test_the_commented_subassemblies_of_init_are_a_valid_spec(tmp_path):
+    pytest.importorskip("cascadio")
+    import shutil
+
+    from asmplan import pipeline
+
+    shutil.copy(STEP, tmp_path / "frame.step")
+    spec = tmp_path / "assembly.yaml"
+    assert (
+        CliRunner().invoke(app, ["init", str(tmp_path / "frame.step"), "-o", str(spec)]).exit_code
+        == 0
+    )
+    text = spec.read_text().replace("# subassemblies:", "subassemblies:")
+    text = text.replace("#   pillar_unit_", "  pillar_unit_")
+    spec.write_text(text)
+    assembly = pipeline.load(spec)
+    assert dict(assembly.spec.subassemblies) == {
+        "pillar_unit_1": ("cap_1", "pillar_1"),
+        "pillar_unit_2": ("cap_2", "pillar_2"),
+    }
+    assert pipeline.state_graph(assembly).count_sequences() > 0

@@ -36,9 +36,10 @@ def dead_pid() -> int:
 
 def test_a_complete_run_names_its_files_last(pump_plan, tmp_path):
     written = pipeline.write_plan(pump_plan, tmp_path)
-    assert [p.name for p in written] == ["plan.json", "dag.png"]
+    files = ["plan.json", "dag.png", "report.html"]
+    assert [p.name for p in written] == files
     manifest = json.loads((tmp_path / MANIFEST).read_text())
-    assert manifest == {"format": "asmplan-manifest/1", "files": ["plan.json", "dag.png"]}
+    assert manifest == {"format": "asmplan-manifest/1", "files": files}
     assert json.loads((tmp_path / "plan.json").read_text()) == json.loads(
         json.dumps(pump_plan.to_dict())
     )
@@ -66,7 +67,7 @@ def test_a_failure_mid_write_leaves_no_mixed_folder(pump_plan, tmp_path, monkeyp
     monkeypatch.undo()
     pipeline.write_plan(pump_plan, tmp_path)
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
-        ["mine.txt", "plan.json", "dag.png", MANIFEST]
+        ["mine.txt", "plan.json", "dag.png", "report.html", MANIFEST]
     )
 
 

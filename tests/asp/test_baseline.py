@@ -202,3 +202,25 @@ def test_tiny_and_unscalable_costs(costs, rounded):
     assert result.detail.get("rounded", False) is rounded
     if not rounded:
         assert result.bound == pytest.approx(result.objective, rel=1e-9)
+
+
+def test_durations_past_the_exact_range_are_refused():
+    """Issue 14, item 5: a horizon beyond int64 was a TypeError inside OR-Tools."""
+    from asp.errors import ScheduleError
+
+    problem = ScheduleProblem(
+        name="huge", tasks=tuple(Task(id=str(k), modes=(("", 4e15),)) for k in range(3))
+    )
+    with pytest.raises(ScheduleError, match="huge: durations too large for CP-SAT"):
+        min_makespan(problem)
+
+
+def test_spec_durations_past_the_cost_limit_are_refused_at_load(tmp_path):
+    """Issue 14, item 5: magnitudes are checked at load, and the message says the limit."""
+    from asp.spec import spec_from_dict
+
+    data = {"agents": {"H": "human"}, "operations": [{"id": "a", "agents": {"H": 1e20}}]}
+    with pytest.raises(
+        ValueError, match=r"operations\[a\]\.agents\.H: expected a number up to 1e\+12"
+    ):
+        spec_from_dict(data, source="big.yaml")

@@ -1,0 +1,287 @@
+"""``report.html``: one self-contained page a person reads (no network: pictures are PNG data URIs).
+
+It shows the metrics, the price-of-robustness curve and the Gantt charts of the concurrent
+game (when it could be solved; drawn by :mod:`asp.gantt`), the CP-SAT schedule's Gantt
+chart, the relations table, the principal line as pictures of the assembly growing step by
+step (rendered from the part meshes, the parts of each step highlighted) and the game DAG
+picture.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+from pathlib import Path
+
+import numpy as np
+
+from asmplan.report.meshes import base_parts, part_meshes
+
+NEW, PLACED, GHOST = "#f28c28", "#4f81bd", "#cccccc"
+REPORT_MAX_STATES = 5_000
+"""Largest state graph whose concurrent game the report solves itself."""
+
+
+def _png(fig) -> str:
+    """A matplotlib Figure as a ``data:image/png;base64,...`` URI."""
+    fig.tight_layout()
+    buffer = io.BytesIO()
+    fig.savefig(buffer, format="png", dpi=90)
+    return "data:image/png;base64," + base64.b64encode(buffer.getvalue()).decode("ascii")
+
+
+def _img(uri: str, alt: str, width: int | None = None) -> str:
+    w = f' width="{width}"' if width else ""
+    return f'<img src="{uri}" alt="{html.escape(alt)}"{w}>'
+
+
+# --------------------------------------------------------------------------- pictures
+
+
+def assembly_steps(plan: dict, *, max_pictures: int = 40) -> list[tuple[dict, str]]:
+    """The principal line's steps that place parts, each with a picture (data URI).
+
+    The assembly is drawn from the part meshes: parts placed before the step in blue, the
+    step's parts in orange, the parts still to come as faint grey outlines.
+    """
+    meshes = part_meshes(plan)
+    if not meshes:
+        return []
+    from matplotlib.figure import Figure
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    everything = np.concatenate([v for v, _ in meshes.values()])
+    lo, hi = everything.min(axis=0), everything.max(axis=0)
+    placed = set(base_parts(plan))
+    out = []
+    for step in plan.get("robust_plan", []):
+        if not step.get("parts") or len(out) >= max_pictures:
+            continue
+        new = set(step["parts"])
+        fig = Figure(figsize=(3.2, 3.0))
+        ax = fig.add_subplot(projection="3d")
+        for pid, (v, f) in meshes.items():
+            if pid in new:
+                colour, alpha = NEW, 1.0
+            elif pid in placed:
+                colour, alpha = PLACED, 1.0
+            else:
+                colour, alpha = GHOST, 0.06
+            poly = Poly3DCollection(v[f], facecolor=colour, edgecolor="none", alpha=alpha)
+            ax.add_collection3d(poly)
+        ax.set_xlim(lo[0], hi[0])
+        ax.set_ylim(lo[1], hi[1])
+        ax.set_zlim(lo[2], hi[2])
+        ax.set_box_aspect(hi - lo + 1e-9)
+        ax.view_init(elev=22, azim=-60)
+        ax.set_axis_off()
+        ax.set_title(
+            f"{step['operation']} ({step['agent']}): {', '.join(step['parts'])}", fontsize=8
+        )
+        out.append((step, _png(fig)))
+        placed |= new
+    return out
+
+
+# --------------------------------------------------------------------------- figures
+
+
+def report_figures(doc: dict, concurrent_plan=None, *, spec=None, graph=None) -> dict[str, bytes]:
+    """The curve and Gantt PNGs of the report (:mod:`asp.gantt`), by name.
+
+    ``concurrent_plan`` (:class:`asp.concurrent_plan.ConcurrentPlan`) gives the curve and
+    the two timelines; without it they are computed here from ``spec`` and ``graph`` when
+    the state graph has at most :data:`REPORT_MAX_STATES` states (else ``"why"`` says why
+    they are missing). The CP-SAT schedule's Gantt chart comes from ``doc["schedule"]``.
+    """
+    import tempfile
+
+    from asp.concurrent import Bar
+    from asp.gantt import plot_gantt, plot_robustness
+
+    out: dict[str, bytes] = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        if concurrent_plan is None and spec is not None and graph is not None:
+            if graph.n_states <= REPORT_MAX_STATES:
+                try:
+                    from asp.concurrent_plan import plan_concurrent
+
+                    concurrent_plan = plan_concurrent(spec, graph, max_nodes=200_000)
+                except (ValueError, MemoryError) as exc:
+                    out["why"] = str(exc).splitlines()[0].encode()
+            else:
+                out["why"] = (
+                    f"{graph.n_states:,} assembly states (the report solves the concurrent "
+                    f"game up to {REPORT_MAX_STATES:,})"
+                ).encode()
+        if concurrent_plan is not None:
+            curve = concurrent_plan.curve.to_list()
+            out["robustness"] = plot_robustness(
+                curve,
+                folder / "r.png",
+                schedule=concurrent_plan.schedule.objective,
+                schedule_rows=concurrent_plan.schedule_worst,
+            ).read_bytes()
+            for name, (bars, makespan) in (
+                ("gantt_cooperative", concurrent_plan.cooperative),
+                ("gantt_worst", concurrent_plan.worst),
+            ):
+                who = "follows the plan" if name == "gantt_cooperative" else "is the worst"
+                out[name] = plot_gantt(
+                    bars,
+                    folder / f"{name}.png",
+                    makespan=makespan,
+                    title=f"concurrent: the person {who}, makespan {makespan:g}",
+                ).read_bytes()
+        rows = (doc.get("schedule") or {}).get("schedule") or []
+        if rows:
+            bars = [
+                Bar(str(r["agent"]), str(r["task"]), float(r["start"]), float(r["end"]))
+                for r in rows
+            ]
+            sched = doc["schedule"]
+            out["gantt_schedule"] = plot_gantt(
+                bars,
+                folder / "s.png",
+                title=f"CP-SAT schedule: makespan {sched.get('objective')} ({sched.get('status')})",
+            ).read_bytes()
+    return out
+
+
+def _data_uri(png: bytes) -> str:
+    return "data:image/png;base64," + base64.b64encode(png).decode("ascii")
+
+
+# --------------------------------------------------------------------------- the page
+
+
+def report_html(plan: dict, figures: dict[str, bytes] | None = None) -> str:
+    """The report page of a plan document (``asmplan-plan/2``) as one HTML string.
+
+    ``figures``: PNGs by name (``dag``, ``robustness``, ``gantt_cooperative``,
+    ``gantt_worst``, ``gantt_schedule``; :func:`report_figures`) and ``why`` (bytes), the
+    reason the concurrent ones are missing.
+    """
+    figures = figures or {}
+    esc = html.escape
+    unit = "" if plan.get("cost") == "steps" else " s"
+    m = plan.get("metrics", {})
+    sched = plan.get("schedule") or {}
+    rows = [
+        ("assembly", plan.get("assembly", "")),
+        ("turn model / cost", f"{plan.get('turn_model', '')} / {plan.get('cost', '')}"),
+        (
+            "assembly states / transitions",
+            f"{plan.get('states', '-')} / {plan.get('transitions', '-')}",
+        ),
+        ("feasible sequences", plan.get("sequences", "-")),
+        ("game nodes / edges", f"{plan.get('game_nodes', '-')} / {plan.get('game_edges', '-')}"),
+        ("TCT (cooperative minimum)", f"{plan.get('tct', 0):g}{unit}"),
+        ("W* (guaranteed against any human)", f"{plan.get('minimax', 0):g}{unit}"),
+        ("W*(0): the person follows the plan", f"{m.get('w0', 0):g}{unit}"),
+        ("adversarial tax W*/TCT", f"{m.get('adversarial_tax', 1):.2f}"),
+        ("policy states / moves", f"{m.get('policy_states', '-')} / {m.get('policy_moves', '-')}"),
+    ]
+    if sched:
+        rows.append(
+            (
+                "CP-SAT makespan (agents in parallel)",
+                f"{sched.get('objective')} s ({sched.get('status')}), lower bound "
+                f"{sched.get('lower_bound', '-')}",
+            )
+        )
+    body = [f"<h1>{esc(str(plan.get('assembly', 'plan')))}: the robust plan</h1>"]
+    body.append("<h2>Metrics</h2><table>")
+    body += [f"<tr><th>{esc(k)}</th><td>{esc(str(v))}</td></tr>" for k, v in rows]
+    body.append("</table>")
+
+    body.append("<h2>Price of robustness and the concurrent game</h2>")
+    if "robustness" in figures:
+        body.append(_img(_data_uri(figures["robustness"]), "price of robustness"))
+        for name in ("gantt_cooperative", "gantt_worst"):
+            body.append(_img(_data_uri(figures[name]), name.replace("_", " ")))
+    else:
+        reason = figures.get("why", b"not computed").decode()
+        body.append(f"<p class='note'>The concurrent game was not solved: {esc(reason)}.</p>")
+    if "gantt_schedule" in figures:
+        body.append("<h2>CP-SAT schedule</h2>")
+        body.append(_img(_data_uri(figures["gantt_schedule"]), "CP-SAT Gantt chart"))
+
+    principal = plan.get("robust_plan", [])
+    body.append("<h2>The principal line (the person follows the plan)</h2>")
+    pictures = assembly_steps(plan)
+    if pictures:
+        body.append("<div class='steps'>")
+        for step, uri in pictures:
+            caption = (
+                f"step {step['step']}: {step['operation']} by {step['agent']}, "
+                f"{step['description']} (cost so far {step['elapsed']:g}{unit})"
+            )
+            body.append(
+                f"<figure>{_img(uri, caption)}<figcaption>{esc(caption)}</figcaption></figure>"
+            )
+        body.append("</div>")
+    else:
+        body.append("<p class='note'>No part meshes: no pictures of the assembly.</p>")
+    body.append(_line_table(principal, unit))
+    body.append("<h2>The worst line (the person delays all she can)</h2>")
+    body.append(_line_table(plan.get("worst_line", []), unit))
+
+    relations = plan.get("relations") or []
+    if relations:
+        body.append(
+            "<h2>Part relations</h2><table><tr><th>part</th><th>touches (directions)</th>"
+            "<th>free directions in the assembly</th></tr>"
+        )
+        for r in relations:
+            touches = "; ".join(f"{q} ({', '.join(ds)})" for q, ds in r["contacts"].items())
+            body.append(
+                f"<tr><td>{esc(r['part'])}</td><td>{esc(touches or '-')}</td>"
+                f"<td>{esc(' '.join(r['free']) or 'none')}</td></tr>"
+            )
+        body.append("</table>")
+    if "dag" in figures:
+        body.append("<h2>The game DAG</h2>")
+        body.append(_img(_data_uri(figures["dag"]), "game DAG", width=1100))
+    if plan.get("credit"):
+        body.append(f"<p class='note'>{esc(plan['credit'])}</p>")
+    return PAGE.format(title=esc(str(plan.get("assembly", "plan"))), body="\n".join(body))
+
+
+def _line_table(steps: list[dict], unit: str) -> str:
+    esc = html.escape
+    out = [
+        "<table class='line'><tr><th>#</th><th>side</th><th>operation</th><th>agent</th>"
+        "<th>description</th><th>parts</th><th>cost</th><th>so far</th><th>bound left</th></tr>"
+    ]
+    for s in steps:
+        if not s["operation"]:
+            continue
+        out.append(
+            f"<tr><td>{s['step']}</td><td>{esc(s['player'])}</td><td>{esc(s['operation'])}</td>"
+            f"<td>{esc(s['agent'])}</td><td>{esc(s['description'])}</td>"
+            f"<td>{esc(', '.join(s['parts']))}</td><td>{s['cost']:g}</td>"
+            f"<td>{s['elapsed']:g}{unit}</td><td>{s['bound']:g}{unit}</td></tr>"
+        )
+    out.append("</table>")
+    return "\n".join(out)
+
+
+PAGE = """<!DOCTYPE html>
+<html lang="en"><head><meta charset="utf-8"><title>{title}: asmplan report</title>
+<style>
+body {{ font-family: system-ui, sans-serif; margin: 1.5em auto; max-width: 1150px; color: #222; }}
+table {{ border-collapse: collapse; margin: 0.5em 0 1em; font-size: 0.9em; }}
+th, td {{ border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: left; }}
+th {{ background: #f0f3f7; }}
+.steps {{ display: flex; flex-wrap: wrap; gap: 0.5em; }}
+figure {{ margin: 0; width: 290px; font-size: 0.8em; }}
+figure img {{ width: 290px; }}
+.note {{ color: #666; }}
+</style></head>
+<body>
+{body}
+</body></html>
+"""

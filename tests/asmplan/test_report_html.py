@@ -1,0 +1,43 @@
+"""``report.html``: one self-contained page (no network) with every part the issue lists."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+from asmplan.planfile import build_plan
+from asmplan.report.html import report_figures, report_html
+from tests.asmplan.plans import cell_game, cell_plan
+
+PUMP = Path(__file__).resolve().parents[2] / "examples" / "vacuum_pump"
+
+
+def _external_references(page: str) -> list[str]:
+    refs = re.findall(r"""(?:src|href)\s*=\s*["']([^"']+)["']""", page)
+    return [r for r in refs if not r.startswith("data:")] + re.findall(r"https?://", page)
+
+
+def test_cell_report_is_self_contained_with_curve_and_gantt():
+    spec, graph, _, _ = cell_game()
+    figures = report_figures(cell_plan(), spec=spec, graph=graph)
+    assert {"robustness", "gantt_cooperative", "gantt_worst"} <= set(figures), figures.get("why")
+    page = report_html(cell_plan(), figures)
+    assert _external_references(page) == []
+    for heading in ("Metrics", "Price of robustness", "The principal line", "The worst line"):
+        assert heading in page
+    assert page.count("<img") >= 3  # curve and two Gantt charts
+    assert "No part meshes" in page
+
+
+def test_report_says_why_a_part_is_missing():
+    page = report_html(cell_plan(), {"why": b"too large"})
+    assert "The concurrent game was not solved: too large" in page
+
+
+def test_pump_report_pictures_each_step_that_places_parts():
+    doc = build_plan(PUMP)
+    page = report_html(doc, {"dag": b"\x89PNG fake"})
+    steps = [s for s in doc["robust_plan"] if s["parts"]]
+    assert page.count("<figure>") == len(steps) == 7
+    assert "step 6: 1.4 by H" in page
+    assert _external_references(page) == []
