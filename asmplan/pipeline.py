@@ -327,8 +327,9 @@ def state_graph(
 ) -> StateGraph:
     """The assembly state graph: every feasible partial assembly and operation.
 
-    When a part can never be inserted alone, subassemblies are added automatically
-    (:func:`asp.units.build_with_units`); the graph's ``spec`` then holds them.
+    Interchangeable parts are placed in a fixed order (:mod:`asp.symmetry`: same TCT and W*,
+    far fewer states) and, when a part can never be inserted alone, subassemblies are added
+    automatically (:func:`asp.units.build_with_units`); the graph's ``spec`` holds both.
 
     Parameters
     ----------
@@ -342,11 +343,11 @@ def state_graph(
     -------
     asp.state_graph.StateGraph
     """
+    from asp.symmetry import reduce_interchangeable
     from asp.units import build_with_units
 
-    return build_with_units(
-        assembly.spec, assembly.relations, progress=progress, max_states=max_states
-    )
+    spec = reduce_interchangeable(assembly.spec, assembly.relations)
+    return build_with_units(spec, assembly.relations, progress=progress, max_states=max_states)
 
 
 def game(graph: StateGraph, *, cost: str | None = None) -> GameDAG:

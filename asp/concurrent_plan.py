@@ -292,7 +292,7 @@ def write_figures(plan: ConcurrentPlan, folder: str | os.PathLike[str] | Callabl
             path_of("robustness.png"),
             schedule=plan.schedule.objective,
             schedule_rows=plan.schedule_worst,
-            title=f"{name}: guaranteed makespan against a person who may deviate k times",
+            title=f"{name}\nguaranteed makespan against a person who may deviate k times",
         )
     ]
     bars, makespan = plan.cooperative

@@ -73,7 +73,7 @@ def plot_robustness(
     ax.set_xlabel("deviations the person may make (k)")
     ax.set_ylabel("guaranteed makespan")
     ax.set_title(title or "price of robustness", fontsize=10)
-    ax.legend(fontsize=8, frameon=False, loc="lower right")
+    ax.legend(fontsize=8, frameon=False, loc="best")
     ax.grid(alpha=0.3)
     fig.tight_layout()
     return _save(fig, path)

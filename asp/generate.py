@@ -8,9 +8,8 @@ rule, fixed so that a generated spec plans the same as the file it writes:
 - parts: one per mesh node of the file (ids and names from the file, :mod:`cad.scene`),
   or per mesh file of the folder (a ``bom.csv``/``bom.yaml`` in the folder still names
   them); ``shape`` is the shape class (identical parts share it, :mod:`cad.identical`);
-- the base part, placed first: the part standing lowest (its bottom within 2% of the
-  assembly's height of the lowest), of those the one with the largest footprint (its
-  bounding box's area across gravity, ``-z``);
+- the base part, placed first: the lowest of the large parts (those whose footprint, the
+  bounding box's area across gravity ``-z``, is at least half the largest);
 - agents: one human ``H`` and one robot ``R1``;
 - one placement operation per part, ids ``"1"``, ``"2"``, ... in the order base first,
   then the others from the lowest to the highest (against gravity), open to both agents;
@@ -47,12 +46,13 @@ def placement_durations(diagonal_mm: float) -> tuple[float, float]:
 
 
 def base_index(bounds: np.ndarray) -> int:
-    """The part that stands lowest, the largest footprint first; ``bounds`` shape (n, 2, 3)."""
-    bottom = bounds[:, 0, 2]
-    height = float(bounds[:, 1, 2].max() - bottom.min())
-    low = np.flatnonzero(bottom <= bottom.min() + 0.02 * height)
-    footprint = np.prod(bounds[low, 1, :2] - bounds[low, 0, :2], axis=1)
-    return int(low[np.argmax(footprint)])
+    """The lowest of the large parts: of the parts whose footprint (bounding-box area
+    across gravity) is at least half the largest, the one whose bottom is lowest (the
+    larger footprint on a tie); ``bounds`` shape (n, 2, 3)."""
+    footprint = np.prod(bounds[:, 1, :2] - bounds[:, 0, :2], axis=1)
+    large = np.flatnonzero(footprint >= 0.5 * footprint.max())
+    order = sorted(large, key=lambda k: (bounds[k, 0, 2], -footprint[k], k))
+    return int(order[0])
 
 
 def spec_geometry(spec: AssemblySpec):
@@ -264,7 +264,7 @@ def spec_text(path: str | Path, spec_folder: str | Path | None = None) -> str:
         "  H: {side: human, description: operator}",
         "  R1: {side: robot, description: robot arm with a gripper}",
         "",
-        f"base_part: {data['base_part']}      # placed first: the lowest part, largest footprint",
+        f"base_part: {data['base_part']}      # placed first: the lowest of the large parts",
         "gravity: -z                # direction of gravity in the file's frame",
         "gripper_approach: [+x, -x, +y, -y, +z, -z]   # directions a part may be inserted from",
         "constraints: {topological: true, stability: true, functional: true}",

@@ -178,12 +178,17 @@ def report_html(plan: dict, figures: dict[str, bytes] | None = None) -> str:
         ),
         ("feasible sequences", plan.get("sequences", "-")),
         ("game nodes / edges", f"{plan.get('game_nodes', '-')} / {plan.get('game_edges', '-')}"),
-        ("TCT (cooperative minimum)", f"{plan.get('tct', 0):g}{unit}"),
-        ("W* (guaranteed against any human)", f"{plan.get('minimax', 0):g}{unit}"),
-        ("W*(0): the person follows the plan", f"{m.get('w0', 0):g}{unit}"),
+        ("TCT (alternating game, cooperative minimum)", f"{plan.get('tct', 0):g}{unit}"),
+        ("W* (alternating game, against any human)", f"{plan.get('minimax', 0):g}{unit}"),
+        ("the person follows the plan (alternating game)", f"{m.get('w0', 0):g}{unit}"),
         ("adversarial tax W*/TCT", f"{m.get('adversarial_tax', 1):.2f}"),
         ("policy states / moves", f"{m.get('policy_states', '-')} / {m.get('policy_moves', '-')}"),
     ]
+    for r in plan.get("robustness") or []:
+        k = "inf" if r["k"] is None else r["k"]
+        rows.append(
+            (f"concurrent game: W*({k}), the person deviates at most {k} times", r["bound"])
+        )
     if sched:
         rows.append(
             (
@@ -277,6 +282,7 @@ table {{ border-collapse: collapse; margin: 0.5em 0 1em; font-size: 0.9em; }}
 th, td {{ border: 1px solid #ccc; padding: 0.25em 0.6em; text-align: left; }}
 th {{ background: #f0f3f7; }}
 .steps {{ display: flex; flex-wrap: wrap; gap: 0.5em; }}
+img {{ max-width: 100%; height: auto; }}
 figure {{ margin: 0; width: 290px; font-size: 0.8em; }}
 figure img {{ width: 290px; }}
 .note {{ color: #666; }}
