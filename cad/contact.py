@@ -7,19 +7,22 @@ Along each axis, a face of i whose outward normal has a component of at least
 degrees of ``d``) along ``d`` is paired with a face of j whose normal has at least that
 component along ``-d``. If their projections along ``d`` overlap and somewhere on the
 overlap the gap between them, measured along the face normal (gap along ``d`` times the
-mean normal component), lies in ``[-tol(i, j), contact_tol]``, then j touches i on
+mean normal component), lies in ``[-tol(i, j), contact_tol(i, j)]``, then j touches i on
 its ``d`` side: ``TC_d(i, j)`` and, by the same evidence, ``TC_-d(j, i)``. A negative gap
 (overlap) counts only where the two faces overlap with positive area; faces that merely meet
-along an edge count only within the contact tolerance, so a step or a hole continued in the
-next part at a slightly different depth is not taken for a sideways contact. Here
-``tol(i, j)`` is the pair's penetration tolerance, by default the sum of the two parts'
-shrinks (:mod:`cad.tolerances`). The range of the gap over the overlap polygon is exact
+along an edge count only within :data:`cad.tolerances.DEFAULT_CONTACT_TOL_MM` (0.01 mm),
+so a step or a hole continued in the next part at a slightly different depth is not taken
+for a sideways contact. Here ``tol(i, j)`` is the pair's penetration tolerance, by default
+the sum of the two parts' shrinks, and ``contact_tol(i, j)`` its contact tolerance, by
+default from the smaller part's size so that clearance fits touch (:mod:`cad.tolerances`).
+The range of the gap over the overlap polygon is exact
 (:func:`cad.projection.height_gap_range`).
 
 So a face contact on an axis-aligned plane gives exactly its axis direction; a face on an
 inclined plane gives every axis direction its normal leans towards by at least 0.25 (a
-45-degree face gives two directions); a round peg touching a hole wall gives the four
-sideways directions. Two parts whose closest surfaces face each other at a steep angle
+45-degree face gives two directions); a round peg touching a hole wall, or sitting in it with a
+clearance within the contact tolerance, gives the four sideways directions (those in which
+the gap is within the tolerance). Two parts whose closest surfaces face each other at a steep angle
 (edge against edge, both normals further than 75.5 degrees from every axis) get no
 direction. Touching along only a line or a point counts (e.g. two boxes that share an
 edge are in contact along both faces' axes).
@@ -33,7 +36,7 @@ from cad.assembly import Assembly
 from cad.faces import FaceSet, axis_face_sets, bounds_overlap, crop_pair, unit_normals
 from cad.progress import progress_bar
 from cad.projection import box_pair_chunks, height_gap_range, overlap_share
-from cad.tolerances import CONTACT_NORMAL_MIN, resolve_tolerances
+from cad.tolerances import CONTACT_NORMAL_MIN, DEFAULT_CONTACT_TOL_MM, resolve_tolerances
 
 _CHUNK = 4096
 
@@ -52,8 +55,8 @@ def contact_relation(
     assembly : Assembly
         ``n`` parts in assembled pose (mm).
     tol : float, optional
-        Contact tolerance in mm: largest gap that still counts as touching (default
-        :data:`cad.tolerances.DEFAULT_CONTACT_TOL_MM`, 0.01 mm).
+        Contact tolerance in mm for every pair: largest gap that still counts as touching
+        (default: per pair, from the smaller part's size, :mod:`cad.tolerances`).
     penetration_tol : float or Tolerances, optional
         Largest overlap in mm that counts as touching, for every pair; default the
         per-part rule of :mod:`cad.tolerances` (``s_i + s_j`` for the pair).
@@ -68,7 +71,6 @@ def contact_relation(
         tc[j, i, d ^ 1]``; the diagonal is false.
     """
     tols = resolve_tolerances(assembly, tol, penetration_tol)
-    ctol = tols.contact
     n = len(assembly)
     tc = np.zeros((n, n, 6), dtype=bool)
     triangles = [np.asarray(p.mesh.triangles, dtype=float) for p in assembly.parts]
@@ -83,7 +85,7 @@ def contact_relation(
         ]
         for a, b in pairs:
             bar.update(1)
-            ptol = tols.pair(a, b)
+            ptol, ctol = tols.pair(a, b), tols.contact_pair(a, b)
             if not bounds_overlap(bounds[a], bounds[b], pad=(ctol + ptol) / CONTACT_NORMAL_MIN):
                 continue
             if faces_touch(sets[a][0], sets[b][1], ctol, ptol):
@@ -124,8 +126,10 @@ def faces_touch(front: FaceSet, back: FaceSet, contact_tol: float, penetration_t
             overlap, gap_min, gap_max = height_gap_range(p_uv, p_h, q_uv, q_h)
             cosine = 0.5 * (front.nk[sa] - back.nk[sb])
             lower, upper = gap_min * cosine, gap_max * cosine
-            # Touching within the contact tolerance: a shared face, edge or point.
-            if np.any(overlap & (lower <= contact_tol) & (upper >= -contact_tol)):
+            # Touching within the contact tolerance: a shared face, edge or point, or a
+            # clearance (a gap up to contact_tol); edges meet within the fixed 0.01 mm.
+            edge_tol = min(contact_tol, DEFAULT_CONTACT_TOL_MM)
+            if np.any(overlap & (lower <= contact_tol) & (upper >= -edge_tol)):
                 return True
             # Overlapping up to the penetration tolerance counts only where the faces
             # overlap with positive area: faces merely meeting along an edge at different

@@ -1,9 +1,28 @@
 """Default tolerances, in millimetres, and how they follow the size of each part.
 
-Contact tolerance
------------------
-0.01 mm (:data:`DEFAULT_CONTACT_TOL_MM`). Two parts are in contact where their facing
-surfaces are at most this far apart (or overlap by at most the penetration tolerance).
+Contact tolerance: per part, the smaller part of a pair decides
+----------------------------------------------------------------
+Two parts are in contact where their facing surfaces are at most the pair's contact
+tolerance apart (or overlap by at most the penetration tolerance). Real products are full
+of clearance fits (a pin in its hole, a bolt in a clearance hole, a shaft in a bush) whose
+surfaces never meet: the gap is a design clearance, not a sign that the parts are apart.
+Every part ``p`` gets a contact reach ``c_p`` and a pair the smaller of its two reaches::
+
+    c_p = min( max(0.01 mm, 0.02 x D_p),  0.2 mm )
+    contact_tol(i, j) = min(c_i, c_j)
+
+with ``D_p`` the diagonal of the part's bounding box, as below. So the gap that counts as
+touching follows the smaller part (a clearance is cut for the pin, not for the plate):
+a 5.6 mm pin accepts 0.11 mm (the Fabrica duct's pins sit in their holes with 0.1 mm
+radial clearance; Fabrica itself used 0.2), an M3 screw (D ~ 12 mm) 0.2 mm, a 0.5 mm
+ball 0.01 mm (the floor, the old fixed tolerance). The cap, 0.2 mm, keeps parts that are
+merely near each other apart (a 0.25 mm gap between a 6 mm wheel and its body is not a
+contact). The direction is the contact's as in DESIGN.md: for a pin with radial
+clearance, the sideways directions in which the gap is within the tolerance (all four
+when the pin is centred). Edges meeting at different depths still count only within
+:data:`DEFAULT_CONTACT_TOL_MM` (:mod:`cad.contact`).
+
+An explicit ``contact_tol`` (``--contact-tol``) replaces the rule for every pair.
 
 Penetration tolerance: per-part shrink amounts, summed per pair
 ---------------------------------------------------------------
@@ -65,6 +84,11 @@ import trimesh
 from cad.errors import GeometryError
 
 DEFAULT_CONTACT_TOL_MM = 0.01
+"""Smallest default contact tolerance (the floor of the per-part rule)."""
+CONTACT_PER_SIZE = 0.02
+"""Default contact reach per mm of the part's bounding-box diagonal."""
+CONTACT_CAP_MM = 0.2
+"""Largest default contact reach of a part."""
 DEFAULT_PENETRATION_TOL_MM = 0.05
 """Smallest default pair tolerance (two parts at the shrink floor)."""
 SHRINK_FLOOR_MM = 0.025
@@ -100,13 +124,30 @@ def part_shrink(diagonal_mm: float, thickness_mm: float) -> float:
     return min(by_size, SHRINK_PER_THICKNESS * float(thickness_mm))
 
 
+def part_contact_reach(diagonal_mm: float) -> float:
+    """Default contact reach (mm) of a part with this bounding-box diagonal (mm)."""
+    by_size = max(DEFAULT_CONTACT_TOL_MM, CONTACT_PER_SIZE * float(diagonal_mm))
+    return min(by_size, CONTACT_CAP_MM)
+
+
+def part_diagonals(meshes: list[trimesh.Trimesh]) -> np.ndarray:
+    """Bounding-box diagonal of each mesh (mm), shape ``(n,)``."""
+    return np.array(
+        [float(np.linalg.norm(np.ptp(np.asarray(m.bounds), axis=0))) for m in meshes]
+    ).reshape(len(meshes))
+
+
+def default_contact_reaches(meshes: list[trimesh.Trimesh]) -> np.ndarray:
+    """Default contact reach of each mesh (mm), shape ``(n,)``."""
+    return np.array([part_contact_reach(d) for d in part_diagonals(meshes)]).reshape(len(meshes))
+
+
 def default_shrinks(meshes: list[trimesh.Trimesh]) -> np.ndarray:
     """Default shrink of each mesh (mm), shape ``(n,)``."""
-    out = np.empty(len(meshes))
-    for k, mesh in enumerate(meshes):
-        diagonal = float(np.linalg.norm(np.ptp(np.asarray(mesh.bounds), axis=0)))
-        out[k] = part_shrink(diagonal, part_thickness(mesh))
-    return out
+    diagonals = part_diagonals(meshes)
+    return np.array(
+        [part_shrink(d, part_thickness(m)) for d, m in zip(diagonals, meshes, strict=True)]
+    ).reshape(len(meshes))
 
 
 def default_penetration_tol(diagonals_mm: np.ndarray) -> float:
@@ -127,17 +168,28 @@ class Tolerances:
     Attributes
     ----------
     contact : float
-        Largest gap that counts as touching.
+        Largest gap that counts as touching, for any pair (the explicit value if one was
+        given); pair ``(i, j)`` uses :meth:`contact_pair`.
     shrink : np.ndarray
         Per-part shrink, shape ``(n,)``; the penetration tolerance of pair ``(i, j)`` is
         ``shrink[i] + shrink[j]``.
     explicit : bool
         The penetration tolerance was given (every shrink is half of it).
+    reach : np.ndarray or None
+        Per-part contact reach, shape ``(n,)``; pair ``(i, j)`` counts a gap up to
+        ``min(reach[i], reach[j])`` as touching. None: ``contact`` for every pair.
     """
 
     contact: float
     shrink: np.ndarray
     explicit: bool = False
+    reach: np.ndarray | None = None
+
+    def contact_pair(self, a: int, b: int) -> float:
+        """Contact tolerance of parts ``a`` and ``b`` (largest gap that counts as touching)."""
+        if self.reach is None:
+            return float(self.contact)
+        return float(min(self.reach[a], self.reach[b]))
 
     def pair(self, a: int, b: int) -> float:
         """Penetration tolerance of parts ``a`` and ``b``."""
@@ -174,14 +226,25 @@ def resolve_tolerances(
         penetration_tol, explicit_shrink = None, base.shrink
     else:
         explicit_shrink = None
-    ctol = DEFAULT_CONTACT_TOL_MM if contact_tol is None else float(contact_tol)
-    if not np.isfinite(ctol) or ctol < 0:
-        raise GeometryError(f"contact tolerance must be >= 0 mm, got {contact_tol}")
+    if contact_tol is None:
+        reach = default_contact_reaches(meshes)
+        ctol = _largest_pair_reach(reach)
+    else:
+        reach, ctol = None, float(contact_tol)
+        if not np.isfinite(ctol) or ctol < 0:
+            raise GeometryError(f"contact tolerance must be >= 0 mm, got {contact_tol}")
     if explicit_shrink is not None:
-        return Tolerances(ctol, explicit_shrink, base.explicit)
+        return Tolerances(ctol, explicit_shrink, base.explicit, reach)
     if penetration_tol is None:
-        return Tolerances(ctol, default_shrinks(meshes), False)
+        return Tolerances(ctol, default_shrinks(meshes), False, reach)
     ptol = float(penetration_tol)
     if not np.isfinite(ptol) or ptol <= 0:
         raise GeometryError(f"penetration tolerance must be > 0 mm, got {penetration_tol}")
-    return Tolerances(ctol, np.full(len(meshes), ptol / 2.0), True)
+    return Tolerances(ctol, np.full(len(meshes), ptol / 2.0), True, reach)
+
+
+def _largest_pair_reach(reach: np.ndarray) -> float:
+    """Largest ``min(reach[i], reach[j])`` over pairs ``i != j`` (a summary of the rule)."""
+    if len(reach) < 2:
+        return DEFAULT_CONTACT_TOL_MM if len(reach) == 0 else float(reach[0])
+    return float(np.sort(reach)[-2])

@@ -22,7 +22,11 @@ def relations_command(
         "--contact-tol",
         min=0.0,
         max=TOL_MAX_MM,
-        help="Contact tolerance in mm (default 0.01).",
+        help=(
+            "Contact tolerance in mm for every pair (default: per pair, 2% of the smaller "
+            "part's bounding-box diagonal, at least 0.01 and at most 0.2 mm, so clearance "
+            "fits touch; see cad/tolerances.py)."
+        ),
     ),
     penetration_tol: float | None = typer.Option(
         None,

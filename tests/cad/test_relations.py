@@ -153,13 +153,48 @@ def test_subassembly_arguments_checked():
         tt_set(rel, "nope", {"tray"})
 
 
-@pytest.mark.parametrize(("gap", "touching"), [(0.0, True), (0.005, True), (0.02, False)])
-def test_contact_tolerance_on_gap(gap, touching):
-    lower = shapes.box_between((0, 0, 0), (10, 10, 10))
-    upper = shapes.box_between((0, 0, 10 + gap), (10, 10, 20 + gap))
-    rel = compute_relations(Assembly.from_meshes({"lower": lower, "upper": upper}))
+@pytest.mark.parametrize(
+    ("size", "gap", "contact_tol", "touching"),
+    [
+        (10, 0.0, 0.01, True),
+        (10, 0.005, 0.01, True),
+        (10, 0.02, 0.01, False),  # an explicit tolerance is used as given
+        (10, 0.02, None, True),  # default for 10 mm cubes: min(0.02 x 17.3, 0.2) = 0.2 mm
+        (10, 0.19, None, True),
+        (10, 0.25, None, False),  # beyond the 0.2 mm cap: near, not touching
+        (1, 0.03, None, True),  # 1 mm cubes: 0.02 x 1.73 = 0.035 mm
+        (1, 0.05, None, False),
+    ],
+)
+def test_contact_tolerance_on_gap(size, gap, contact_tol, touching):
+    lower = shapes.box_between((0, 0, 0), (size, size, size))
+    upper = shapes.box_between((0, 0, size + gap), (size, size, 2 * size + gap))
+    assembly = Assembly.from_meshes({"lower": lower, "upper": upper})
+    rel = compute_relations(assembly, contact_tol=contact_tol)
     assert pair(rel, "upper", "lower")[0] == ({"-z"} if touching else set())
     assert pair(rel, "upper", "lower")[1] == ALL - {"-z"}
+
+
+def test_default_contact_tolerance_follows_the_smaller_part():
+    """A 1 mm cube 0.1 mm above a 100 mm slab: the cube's reach (0.035 mm) decides."""
+    slab = shapes.box_between((-50, -50, -10), (50, 50, 0))
+    near = shapes.box_between((0, 0, 0.03), (1, 1, 1.03))
+    far = shapes.box_between((5, 5, 0.1), (6, 6, 1.1))
+    rel = compute_relations(Assembly.from_meshes({"slab": slab, "near": near, "far": far}))
+    assert pair(rel, "near", "slab")[0] == {"-z"}
+    assert pair(rel, "far", "slab")[0] == set()
+
+
+@pytest.mark.parametrize(("clearance", "touching"), [(0.1, True), (0.3, False)])
+def test_pin_with_radial_clearance_touches_its_hole_sideways(clearance, touching):
+    """A 6 mm pin in a blind hole 0.1 mm wider in radius: a clearance fit is a contact on
+    the four sideways directions (and the hole bottom below); 0.3 mm is beyond the cap."""
+    block = shapes.box_between((-10, -10, 0), (10, 10, 10))
+    plate = shapes.difference(block, shapes.cylinder(3 + clearance, 4, 11, 64))
+    pin = shapes.cylinder(3, 4, 12, 64)
+    rel = compute_relations(Assembly.from_meshes({"plate": plate, "pin": pin}))
+    assert pair(rel, "pin", "plate")[0] == (SIDE | {"-z"} if touching else {"-z"})
+    assert pair(rel, "pin", "plate")[1] == {"+z"}
 
 
 def test_small_part_inside_the_sweep_of_a_large_face_blocks():
