@@ -242,26 +242,35 @@ def load(
     """:func:`load_assembly` and, when the spec has meshes, its :func:`relations`.
 
     A generated spec (no ``assembly.yaml``) is announced through ``on_step``, else as a
-    warning.
+    warning; its placements of parts nothing can keep from falling become ``held``
+    (:func:`asp.generate.hold_unsupported`), named in a second note.
     """
+    from asp.generate import HELD_REASON, hold_unsupported
+
     spec = load_assembly(source)
+
+    def note(text: str) -> None:
+        if on_step is not None:
+            on_step(text)
+        else:
+            import warnings
+
+            warnings.warn(text, stacklevel=3)
+
     if spec.generated:
-        note = (
+        note(
             f"no assembly.yaml: generated a spec from {source} ({len(spec.parts)} parts, one "
             "placement each, agents H and R1, durations from part size); "
             f"`asmplan init {source} -o assembly.yaml` writes it for editing"
         )
-        if on_step is not None:
-            on_step(note)
-        else:
-            import warnings
-
-            warnings.warn(note, stacklevel=2)
     rel = None
     if spec.has_geometry:
         if on_step is not None:
             on_step(f"computing part relations of {len(spec.parts)} parts ...")
         rel = relations(spec, progress=progress)
+        spec, held = hold_unsupported(spec, rel)
+        if held:
+            note(f"generated spec: held: true for {', '.join(held)} ({HELD_REASON})")
     return Assembly(spec=spec, relations=rel)
 
 
