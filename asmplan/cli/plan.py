@@ -56,9 +56,14 @@ def plan_summary(result) -> list[str]:
         plan_text(list(result.steps)),
     ]
     sched = result.schedule
+    if sched.result.objective is None:
+        why = sched.result.detail.get("replay", "no schedule found within the time limit")
+        found = f"none: {why} ({sched.result.status}; --time-limit raises it)"
+    else:
+        found = f"{sched.result.objective:g} s ({sched.result.status})"
     lines.append(
-        f"CP-SAT makespan (agents in parallel): {sched.result.objective} s "
-        f"({sched.result.status}); state-graph lower bound {sched.lower_bound:g} s"
+        f"CP-SAT makespan (agents in parallel): {found}; "
+        f"state-graph lower bound {sched.lower_bound:g} s"
     )
     return lines
 
