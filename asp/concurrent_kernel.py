@@ -275,26 +275,10 @@ def build_kernel(
                         else:
                             new[3 + 2 * nw + w] = chosen[d]
                     new[0] = 1
-                    key = _key(new, nw)
-                    if key in index:
-                        t = index[key]
-                    else:
-                        if n >= max_nodes:
-                            overflow = True
-                            break
-                        if n >= rows.shape[0]:
-                            grown = np.empty((2 * rows.shape[0], width), np.int32)
-                            grown[:n] = rows[:n]
-                            rows = grown
-                            gs = np.empty(2 * stack.shape[0], np.int64)
-                            gs[:top] = stack[:top]
-                            stack = gs
-                        t = n
-                        index[key] = t
-                        rows[t] = new
-                        stack[top] = t
-                        top += 1
-                        n += 1
+                    t, rows, stack, n, top = _intern(new, nw, index, rows, stack, n, top, max_nodes)
+                    if t < 0:
+                        overflow = True
+                        break
                     if m_edges >= e_src.shape[0]:
                         size = 2 * e_src.shape[0]
                         e_src = _grow1(e_src, size)
@@ -378,26 +362,12 @@ def build_kernel(
                         if complete[s2] and not running:
                             t = 0
                         else:
-                            key = _key(new, nw)
-                            if key in index:
-                                t = index[key]
-                            else:
-                                if n >= max_nodes:
-                                    overflow = True
-                                    break
-                                if n >= rows.shape[0]:
-                                    grown = np.empty((2 * rows.shape[0], width), np.int32)
-                                    grown[:n] = rows[:n]
-                                    rows = grown
-                                    gs = np.empty(2 * stack.shape[0], np.int64)
-                                    gs[:top] = stack[:top]
-                                    stack = gs
-                                t = n
-                                index[key] = t
-                                rows[t] = new
-                                stack[top] = t
-                                top += 1
-                                n += 1
+                            t, rows, stack, n, top = _intern(
+                                new, nw, index, rows, stack, n, top, max_nodes
+                            )
+                            if t < 0:
+                                overflow = True
+                                break
                         dup = False
                         for i in range(n_seen):
                             if seen_t[i] == t and seen_c[i] == delta:
@@ -470,6 +440,29 @@ def build_kernel(
         e_dur[:m_edges].copy(),
         e_dev[:m_edges].copy(),
     )
+
+
+@numba.njit(cache=True)
+def _intern(new, nw, index, rows, stack, n, top, max_nodes):  # pragma: no cover - compiled
+    """The node of state row ``new``: found in ``index``, or appended (to ``rows`` and the
+    work ``stack``, grown as needed). Returns ``(t, rows, stack, n, top)``; ``t`` is -1 when a
+    new node would pass ``max_nodes``."""
+    key = _key(new, nw)
+    if key in index:
+        return index[key], rows, stack, n, top
+    if n >= max_nodes:
+        return -1, rows, stack, n, top
+    if n >= rows.shape[0]:
+        grown = np.empty((2 * rows.shape[0], rows.shape[1]), np.int32)
+        grown[:n] = rows[:n]
+        rows = grown
+        gs = np.empty(2 * stack.shape[0], np.int64)
+        gs[:top] = stack[:top]
+        stack = gs
+    index[key] = n
+    rows[n] = new
+    stack[top] = n
+    return n, rows, stack, n + 1, top + 1
 
 
 @numba.njit(cache=True)
