@@ -242,10 +242,11 @@ def load(
     """:func:`load_assembly` and, when the spec has meshes, its :func:`relations`.
 
     A generated spec (no ``assembly.yaml``) is announced through ``on_step``, else as a
-    warning; its placements of parts nothing can keep from falling become ``held``
-    (:func:`asp.generate.hold_unsupported`), named in a second note.
+    warning; its placements of parts nothing can keep from falling become ``held`` and, when
+    no complete sequence can start from its base part, another base is taken
+    (:func:`asp.generate.workable_base`), each named in a note.
     """
-    from asp.generate import HELD_REASON, hold_unsupported
+    from asp.generate import HELD_REASON, workable_base
 
     spec = load_assembly(source)
 
@@ -268,8 +269,11 @@ def load(
         if on_step is not None:
             on_step(f"computing part relations of {len(spec.parts)} parts ...")
         rel = relations(spec, progress=progress)
-        spec, held = hold_unsupported(spec, rel)
-        if held:
+        spec, rebased = workable_base(spec, rel)
+        if rebased:
+            note(rebased)
+        held = tuple(p for op in spec.operations if op.held for p in op.parts)
+        if held and spec.generated:
             note(f"generated spec: held: true for {', '.join(held)} ({HELD_REASON})")
     return Assembly(spec=spec, relations=rel)
 
@@ -336,9 +340,13 @@ def state_graph(
 ) -> StateGraph:
     """The assembly state graph: every feasible partial assembly and operation.
 
-    Interchangeable parts are placed in a fixed order (:mod:`asp.symmetry`: same TCT and W*,
-    far fewer states) and, when a part can never be inserted alone, subassemblies are added
-    automatically (:func:`asp.units.build_with_units`); the graph's ``spec`` holds both.
+    The spec is first reduced (:func:`asp.symmetry.reduced_state_graph`: the precedences
+    every complete sequence keeps, interchangeable parts in a fixed order or, for blocks of
+    parts that cannot be, only the first of equal blocks moving; same TCT and W*, far fewer
+    states). When that has no complete sequence, a part can never be inserted
+    alone: subassemblies are added automatically to the spec as given, its exactly alike parts
+    in a fixed order (:func:`asp.units.build_with_units`). The graph's ``spec`` holds what
+    was used.
 
     Parameters
     ----------
@@ -352,11 +360,20 @@ def state_graph(
     -------
     asp.state_graph.StateGraph
     """
-    from asp.symmetry import reduce_interchangeable
+    from asp.errors import SpecError
+    from asp.symmetry import reduce_exact, reduced_state_graph
     from asp.units import build_with_units
 
-    spec = reduce_interchangeable(assembly.spec, assembly.relations)
-    return build_with_units(spec, assembly.relations, progress=progress, max_states=max_states)
+    spec, rel = assembly.spec, assembly.relations
+    try:
+        graph = reduced_state_graph(spec, rel, progress=progress, max_states=max_states)
+        if graph is not None:
+            return graph
+    except SpecError as exc:
+        if "infeasible assembly" not in str(exc):
+            raise
+    exact = reduce_exact(spec, rel)
+    return build_with_units(exact, rel, progress=progress, max_states=max_states)
 
 
 def game(graph: StateGraph, *, cost: str | None = None) -> GameDAG:

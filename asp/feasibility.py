@@ -326,6 +326,8 @@ class OperationModel:
         Per subassembly, the operation that inserts it.
     unit_masks : (U, PW) uint64
         Per subassembly, its member parts.
+    symmetric : tuple of classes of blocks of operation indices
+        Interchangeable blocks: of equal blocks only the first moves (:mod:`asp.symmetry`).
     """
 
     spec: AssemblySpec
@@ -348,6 +350,7 @@ class OperationModel:
     op_workspace: tuple[int, ...] = ()
     unit_ops: tuple[int, ...] = ()
     unit_masks: np.ndarray | None = None
+    symmetric: tuple[tuple[tuple[int, ...], ...], ...] = ()
 
     @property
     def n_ops(self) -> int:
@@ -478,7 +481,28 @@ class OperationModel:
                 good &= self.oracle.feasible(p, s, held=held, workspace=workspace)
                 s = s | self.oracle.bit(p)
             column[rows] = good
+        if self.symmetric:
+            self._first_of_equals(keys, ok)
         return ok
+
+    def _first_of_equals(self, keys: np.ndarray, ok: np.ndarray) -> None:
+        """Keep, of interchangeable blocks in the same state, only the first one's moves.
+
+        ``symmetric`` holds classes of blocks (tuples of operation indices, position by
+        position alike): every transposition of two blocks of a class is a symmetry of the
+        game (:mod:`asp.symmetry`). Two blocks with the same operations done (position by
+        position) are swapped by a symmetry that fixes the state, so a move in the later one
+        has the same cost and an isomorphic future as the same move in the earlier one: only
+        the earlier one's is kept. TCT and W* do not change.
+        """
+        for blocks in self.symmetric:
+            codes = np.zeros((keys.shape[0], len(blocks)), dtype=np.int64)
+            for j, block in enumerate(blocks):
+                for pos, i in enumerate(block):
+                    codes[:, j] |= self.has_op(keys, i).astype(np.int64) << pos
+            for j in range(1, len(blocks)):
+                twin = (codes[:, :j] == codes[:, j : j + 1]).any(axis=1)
+                ok[:, list(blocks[j])] &= ~twin[:, None]
 
     def pending_units(self, keys: np.ndarray) -> np.ndarray | None:
         """(k, PW) uint64: members of the subassemblies not yet inserted, per state."""
@@ -555,11 +579,15 @@ def _split(value: int, n_words: int) -> list[int]:
     return [(value >> (WORD_BITS * k)) & mask for k in range(n_words)]
 
 
-def operation_model(spec: AssemblySpec, relations=None, *, _min_words: int = 1) -> OperationModel:
+def operation_model(
+    spec: AssemblySpec, relations=None, *, _min_words: int = 1, symmetric=()
+) -> OperationModel:
     """Compile ``spec`` (and the cad relations, if any) into an :class:`OperationModel`.
 
     The state key takes as many 64-bit words as the operations and tool fields need
-    (``_min_words`` forces more, for tests of the multi-word path).
+    (``_min_words`` forces more, for tests of the multi-word path). ``symmetric``: classes of
+    interchangeable blocks of operation ids (:func:`asp.symmetry.interchangeable_blocks`),
+    of which only the first of equal blocks moves (:meth:`OperationModel.enabled`).
 
     Raises
     ------
@@ -640,6 +668,9 @@ def operation_model(spec: AssemblySpec, relations=None, *, _min_words: int = 1) 
         op_workspace=op_workspace,
         unit_ops=tuple(index[u] for u in units),
         unit_masks=unit_masks,
+        symmetric=tuple(
+            tuple(tuple(index[o] for o in block) for block in cls) for cls in symmetric
+        ),
     )
 
 

@@ -1,33 +1,483 @@
 """Interchangeable parts: identical choices do not multiply the states.
 
-Two placement operations ``a`` and ``b`` (placing parts ``p`` and ``q``) are interchangeable
-when swapping ``p`` and ``q`` maps the whole problem onto itself: every relation table row
-and column of ``p`` equals that of ``q`` (contact, freedom and support towards every other
-part, and between the two the same both ways), and the operations are alike in everything
-but their id and part (agents and durations, tools read and written, ``held``, their own
-predecessors, and every other operation needs both or neither). Pins standing in the holes of
-one disc, or the balls of a bearing, are such parts.
+Inserting the part ``p`` of operation ``o`` into the assembled set ``S`` is feasible iff its
+predecessors are done, ``p`` touches ``S``, rests on ``S`` (unless held) and some direction
+``d`` is free: ``B(p, d) & S`` is empty, with ``B(p, d)`` the parts blocking ``p`` along ``d``
+(:mod:`asp.feasibility`). Only the *family* of blocker sets matters, not which direction
+carries which set, and much of it never decides anything:
 
-A class of ``k`` interchangeable operations is acted on by every permutation of it, and each
-set of done operations has exactly one image in which the class's done members are its first
-``m``; so the graph restricted to those states (the class done in a fixed order, a chain of
-precedences) is the quotient of the full graph by the symmetry. Every move of the full game
-maps onto a move of the quotient with the same cost and an isomorphic future, so TCT and W*
-are the same (tested against the full graph), with ``k + 1`` states for the class instead of
-``2**k``.
+1. **Derived precedences** (:func:`reduced_model`): operation ``a`` must come before ``o`` in
+   every complete sequence when it is an explicit or transitive predecessor, places the base
+   part, places the only part ``o``'s part can touch or rest on, or when ``o``'s part blocks
+   ``a``'s part along every direction ``a`` may still use (once ``o`` is in, ``a`` could never
+   follow). These are iterated to a fixpoint. Every state from which the assembly can be
+   completed respects them (call such states *valid*); the game drops the others.
+2. **Reduced tests**: for ``o`` in a valid state, the parts of its predecessors are there and
+   the parts of its successors are not. So a blocker set holding a predecessor's part is a
+   direction that is never free (dropped), successors' parts are removed from every set,
+   a set that contains another is dropped (it is free only when the smaller one is), and a
+   contact or support set meeting a predecessor's part is always satisfied.
+
+A permutation ``sigma`` of the operations (and of their parts) is a *symmetry* when it maps
+every operation's reduced test onto the image operation's (the same durations, agents,
+tools and ``held``; ``sigma`` of its predecessors, contact, support and blocker family). Then
+``sigma`` maps valid states and their feasible moves onto valid states and feasible moves of
+the same cost, so it is an automorphism of the game restricted to completable states.
+
+Symmetries are found as involutions swapping two operations of identical parts together with
+the parts attached to them (:func:`_swap`): a dowel and the roller it carries are swapped with
+another dowel and its roller; the rollers are found through their contacts. The operations
+moved from one side form a *block*. A class of ``k`` blocks where every transposition is a
+symmetry is acted on by the whole permutation group; when each block's operations are totally
+ordered by the derived precedences (a valid state has a prefix of each block done), the states
+whose blocks are sorted by prefix length (longest first) hold exactly one state of every orbit.
+Those are the states in which, for every position ``i`` in the blocks, the ``i``-th operations
+of the blocks are done in block order: chains of precedences (:func:`with_fixed_order`). From a
+sorted state every move is mapped by a transposition of two blocks with the same prefix onto a
+move of the sorted graph with the same cost and an isomorphic future, so TCT and W* are the
+same (tested against the full graph), with far fewer states.
 """
 
 from __future__ import annotations
 
-from dataclasses import replace
+from collections import defaultdict
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from asp.spec import AssemblySpec
 
+TRUE = -1
+"""A contact or support test that always holds in valid states (bitset stand-in)."""
+
+
+@dataclass(frozen=True)
+class ReducedModel:
+    """The reduced insertion tests of a spec's operations (bitsets as Python ints).
+
+    Attributes
+    ----------
+    part_of : tuple of int
+        Per operation, its part index in the oracle (-1: places no part).
+    op_of : dict of int to int
+        Part index -> operation placing it.
+    must : tuple of int
+        Per operation, the operations that precede it in every complete sequence (bitset).
+    contact, support : tuple of int
+        Per operation, the parts its part may touch / rest on in a valid state (bitset), or
+        :data:`TRUE` when a predecessor's part guarantees it.
+    family : tuple of frozenset of int
+        Per operation, the minimal blocker sets of its allowed directions in valid states.
+    """
+
+    part_of: tuple[int, ...]
+    op_of: dict[int, int]
+    must: tuple[int, ...]
+    contact: tuple[int, ...]
+    support: tuple[int, ...]
+    family: tuple[frozenset[int], ...]
+    raw_near: tuple[int, ...] = ()
+
+
+def _bits(mask: int):
+    while mask:
+        low = mask & -mask
+        yield low.bit_length() - 1
+        mask ^= low
+
+
+def _applicable(spec: AssemblySpec, relations) -> bool:
+    """The reduction's preconditions: geometry, one part per operation, no units, a base."""
+    if relations is None or spec.subassemblies or not spec.constraints.topological:
+        return False
+    if not spec.base_part:
+        return False
+    placed = [p for op in spec.operations for p in op.parts]
+    return all(len(op.parts) <= 1 and not op.unit for op in spec.operations) and len(placed) == len(
+        set(placed)
+    )
+
+
+def reduced_model(spec: AssemblySpec, relations) -> ReducedModel | None:
+    """The derived precedences and reduced tests of ``spec`` (None: not applicable).
+
+    None when the spec has subassemblies, an operation placing several parts, no base part or
+    no geometry, or when the derived precedences show the assembly cannot be completed
+    (:func:`infeasibility`): the state graph then reports why.
+    """
+    return _derive(spec, relations)[0]
+
+
+def infeasibility(spec: AssemblySpec, relations) -> str:
+    """Why the derived precedences prove that no complete sequence exists ("" if they do not):
+    a part with nothing to touch or rest on or no direction left once its predecessors are
+    in, or a cycle of precedences."""
+    return _derive(spec, relations)[1]
+
+
+def _derive(spec: AssemblySpec, relations) -> tuple[ReducedModel | None, str]:
+    """:func:`reduced_model` and :func:`infeasibility` in one pass."""
+    if not _applicable(spec, relations):
+        return None, ""
+    from asp.feasibility import insertion_oracle, unpack_words
+
+    oracle = insertion_oracle(spec, relations)
+    n_ops = len(spec.operations)
+    pidx = {p: k for k, p in enumerate(oracle.parts)}
+    part_of = tuple(pidx[op.parts[0]] if op.parts else -1 for op in spec.operations)
+    op_of = {p: i for i, p in enumerate(part_of) if p >= 0}
+    base = oracle.base
+    initial = 0 if base in op_of or base < 0 else 1 << base
+    absent = ((1 << len(oracle.parts)) - 1) & ~initial & ~sum(1 << p for p in op_of)
+    contact = [unpack_words(oracle.contact[p]) if p >= 0 else 0 for p in part_of]
+    support = [unpack_words(oracle.support[p]) if p >= 0 else 0 for p in part_of]
+    blocked = [
+        [unpack_words(oracle.blocked[p, d]) for d in range(6) if oracle.directions[d]]
+        if p >= 0
+        else []
+        for p in part_of
+    ]
+    index = {op.id: i for i, op in enumerate(spec.operations)}
+    must = [sum(1 << index[a] for a in op.after) for op in spec.operations]
+    if base in op_of:
+        b = op_of[base]
+        for i in range(n_ops):
+            if i != b and part_of[i] >= 0:
+                must[i] |= 1 << b
+    held = [op.held or not oracle.stability for op in spec.operations]
+
+    def parts_of(ops: int) -> int:
+        out = initial
+        for i in _bits(ops):
+            if part_of[i] >= 0:
+                out |= 1 << part_of[i]
+        return out
+
+    def ops_of(parts: int) -> int:
+        return sum(1 << op_of[p] for p in _bits(parts) if p in op_of)
+
+    while True:
+        must = _closure(must)
+        ancestors = {
+            p: (parts_of(must[op_of[p]]) if p in op_of else initial) | 1 << p
+            for p in range(len(oracle.parts))
+        }
+
+        def covers(b: int, t: int, ancestors=ancestors) -> bool:
+            """Every part of ``t`` has an ancestor (or itself) in ``b``."""
+            return all(ancestors[r] & b for r in _bits(t))
+
+        cycle = [i for i in range(n_ops) if must[i] >> i & 1]
+        if cycle:
+            return None, f"operation {spec.operations[cycle[0]].id} must precede itself"
+        after = [0] * n_ops
+        for i in range(n_ops):
+            for a in _bits(must[i]):
+                after[a] |= 1 << i
+        red_c, red_s, fams = [], [], []
+        changed = False
+        for i in range(n_ops):
+            p = part_of[i]
+            there, never = parts_of(must[i]), (parts_of(after[i]) & ~initial) | absent
+            if p < 0 or p == base:  # no part, or the base part (placed first, into nothing)
+                red_c.append(TRUE)
+                red_s.append(TRUE)
+                fams.append(frozenset({0}))
+                continue
+            tests = []
+            for mask in (contact[i], TRUE if held[i] else support[i]):
+                tests.append(TRUE if mask == TRUE or mask & there else mask & ~never)
+            red_c.append(tests[0])
+            red_s.append(tests[1])
+            # a set holding every part it may touch (or rest on) is never free
+            # a set holding an ancestor (or itself) of every part it may touch or rest on is
+            # never free; a set holding an ancestor of every part of another set is free only
+            # when that one is (valid states hold the ancestors of what they hold)
+            need = [t for t in tests if t != TRUE]
+            sets = {b & ~never for b in blocked[i] if not b & there}
+            sets = {b for b in sets if not any(covers(b, t) for t in need)}
+            family = frozenset(
+                b for b in sets if not any(covers(b, t) and not covers(t, b) for t in sets)
+            )
+            why = _never(spec, i, tests, family)
+            if why:
+                return None, why
+            fams.append(family)
+            # the only part it can touch or rest on comes first
+            for mask in tests:
+                if mask not in (TRUE, 0) and mask & (mask - 1) == 0:
+                    q = ops_of(mask)
+                    if q and not must[i] & q:
+                        must[i] |= q
+                        changed = True
+            # a part blocking it along every direction left comes after it
+            common = ~0
+            for s in family:
+                common &= s
+            for r in _bits(ops_of(common & ~initial) if common > 0 else 0):
+                if not must[r] >> i & 1:
+                    must[r] |= 1 << i
+                    changed = True
+        if not changed:
+            model = ReducedModel(
+                part_of=part_of,
+                op_of=op_of,
+                must=tuple(must),
+                contact=tuple(red_c),
+                support=tuple(red_s),
+                family=tuple(fams),
+                raw_near=tuple(ops_of(contact[i] | support[i]) for i in range(n_ops)),
+            )
+            return model, ""
+
+
+def _never(spec: AssemblySpec, i: int, tests: list[int], family: frozenset[int]) -> str:
+    """Why operation ``i`` can never be done once its predecessors are ("" if it can)."""
+    op = spec.operations[i]
+    what = f"part {op.parts[0]} (operation {op.id})"
+    if tests[0] == 0:
+        return f"{what} touches nothing that can be there before it"
+    if tests[1] == 0:
+        return f"{what} rests on nothing that can be there before it"
+    if not family:
+        return f"{what} is blocked along every direction by parts that must be there before it"
+    return ""
+
+
+def _closure(must: list[int]) -> list[int]:
+    """Transitive closure of the predecessor bitsets."""
+    out = list(must)
+    changed = True
+    while changed:
+        changed = False
+        for i, m in enumerate(out):
+            full = m
+            for a in _bits(m):
+                full |= out[a]
+            if full != m:
+                out[i] = full
+                changed = True
+    return out
+
+
+def _signature(spec: AssemblySpec, i: int):
+    op = spec.operations[i]
+    shape = None
+    if op.parts:
+        record = next((p for p in spec.parts if p.id == op.parts[0]), None)
+        shape = getattr(record, "shape", None) or None
+    return (
+        tuple(sorted(op.durations)),
+        tuple(sorted(op.ranges)),
+        op.requires,
+        op.sets,
+        op.held,
+        shape,
+    )
+
+
+class _Symmetry:
+    """Checks and builds operation permutations that are symmetries of a reduced model."""
+
+    def __init__(self, spec: AssemblySpec, model: ReducedModel):
+        self.spec, self.m = spec, model
+        n = len(spec.operations)
+        self.n = n
+        self.sig = [_signature(spec, i) for i in range(n)]
+        m = model
+        self.colour = [
+            (
+                self.sig[i],
+                bin(m.must[i]).count("1"),
+                -1 if m.contact[i] == TRUE else bin(m.contact[i]).count("1"),
+                -1 if m.support[i] == TRUE else bin(m.support[i]).count("1"),
+                tuple(sorted(bin(s).count("1") for s in m.family[i])),
+            )
+            for i in range(n)
+        ]
+        # relations to propagate a swap along: the raw contacts and supports (both ways),
+        # the derived predecessors and successors
+        near = [m.raw_near[i] for i in range(n)]
+        for i in range(n):
+            for j in _bits(near[i]):
+                near[j] |= 1 << i
+        after = [0] * n
+        for i in range(n):
+            for a in _bits(m.must[i]):
+                after[a] |= 1 << i
+        self.relations = (near, list(m.must), after)
+
+    def _map_ops(self, perm: dict[int, int], mask: int) -> int:
+        out = 0
+        for i in _bits(mask):
+            out |= 1 << perm.get(i, i)
+        return out
+
+    def _map_parts(self, perm: dict[int, int], mask: int) -> int:
+        if mask == TRUE:
+            return TRUE
+        m = self.m
+        out = 0
+        for p in _bits(mask):
+            q = m.part_of[perm[m.op_of[p]]] if p in m.op_of and m.op_of[p] in perm else p
+            out |= 1 << q
+        return out
+
+    def breakers(self, perm: dict[int, int]) -> list[int]:
+        """The operations whose reduced tests ``perm`` (identity elsewhere) does not map onto
+        their image's: none for a symmetry."""
+        m = self.m
+        if any(self.sig[i] != self.sig[j] for i, j in perm.items()):
+            return list(perm)
+        # only operations whose tests mention a moved one can change
+        moved_parts = sum(1 << m.part_of[i] for i in perm if m.part_of[i] >= 0)
+        moved_ops = sum(1 << i for i in perm)
+        out = []
+        for i in range(self.n):
+            j = perm.get(i, i)
+            if i == j:
+                touches = m.must[i] & moved_ops or any(
+                    t != TRUE and t & moved_parts for t in (m.contact[i], m.support[i])
+                )
+                if not touches and not any(s & moved_parts for s in m.family[i]):
+                    continue
+            if (
+                self._map_ops(perm, m.must[i]) != m.must[j]
+                or self._map_parts(perm, m.contact[i]) != m.contact[j]
+                or self._map_parts(perm, m.support[i]) != m.support[j]
+                or frozenset(self._map_parts(perm, s) for s in m.family[i]) != m.family[j]
+            ):
+                out.append(i)
+        return out
+
+    def swap(self, a: int, b: int) -> tuple[dict[int, int], int] | None:
+        """An involution swapping ``a`` and ``b`` and the operations attached to them, and
+        the block of ``a`` (the operations it moves on ``a``'s side); None if none found."""
+        perm = {a: b, b: a}
+        if not self.breakers(perm):
+            return perm, 1 << a
+        side = {a: 0, b: 1}
+        queue = [a, b]
+        while queue:
+            x = queue.pop()
+            y = perm[x]
+            for rel in self.relations:
+                if not self._pair_up(rel[x] & ~rel[y], rel[y] & ~rel[x], x, y, perm, side, queue):
+                    return None
+        if self.breakers(perm):
+            return None
+        return perm, sum(1 << i for i, s in side.items() if s == 0)
+
+    def _pair_up(self, mine, theirs, x, y, perm, side, queue) -> bool:
+        """Extend ``perm`` so that it maps ``mine`` onto ``theirs`` (False: no unique way)."""
+        by_colour: dict = defaultdict(lambda: ([], []))
+        for k, mask in ((0, mine), (1, theirs)):
+            for i in _bits(mask):
+                by_colour[self.colour[i]][k].append(i)
+        for xs0, ys0 in by_colour.values():
+            xs = [i for i in xs0 if perm.get(i) not in ys0]
+            ys = [i for i in ys0 if perm.get(i) not in xs0]
+            if not xs and not ys:
+                continue
+            if len(xs) != 1 or len(ys) != 1:
+                return False
+            u, v = xs[0], ys[0]
+            if u in perm or v in perm:
+                return False
+            perm[u], perm[v] = v, u
+            side[u], side[v] = side[x], side[y]
+            queue += [u, v]
+        return True
+
+    def block_order(self, block: int) -> list[int]:
+        """The block's operations in derived-precedence order (by how many of the block come
+        before each, then by index): a chain when :meth:`is_chain`."""
+        return sorted(_bits(block), key=lambda i: (bin(self.m.must[i] & block).count("1"), i))
+
+    def is_chain(self, order: list[int]) -> bool:
+        """Whether each operation of ``order`` needs every one before it."""
+        block = sum(1 << i for i in order)
+        return all(bin(self.m.must[i] & block).count("1") == k for k, i in enumerate(order))
+
+
+def interchangeable_blocks(
+    spec: AssemblySpec, relations, *, chains_only: bool = True
+) -> list[list[list[str]]]:
+    """Classes of interchangeable blocks of operations (ids), each block in its
+    derived-precedence order.
+
+    A class ``[[a1, a2], [b1, b2], ...]`` says: every transposition of two of its blocks
+    (``a1 <-> b1`` together with ``a2 <-> b2``) is a symmetry of the reduced model. With
+    ``chains_only`` (default) only classes whose blocks are chains (each block's operations
+    are done in that order in every complete sequence). Blocks of different classes are
+    disjoint.
+    """
+    model = reduced_model(spec, relations)
+    if model is None:
+        return []
+    sym = _Symmetry(spec, model)
+    base = model.op_of.get(_base_index(spec, model), -1)
+    groups: dict = defaultdict(list)
+    for i in range(sym.n):
+        if model.part_of[i] >= 0 and i != base:
+            groups[sym.colour[i]].append(i)
+    used = 0
+    out = []
+    ids = [op.id for op in spec.operations]
+    for members in groups.values():
+        left = [i for i in members if not used >> i & 1]
+        while len(left) > 1:
+            first, rest = left[0], left[1:]
+            blocks, block0, order0 = [], None, None
+            taken = 0
+            for j in rest:
+                if used >> j & 1 or taken >> j & 1:
+                    continue
+                found = sym.swap(first, j)
+                if found is None:
+                    continue
+                perm, block = found
+                if block0 is None:
+                    order0 = sym.block_order(block)
+                    if block & used:
+                        break
+                    block0 = block
+                elif block != block0:
+                    continue
+                image = sum(1 << perm[i] for i in _bits(block))
+                if image & (used | taken | block0):
+                    continue
+                blocks.append([perm[i] for i in order0])
+                taken |= image
+            if blocks and (sym.is_chain(order0) or not chains_only):
+                out.append([[ids[i] for i in order0]] + [[ids[i] for i in b] for b in blocks])
+                used |= block0 | taken
+            left = [i for i in rest if not (used | taken) >> i & 1]
+    return out
+
+
+def _base_index(spec: AssemblySpec, model: ReducedModel) -> int:
+    """The oracle index of the base part."""
+    for i, op in enumerate(spec.operations):
+        if op.parts and op.parts[0] == spec.base_part:
+            return model.part_of[i]
+    return -1
+
 
 def interchangeable_classes(spec: AssemblySpec, relations) -> list[list[str]]:
-    """Classes (two or more operation ids, in spec order) of interchangeable operations."""
+    """Classes (two or more operation ids, in spec order) of interchangeable operations: the
+    first operation of each block of :func:`interchangeable_blocks` (or, for a spec the
+    reduced model does not apply to, the operations an exact swap of table rows exchanges)."""
+    model, why = _derive(spec, relations)
+    if model is None:
+        return [] if why else _exact_classes(spec, relations)
+    return [[b[0] for b in cls] for cls in interchangeable_blocks(spec, relations)]
+
+
+def _exact_classes(spec: AssemblySpec, relations) -> list[list[str]]:
+    """Classes of operations whose parts an exact swap of the relation tables' rows and
+    columns exchanges (the test for specs :func:`reduced_model` does not apply to:
+    subassemblies, operations placing several parts)."""
     if relations is None:
         return []
     rel_ids = [str(p) for p in relations.parts]
@@ -100,5 +550,85 @@ def with_fixed_order(spec: AssemblySpec, classes: list[list[str]]) -> AssemblySp
 
 
 def reduce_interchangeable(spec: AssemblySpec, relations) -> AssemblySpec:
-    """:func:`with_fixed_order` of the :func:`interchangeable_classes` of ``spec``."""
-    return with_fixed_order(spec, interchangeable_classes(spec, relations))
+    """``spec`` reduced for the state graph, with the full graph's TCT and W*.
+
+    With the reduced model (:func:`reduced_model`): its derived precedences become ``after``
+    (:func:`with_derived_precedences`; only dead ends go) and, for every class of
+    :func:`interchangeable_blocks`, the ``i``-th operations of its blocks are chained in block
+    order. Otherwise the classes of an exact swap are chained. A spec the derived precedences
+    prove infeasible is returned as it is (the state graph names the cause).
+    """
+    model, why = _derive(spec, relations)
+    if model is None:
+        return spec if why else with_fixed_order(spec, _exact_classes(spec, relations))
+    chains = []
+    for cls in interchangeable_blocks(spec, relations):
+        for position in range(len(cls[0])):
+            chains.append([block[position] for block in cls])
+    return with_fixed_order(with_derived_precedences(spec, relations), chains)
+
+
+def symmetry_reduction(spec: AssemblySpec, relations) -> tuple[AssemblySpec, list[list[list[str]]]]:
+    """:func:`reduce_interchangeable`, and the classes whose blocks are not chains.
+
+    Such a class (a shaft with its two bearings and a collar, three times around a drive)
+    cannot be put in a fixed order by precedences; its first operations are chained when a
+    block has one operation every other of it needs, and the state graph moves only the
+    first of equal blocks (:meth:`asp.feasibility.OperationModel.enabled`, pass the classes
+    as ``operation_model(..., symmetric=...)``).
+    """
+    model, why = _derive(spec, relations)
+    reduced = reduce_interchangeable(spec, relations)
+    if model is None:
+        return reduced, []
+    index = {op.id: i for i, op in enumerate(spec.operations)}
+    chains, others = [], []
+    for cls in interchangeable_blocks(spec, relations, chains_only=False):
+        block = sum(1 << index[o] for o in cls[0])
+        if all(bin(model.must[index[o]] & block).count("1") == k for k, o in enumerate(cls[0])):
+            continue  # a chain: reduce_interchangeable ordered it
+        others.append(cls)
+        root = index[cls[0][0]]
+        if all(model.must[index[o]] >> root & 1 for o in cls[0][1:]):
+            chains.append([b[0] for b in cls])
+    return with_fixed_order(reduced, chains), others
+
+
+def reduced_state_graph(spec: AssemblySpec, relations, **kwargs):
+    """The state graph of :func:`symmetry_reduction` (same TCT and W* as the full graph).
+
+    Keyword arguments go to :func:`asp.state_graph.build_state_graph`; returns None when
+    there is nothing to reduce (build the full graph).
+    """
+    from asp.feasibility import operation_model
+    from asp.state_graph import build_state_graph
+
+    reduced, others = symmetry_reduction(spec, relations)
+    if reduced is spec and not others:
+        return None
+    model = operation_model(reduced, relations, symmetric=others)
+    return build_state_graph(reduced, relations, model=model, **kwargs)
+
+
+def reduce_exact(spec: AssemblySpec, relations) -> AssemblySpec:
+    """``spec`` with the classes of an exact swap of table rows chained (for specs with
+    subassemblies, where :func:`reduce_interchangeable` keeps to this test)."""
+    return with_fixed_order(spec, _exact_classes(spec, relations))
+
+
+def with_derived_precedences(spec: AssemblySpec, relations) -> AssemblySpec:
+    """``spec`` with the derived precedences of :func:`reduced_model` as ``after`` (only the
+    direct ones: a predecessor implied by another is left out). Every completable state keeps
+    them, so the graph loses only dead ends."""
+    model = reduced_model(spec, relations)
+    if model is None:
+        return spec
+    ids = [op.id for op in spec.operations]
+    ops = []
+    for i, op in enumerate(spec.operations):
+        implied = 0
+        for a in _bits(model.must[i]):
+            implied |= model.must[a]
+        direct = [ids[a] for a in _bits(model.must[i] & ~implied) if ids[a] not in op.after]
+        ops.append(replace(op, after=(*op.after, *direct)) if direct else op)
+    return replace(spec, operations=tuple(ops))

@@ -45,12 +45,20 @@ def test_classes_are_the_alike_parts_only():
         [f"pin{k}" for k in range(5)],
         [f"screw{k}" for k in range(3)],
     ]
-    # a pin that also touches the base is not like the others
-    other = relations(rel.parts, [("pin0", "base", "-z")])
-    tc = rel.tc | other.tc
-    odd = type(rel)(rel.parts, tc, rel.tt)
+    # a pin the cover does not stop (it can still go in after the cover) is not like the
+    # others; a pin that also touches the base is (it comes after the disc all the same)
+    pin0, cover = rel.parts.index("pin0"), rel.parts.index("cover")
+    assert not rel.tt[pin0, cover, 4]
+    loose = rel.tt.copy()
+    loose[pin0, cover, 4] = loose[cover, pin0, 5] = True  # pin0 free along +z past the cover
+    odd = type(rel)(rel.parts, rel.tc, loose)
     assert [c for c in interchangeable_classes(spec, odd) if "pin1" in c] == [
         [f"pin{k}" for k in range(1, 5)]
+    ]
+    other = relations(rel.parts, [("pin0", "base", "-z")])
+    touching = type(rel)(rel.parts, rel.tc | other.tc, rel.tt)
+    assert [c for c in interchangeable_classes(spec, touching) if "pin1" in c] == [
+        [f"pin{k}" for k in range(5)]
     ]
 
 
