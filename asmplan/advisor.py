@@ -185,9 +185,16 @@ class Advisor:
         return super().__new__(cls)
 
     def __init__(self, plan: dict):
+        self._read(plan, "alternate")
+        self._cursor = _Cursor(self._policy["start"])
+        self._cursor.state = self._skip_passes(self._cursor.state)
+
+    def _read(self, plan: dict, turn_model: str) -> None:
+        """Check the plan and index its policy's operations and agents."""
         check_plan(plan)
-        if plan["policy"]["turn_model"] != "alternate":
-            raise ValueError(f"advisor: turn model {plan['policy']['turn_model']!r} unknown")
+        if plan["policy"]["turn_model"] != turn_model:
+            got = plan["policy"]["turn_model"]
+            raise ValueError(f"advisor: expected a plan of turn model {turn_model}, got {got!r}")
         self.plan = plan
         self._policy = plan["policy"]
         self._ops = self._policy["operations"]
@@ -195,8 +202,6 @@ class Advisor:
         self._agents = self._policy["agents"]
         self._agent_index = {a: k for k, a in enumerate(self._agents)}
         self._operations = plan.get("operations", {})
-        self._cursor = _Cursor(self._policy["start"])
-        self._cursor.state = self._skip_passes(self._cursor.state)
 
     # ------------------------------------------------------------------ queries
     @property
@@ -423,16 +428,7 @@ class ConcurrentAdvisor(Advisor):
     one for a plan of turn model ``concurrent``."""
 
     def __init__(self, plan: dict):
-        check_plan(plan)
-        if plan["policy"]["turn_model"] != "concurrent":
-            raise ValueError("ConcurrentAdvisor: the plan's turn model is not concurrent")
-        self.plan = plan
-        self._policy = plan["policy"]
-        self._ops = self._policy["operations"]
-        self._op_index = {op: k for k, op in enumerate(self._ops)}
-        self._agents = self._policy["agents"]
-        self._agent_index = {a: k for k, a in enumerate(self._agents)}
-        self._operations = plan.get("operations", {})
+        self._read(plan, "concurrent")
         sides = plan.get("agents", {})
         self._robot = [_worker_side(a, sides) == "robot" for a in self._agents]
         self._events: list[Event] = []
