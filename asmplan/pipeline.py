@@ -27,6 +27,7 @@ them, so importing this module is cheap.
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 from collections.abc import Callable
@@ -162,29 +163,43 @@ class AssemblyPlan:
         return self.game.dag
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``asmplan-plan/2`` object written as ``plan.json`` (:mod:`asmplan.planfile`)."""
+        """The ``asmplan-plan/2`` object written as ``plan.json`` (:mod:`asmplan.planfile`;
+        computed once)."""
+        return self._document
+
+    @functools.cached_property
+    def _document(self) -> dict[str, Any]:
         from asmplan.planfile import alternate_states, plan_document
 
+        extra = {
+            "relations": self.relations_summary,
+            "states": self.graph.n_states,
+            "transitions": self.graph.n_transitions,
+            "sequences": self.sequences,
+            "schedule": self.schedule.to_dict(),
+        }
+        if self.concurrent is None:
+            return plan_document(
+                spec=self.assembly.spec,
+                dag=self.game.dag,
+                solution=self.solution,
+                describe=alternate_states(self.graph, self.game.dag),
+                extra=extra,
+            )
+        curve = self.concurrent.curve
         doc = plan_document(
             spec=self.assembly.spec,
-            dag=self.game.dag,
-            solution=self.solution,
-            describe=alternate_states(self.graph, self.game.dag),
-            extra={
-                "relations": self.relations_summary,
-                "states": self.graph.n_states,
-                "transitions": self.graph.n_transitions,
-                "sequences": self.sequences,
-                "schedule": self.schedule.to_dict(),
-            },
+            dag=curve.game.dag,
+            solution=curve.solution,
+            game=curve.game,
+            extra=extra,
         )
-        if self.concurrent is not None:
-            from asp.concurrent_plan import plan_entries
+        from asp.concurrent_plan import plan_entries
 
-            doc.update(plan_entries(self.concurrent))
-            doc["schedule"].update(
-                chain_bound=self.schedule.chain_bound, load_bound=self.schedule.load_bound
-            )
+        doc.update(plan_entries(self.concurrent))
+        doc["schedule"].update(
+            chain_bound=self.schedule.chain_bound, load_bound=self.schedule.load_bound
+        )
         return doc
 
 
@@ -336,7 +351,11 @@ def part_geometry(source: str | os.PathLike[str], *, units: str | None = None):
 
 
 def state_graph(
-    assembly: Assembly, *, progress: bool = False, max_states: int | None = None
+    assembly: Assembly,
+    *,
+    progress: bool = False,
+    max_states: int | None = None,
+    on_step: Progress | None = None,
 ) -> StateGraph:
     """The assembly state graph: every feasible partial assembly and operation.
 
@@ -355,6 +374,8 @@ def state_graph(
         Show progress on stderr.
     max_states : int, optional
         State limit (default: the spec's ``max_states``, else 20,000,000).
+    on_step : callable, optional
+        Called with a line for each round of automatic subassemblies.
 
     Returns
     -------
@@ -372,8 +393,9 @@ def state_graph(
     except SpecError as exc:
         if "infeasible assembly" not in str(exc):
             raise
-    exact = reduce_exact(spec, rel)
-    return build_with_units(exact, rel, progress=progress, max_states=max_states)
+    return build_with_units(
+        reduce_exact(spec, rel), rel, on_unit=on_step, progress=progress, max_states=max_states
+    )
 
 
 def game(graph: StateGraph, *, cost: str | None = None) -> GameDAG:
@@ -444,12 +466,14 @@ def schedule(
     time_limit: float = 30.0,
     workers: int = 1,
     seed: int = 0,
+    sequence: list[str] | None = None,
 ) -> Schedule:
     """CP-SAT minimum makespan with the agents working in parallel, physically feasible.
 
     Every schedule is replayed through the state graph and cut until one passes
     (:func:`asp.concurrent.assembly_makespan`); the status is ``OPTIMAL`` only for a
-    proven optimum that passed.
+    proven optimum that passed, ``FEASIBLE`` for the best passing schedule when time ran
+    out (a list schedule along a state-graph path is always there to fall back on).
 
     Parameters
     ----------
@@ -462,6 +486,9 @@ def schedule(
         CP-SAT workers (1: repeatable).
     seed : int
         CP-SAT random seed.
+    sequence : list of str, optional
+        A complete sequence of operation ids along the state graph (the robust plan's
+        line): a list schedule along it is one more starting point.
 
     Returns
     -------
@@ -470,7 +497,12 @@ def schedule(
     from asp.concurrent import assembly_makespan
 
     sched, result = assembly_makespan(
-        assembly.spec, graph, time_limit=time_limit, workers=workers, seed=seed
+        assembly.spec,
+        graph,
+        time_limit=time_limit,
+        workers=workers,
+        seed=seed,
+        sequence=sequence,
     )
     return Schedule(result, sched.lower_bound, sched.chain_bound, sched.load_bound)
 
@@ -524,7 +556,7 @@ def plan(
     assembly = source if isinstance(source, Assembly) else load(source, progress=True, on_step=say)
     summary = relations_summary(assembly.relations) if assembly.relations is not None else []
     say("[2/5] building the assembly state graph ...")
-    graph = state_graph(assembly, max_states=max_states)
+    graph = state_graph(assembly, max_states=max_states, on_step=on_step)
     if graph.spec is not assembly.spec:  # subassemblies found: their insertions are operations
         assembly = Assembly(graph.spec, assembly.relations)
     sequences = graph.count_sequences()
@@ -533,7 +565,8 @@ def plan(
     solution = solve_game(the_game.dag)
     steps = robust_plan(the_game, solution)
     say("[4/5] CP-SAT minimum-makespan schedule ...")
-    sched = schedule(assembly, graph, time_limit=time_limit, seed=seed)
+    line = [step.operation for step in steps if step.operation]
+    sched = schedule(assembly, graph, time_limit=time_limit, seed=seed, sequence=line)
     turn = assembly.spec.turn_model if turn_model is None else turn_model
     concurrent = None
     from asp.spec import TURN_MODELS

@@ -35,6 +35,29 @@ CELL = {
     ],
 }
 
+CHOICES = {
+    "name": "choices",
+    "agents": {"H": {"side": "human"}, "R1": {"side": "robot"}},
+    "cost": "time",
+    "operations": [
+        {"id": "p", "description": "place plate", "agents": {"H": 3}},
+        {"id": "q", "description": "place cover", "agents": {"H": 4}},
+        {"id": "r", "description": "place pin", "agents": {"H": 2, "R1": 6}},
+        {"id": "s", "description": "screw plate", "agents": {"R1": 5}, "after": ["p"]},
+        {"id": "t", "description": "screw cover", "agents": {"R1": 4}, "after": ["q"]},
+    ],
+}
+"""A concurrent job where the person has real choices: W*(0) 12, W*(1) 14, W*(2) = W*(inf) 15."""
+
+
+def with_ranges(data: dict, extra: float = 2) -> dict:
+    """The job with every person's duration ``d`` made the range ``[d, d + extra]``."""
+    ops = [
+        {**op, "agents": {a: ([d, d + extra] if a == "H" else d) for a, d in op["agents"].items()}}
+        for op in data["operations"]
+    ]
+    return {**data, "operations": ops}
+
 
 def cell_game(cost: str | None = None):
     """(spec, graph, dag, solution) of the small cell."""
@@ -48,4 +71,26 @@ def cell_plan(cost: str | None = None) -> dict:
     spec, graph, dag, solution = cell_game(cost)
     return plan_document(
         spec=spec, dag=dag, solution=solution, describe=alternate_states(graph, dag)
+    )
+
+
+def concurrent_cell(data: dict | None = None, *, max_k: int = 2, step: float | None = 1.0):
+    """(spec, curve) of a job in the concurrent game (default: the small cell), budgets
+    ``0..max_k`` (:func:`asp.concurrent.robustness`)."""
+    from asp.concurrent import concurrent_model, robustness
+
+    spec = spec_from_dict(data or CELL, source="cell.yaml")
+    graph = build_state_graph(spec)
+    return spec, robustness(concurrent_model(spec, graph, step=step), max_k=max_k)
+
+
+def concurrent_plan(data: dict | None = None, *, max_k: int = 2, step: float | None = 1.0):
+    """The plan document of a job in the concurrent game (no CP-SAT schedule)."""
+    spec, curve = concurrent_cell(data, max_k=max_k, step=step)
+    return plan_document(
+        spec=spec,
+        dag=curve.game.dag,
+        solution=curve.solution,
+        game=curve.game,
+        extra={"robustness": curve.to_list()},
     )
