@@ -33,6 +33,7 @@ uint64 words (one word, the fast path, up to 64 bits; see :class:`OperationModel
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -437,6 +438,15 @@ class OperationModel:
         (k, n_ops) bool
         """
         keys = self._keys(keys)
+        if self._kernel_args is not None:  # compiled: one pass over the states
+            from asp.enabled_kernel import enabled_single
+
+            ok = np.empty((keys.shape[0], self.n_ops), dtype=bool)
+            sets = np.ascontiguousarray(self.oracle.sets(parts))
+            enabled_single(np.ascontiguousarray(keys), sets, *self._kernel_args, ok)
+            if self.symmetric:
+                self._first_of_equals(keys, ok)
+            return ok
         zero = np.uint64(0)
         if self.n_words == 1:  # the fast path: one broadcast test per mask
             col = keys[:, :1]
@@ -484,6 +494,36 @@ class OperationModel:
         if self.symmetric:
             self._first_of_equals(keys, ok)
         return ok
+
+    @functools.cached_property
+    def _kernel_args(self) -> tuple | None:
+        """The arrays of :func:`asp.enabled_kernel.enabled_single`, or None when an
+        operation places several parts or the spec has subassemblies (the numpy path)."""
+        if self.unit_ops or any(len(p) > 1 for p in self.part_lists):
+            return None
+        o = self.oracle
+        n_ops = self.n_ops
+        part_of = np.array([p[0] if p else -1 for p in self.part_lists], dtype=np.int64)
+        needs_base = (part_of >= 0) & (part_of != o.base) & bool(o.topological and o.base >= 0)
+        base = max(o.base, 0)
+        return (
+            np.arange(n_ops, dtype=np.int64) // WORD_BITS,
+            np.array([1 << (i % WORD_BITS) for i in range(n_ops)], dtype=np.uint64),
+            np.ascontiguousarray(self.pred_masks),
+            np.ascontiguousarray(self.requires_mask),
+            np.ascontiguousarray(self.requires_value),
+            part_of,
+            needs_base,
+            np.array([op.held for op in self.spec.operations], dtype=bool),
+            np.ascontiguousarray(o.contact),
+            np.ascontiguousarray(o.blocked),
+            np.ascontiguousarray(o.support),
+            np.asarray(o.directions, dtype=bool),
+            base // WORD_BITS,
+            np.uint64(1 << (base % WORD_BITS)),
+            bool(o.geometric),
+            bool(o.stability),
+        )
 
     def _first_of_equals(self, keys: np.ndarray, ok: np.ndarray) -> None:
         """Keep, of interchangeable blocks in the same state, only the first one's moves.
@@ -677,11 +717,12 @@ def operation_model(
 def load_relations(spec: AssemblySpec, *, progress: bool = False):
     """Compute the cad relations of ``spec``'s parts (``None`` when it has no geometry).
 
-    Reads the meshes of the spec's parts (:func:`asp.generate.spec_geometry`).
+    Reads the meshes of the spec's parts (``cad.loading.load_parts``, as
+    :func:`asp.generate.spec_geometry` does).
     """
     if not spec.has_geometry:
         return None
     import cad
-    from asp.generate import spec_geometry
+    from cad.loading import load_parts
 
-    return cad.compute_relations(spec_geometry(spec), progress=progress)
+    return cad.compute_relations(load_parts(spec.parts, spec.folder, spec.units), progress=progress)

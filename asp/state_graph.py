@@ -420,18 +420,20 @@ def _join(layers: list[np.ndarray], dtype) -> np.ndarray:
 
 
 def _unique_rows(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Distinct rows of the (m, W) keys in increasing integer order, and each row's index."""
-    if keys.shape[1] == 1:
-        uniq, inv = np.unique(keys[:, 0], return_inverse=True)
-        return uniq[:, None], inv.reshape(-1)
-    order = np.lexsort(keys.T)  # the last word (most significant) is the primary key
-    ordered = keys[order]
-    first = np.empty(keys.shape[0], dtype=bool)
-    first[:1] = True
-    np.any(ordered[1:] != ordered[:-1], axis=1, out=first[1:])
-    inv = np.empty(keys.shape[0], dtype=np.int64)
-    inv[order] = np.cumsum(first) - 1
-    return ordered[first], inv
+    """Distinct rows of the (m, W) keys in increasing integer order, and each row's index.
+
+    The rows are first made distinct by hashing (:func:`asp.enabled_kernel.first_rows`,
+    linear), then only the distinct ones are sorted (a layer has several times more
+    transitions than states).
+    """
+    from asp.enabled_kernel import first_rows
+
+    firsts, inv = first_rows(np.ascontiguousarray(keys))
+    uniq = keys[firsts]
+    order = np.lexsort(uniq.T)  # the last word (most significant) is the primary key
+    rank = np.empty(order.size, dtype=np.int64)
+    rank[order] = np.arange(order.size)
+    return uniq[order], rank[inv]
 
 
 def _too_many(model: OperationModel, keys: np.ndarray, limit: int, reached: str, layer: int):

@@ -1,0 +1,147 @@
+"""The enabled-operations test compiled with numba (:meth:`asp.feasibility.OperationModel.enabled`).
+
+One pass over the states: for each state and operation, the key tests (not done, explicit
+predecessors done, tools ready) and then the geometric test of the part it places (touches
+the assembled parts, rests on them unless held, some allowed direction free; the base part
+first) on the state's part set, word by word. The same rules as the numpy path, which stays
+for subassemblies and operations placing several parts; the results are equal (tested).
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+
+@numba.njit(cache=True, nogil=True)
+def enabled_single(
+    keys,
+    parts,
+    op_word,
+    op_bit,
+    pred,
+    req_mask,
+    req_value,
+    part_of,
+    needs_base,
+    held,
+    contact,
+    blocked,
+    support,
+    directions,
+    base_word,
+    base_bit,
+    geometric,
+    stability,
+    out,
+):
+    """Fill ``out`` (k, n_ops) bool: operation ``i`` may be done in state ``s``.
+
+    Parameters
+    ----------
+    keys : (k, W) uint64
+    parts : (k, PW) uint64
+    op_word, op_bit : (n_ops,) int64, uint64
+        Where operation ``i``'s own key bit is.
+    pred, req_mask, req_value : (n_ops, W) uint64
+    part_of : (n_ops,) int64
+        The part each operation places, -1 for none.
+    needs_base : (n_ops,) bool
+        The base part must be there (topological, the operation places another part).
+    held : (n_ops,) bool
+    contact, support : (n, PW) uint64
+    blocked : (n, 6, PW) uint64
+    directions : (6,) bool
+    base_word, base_bit : int, uint64
+    geometric, stability : bool
+    """
+    k, n_words = keys.shape
+    pw = parts.shape[1]
+    n_ops = op_word.shape[0]
+    zero = np.uint64(0)
+    for s in range(k):
+        empty = True
+        for w in range(pw):
+            if parts[s, w] != zero:
+                empty = False
+        for i in range(n_ops):
+            ok = (keys[s, op_word[i]] & op_bit[i]) == zero
+            w = 0
+            while ok and w < n_words:
+                key = keys[s, w]
+                if (key & pred[i, w]) != pred[i, w] or (key & req_mask[i, w]) != req_value[i, w]:
+                    ok = False
+                w += 1
+            p = part_of[i]
+            if ok and p >= 0:
+                if needs_base[i] and (parts[s, base_word] & base_bit) == zero:
+                    ok = False
+                elif geometric and not empty:
+                    touch = False
+                    rest = not stability or held[i]
+                    for w in range(pw):
+                        if parts[s, w] & contact[p, w]:
+                            touch = True
+                        if parts[s, w] & support[p, w]:
+                            rest = True
+                    free = False
+                    if touch and rest:
+                        for d in range(6):
+                            if not directions[d]:
+                                continue
+                            clear = True
+                            for w in range(pw):
+                                if parts[s, w] & blocked[p, d, w]:
+                                    clear = False
+                                    break
+                            if clear:
+                                free = True
+                                break
+                    ok = touch and rest and free
+            out[s, i] = ok
+
+
+@numba.njit(cache=True, nogil=True)
+def first_rows(keys):
+    """Hash the (m, W) uint64 rows: the index of each distinct row's first occurrence, and
+    for every row the number of its distinct row (in order of first occurrence).
+
+    Returns
+    -------
+    firsts : (u,) int64
+    inverse : (m,) int64
+    """
+    m, n_words = keys.shape
+    size = 2
+    while size < 2 * m:
+        size *= 2
+    mask = size - 1
+    table = np.full(size, -1, dtype=np.int64)
+    firsts = np.empty(m, dtype=np.int64)
+    inverse = np.empty(m, dtype=np.int64)
+    u = 0
+    for r in range(m):
+        h = np.uint64(0x9E3779B97F4A7C15)
+        for w in range(n_words):
+            h = (h ^ keys[r, w]) * np.uint64(0xBF58476D1CE4E5B9)
+            h ^= h >> np.uint64(31)
+        slot = np.int64(h & np.uint64(mask))
+        while True:
+            t = table[slot]
+            if t == -1:
+                table[slot] = u
+                firsts[u] = r
+                inverse[r] = u
+                u += 1
+                break
+            f = firsts[t]
+            same = True
+            for w in range(n_words):
+                if keys[f, w] != keys[r, w]:
+                    same = False
+                    break
+            if same:
+                inverse[r] = t
+                break
+            slot = (slot + 1) & mask
+    return firsts[:u], inverse

@@ -1,0 +1,41 @@
+"""The compiled enabled-operations test agrees with the numpy one (asp/enabled_kernel.py)."""
+
+from __future__ import annotations
+
+import numpy as np
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from asp.feasibility import operation_model, pack_words
+from tests.asp.test_symmetry_ring import _random_spec, _random_tables
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(
+    data=st.data(),
+    copies=st.integers(2, 3),
+    singles=st.integers(0, 2),
+    words=st.sampled_from([1, 2]),
+)
+def test_kernel_and_numpy_agree(data, copies, singles, words):
+    rel = _random_tables(data.draw, copies, singles)
+    held = data.draw(st.sets(st.sampled_from("psr")))
+    spec = _random_spec(rel.parts, held)
+    compiled = operation_model(spec, rel, _min_words=words)
+    plain = operation_model(spec, rel, _min_words=words)
+    plain.__dict__["_kernel_args"] = None  # the numpy path
+    assert compiled._kernel_args is not None
+    n_ops, n = len(spec.operations), len(rel.parts)
+    done = data.draw(st.lists(st.integers(0, (1 << n_ops) - 1), min_size=1, max_size=30))
+    keys = compiled.pack(done)
+    by_op = [spec.operations[i].parts[0] for i in range(n_ops)]
+    parts = pack_words(
+        [
+            sum(1 << rel.parts.index(by_op[i]) for i in range(n_ops) if d >> i & 1)
+            | data.draw(st.sampled_from([0, 1]))  # the base part there or not
+            for d in done
+        ],
+        compiled.oracle.n_words,
+    )
+    assert n == len(compiled.oracle.parts)
+    np.testing.assert_array_equal(compiled.enabled(keys, parts), plain.enabled(keys, parts))
