@@ -145,3 +145,38 @@ def first_rows(keys):
                 break
             slot = (slot + 1) & mask
     return firsts[:u], inverse
+
+
+@numba.njit(cache=True, nogil=True)
+def stuck(keys, parts, op_word, op_bit, part_of, blocked, directions):
+    """(k,) bool: some operation not done places a part that is blocked along every allowed
+    direction by the parts already there (it can never be done: parts are never removed).
+
+    Same arrays as :func:`enabled_single`.
+    """
+    k = keys.shape[0]
+    pw = parts.shape[1]
+    n_ops = op_word.shape[0]
+    zero = np.uint64(0)
+    out = np.zeros(k, dtype=np.bool_)
+    for s in range(k):
+        for i in range(n_ops):
+            p = part_of[i]
+            if p < 0 or (keys[s, op_word[i]] & op_bit[i]) != zero:
+                continue
+            free = False
+            for d in range(6):
+                if not directions[d]:
+                    continue
+                clear = True
+                for w in range(pw):
+                    if parts[s, w] & blocked[p, d, w]:
+                        clear = False
+                        break
+                if clear:
+                    free = True
+                    break
+            if not free:
+                out[s] = True
+                break
+    return out

@@ -495,6 +495,19 @@ class OperationModel:
             self._first_of_equals(keys, ok)
         return ok
 
+    def stuck(self, keys: np.ndarray, parts: np.ndarray) -> np.ndarray:
+        """(k,) bool: some operation not done places a part that the parts already there
+        block along every allowed direction, so it can never be done (a dead end). Always
+        False for specs off the compiled path (subassemblies, several parts an operation)."""
+        keys = self._keys(keys)
+        if self._kernel_args is None:
+            return np.zeros(keys.shape[0], dtype=bool)
+        from asp.enabled_kernel import stuck
+
+        a = self._kernel_args
+        sets = np.ascontiguousarray(self.oracle.sets(parts))
+        return stuck(np.ascontiguousarray(keys), sets, a[0], a[1], a[5], a[9], a[11])
+
     @functools.cached_property
     def _kernel_args(self) -> tuple | None:
         """The arrays of :func:`asp.enabled_kernel.enabled_single`, or None when an

@@ -181,6 +181,7 @@ def build_state_graph(
     max_states: int | None = None,
     progress: bool = False,
     check: bool = True,
+    drop_stuck: bool = False,
 ) -> StateGraph:
     """Build the state graph of ``spec`` breadth-first, vectorised over each layer.
 
@@ -199,6 +200,11 @@ def build_state_graph(
     check : bool
         Raise a ``ValueError`` naming the parts that can never be inserted when no complete
         sequence exists.
+    drop_stuck : bool
+        Leave out the states in which some part still to come is blocked along every
+        direction (:meth:`asp.feasibility.OperationModel.stuck`): dead ends, which the game
+        drops anyway (TCT and W* do not change), but not the states an infeasibility report
+        or the automatic subassemblies look at.
     """
     model = operation_model(spec, relations) if model is None else model
     if max_states is None:
@@ -233,10 +239,16 @@ def build_state_graph(
         if at_least > max_states:
             raise _too_many(model, keys, max_states, f"at least {at_least:,}", layer)
         uniq, inv = _unique_rows(model.successor_keys(keys[si], oi))
-        if total + uniq.shape[0] > max_states:
-            raise _too_many(model, uniq, max_states, f"{total + uniq.shape[0]:,}", layer)
         new_parts = np.empty((uniq.shape[0], parts.shape[1]), dtype=np.uint64)
         new_parts[inv] = parts[si] | model.op_parts[oi]
+        if drop_stuck:
+            keep = ~model.stuck(uniq, new_parts)
+            if not keep.all():
+                live = keep[inv]
+                si, oi, inv = si[live], oi[live], (np.cumsum(keep) - 1)[inv[live]]
+                uniq, new_parts = uniq[keep], new_parts[keep]
+        if total + uniq.shape[0] > max_states:
+            raise _too_many(model, uniq, max_states, f"{total + uniq.shape[0]:,}", layer)
         del si_l, oi_l
         n_new = int(si.size)
         src_l.append(si + index_type(offset))

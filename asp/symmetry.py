@@ -595,7 +595,8 @@ def symmetry_reduction(spec: AssemblySpec, relations) -> tuple[AssemblySpec, lis
 
 
 def reduced_state_graph(spec: AssemblySpec, relations, **kwargs):
-    """The state graph of :func:`symmetry_reduction` (same TCT and W* as the full graph).
+    """The state graph of :func:`symmetry_reduction` (same TCT and W* as the full graph),
+    without the states that are stuck (dead ends, see ``build_state_graph(drop_stuck=...)``).
 
     Keyword arguments go to :func:`asp.state_graph.build_state_graph`; returns None when
     there is nothing to reduce (build the full graph).
@@ -607,7 +608,7 @@ def reduced_state_graph(spec: AssemblySpec, relations, **kwargs):
     if reduced is spec and not others:
         return None
     model = operation_model(reduced, relations, symmetric=others)
-    return build_state_graph(reduced, relations, model=model, **kwargs)
+    return build_state_graph(reduced, relations, model=model, drop_stuck=True, **kwargs)
 
 
 def reduce_exact(spec: AssemblySpec, relations) -> AssemblySpec:
