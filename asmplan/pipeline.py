@@ -27,6 +27,7 @@ them, so importing this module is cheap.
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 from collections.abc import Callable
@@ -162,29 +163,43 @@ class AssemblyPlan:
         return self.game.dag
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``asmplan-plan/2`` object written as ``plan.json`` (:mod:`asmplan.planfile`)."""
+        """The ``asmplan-plan/2`` object written as ``plan.json`` (:mod:`asmplan.planfile`;
+        computed once)."""
+        return self._document
+
+    @functools.cached_property
+    def _document(self) -> dict[str, Any]:
         from asmplan.planfile import alternate_states, plan_document
 
+        extra = {
+            "relations": self.relations_summary,
+            "states": self.graph.n_states,
+            "transitions": self.graph.n_transitions,
+            "sequences": self.sequences,
+            "schedule": self.schedule.to_dict(),
+        }
+        if self.concurrent is None:
+            return plan_document(
+                spec=self.assembly.spec,
+                dag=self.game.dag,
+                solution=self.solution,
+                describe=alternate_states(self.graph, self.game.dag),
+                extra=extra,
+            )
+        curve = self.concurrent.curve
         doc = plan_document(
             spec=self.assembly.spec,
-            dag=self.game.dag,
-            solution=self.solution,
-            describe=alternate_states(self.graph, self.game.dag),
-            extra={
-                "relations": self.relations_summary,
-                "states": self.graph.n_states,
-                "transitions": self.graph.n_transitions,
-                "sequences": self.sequences,
-                "schedule": self.schedule.to_dict(),
-            },
+            dag=curve.game.dag,
+            solution=curve.solution,
+            game=curve.game,
+            extra=extra,
         )
-        if self.concurrent is not None:
-            from asp.concurrent_plan import plan_entries
+        from asp.concurrent_plan import plan_entries
 
-            doc.update(plan_entries(self.concurrent))
-            doc["schedule"].update(
-                chain_bound=self.schedule.chain_bound, load_bound=self.schedule.load_bound
-            )
+        doc.update(plan_entries(self.concurrent))
+        doc["schedule"].update(
+            chain_bound=self.schedule.chain_bound, load_bound=self.schedule.load_bound
+        )
         return doc
 
 
