@@ -381,7 +381,11 @@ def part_geometry(source: str | os.PathLike[str], *, units: str | None = None):
 
 
 def state_graph(
-    assembly: Assembly, *, progress: bool = False, max_states: int | None = None
+    assembly: Assembly,
+    *,
+    progress: bool = False,
+    max_states: int | None = None,
+    on_step: Progress | None = None,
 ) -> StateGraph:
     """The assembly state graph: every feasible partial assembly and operation.
 
@@ -396,6 +400,8 @@ def state_graph(
         Show progress on stderr.
     max_states : int, optional
         State limit (default: the spec's ``max_states``, else 20,000,000).
+    on_step : callable, optional
+        Called with a line for each round of automatic subassemblies.
 
     Returns
     -------
@@ -405,7 +411,9 @@ def state_graph(
     from asp.units import build_with_units
 
     spec = reduce_interchangeable(assembly.spec, assembly.relations)
-    return build_with_units(spec, assembly.relations, progress=progress, max_states=max_states)
+    return build_with_units(
+        spec, assembly.relations, on_unit=on_step, progress=progress, max_states=max_states
+    )
 
 
 def game(graph: StateGraph, *, cost: str | None = None) -> GameDAG:
@@ -571,7 +579,7 @@ def plan(
     )
     summary = relations_summary(assembly.relations) if assembly.relations is not None else []
     say("[2/5] building the assembly state graph ...")
-    graph = state_graph(assembly, max_states=max_states)
+    graph = state_graph(assembly, max_states=max_states, on_step=on_step)
     if graph.spec is not assembly.spec:  # subassemblies found: their insertions are operations
         assembly = Assembly(graph.spec, assembly.relations)
     sequences = graph.count_sequences()
