@@ -27,6 +27,7 @@ them, so importing this module is cheap.
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 from collections.abc import Callable
@@ -162,29 +163,43 @@ class AssemblyPlan:
         return self.game.dag
 
     def to_dict(self) -> dict[str, Any]:
-        """The ``asmplan-plan/2`` object written as ``plan.json`` (:mod:`asmplan.planfile`)."""
+        """The ``asmplan-plan/2`` object written as ``plan.json`` (:mod:`asmplan.planfile`;
+        computed once)."""
+        return self._document
+
+    @functools.cached_property
+    def _document(self) -> dict[str, Any]:
         from asmplan.planfile import alternate_states, plan_document
 
+        extra = {
+            "relations": self.relations_summary,
+            "states": self.graph.n_states,
+            "transitions": self.graph.n_transitions,
+            "sequences": self.sequences,
+            "schedule": self.schedule.to_dict(),
+        }
+        if self.concurrent is None:
+            return plan_document(
+                spec=self.assembly.spec,
+                dag=self.game.dag,
+                solution=self.solution,
+                describe=alternate_states(self.graph, self.game.dag),
+                extra=extra,
+            )
+        curve = self.concurrent.curve
         doc = plan_document(
             spec=self.assembly.spec,
-            dag=self.game.dag,
-            solution=self.solution,
-            describe=alternate_states(self.graph, self.game.dag),
-            extra={
-                "relations": self.relations_summary,
-                "states": self.graph.n_states,
-                "transitions": self.graph.n_transitions,
-                "sequences": self.sequences,
-                "schedule": self.schedule.to_dict(),
-            },
+            dag=curve.game.dag,
+            solution=curve.solution,
+            game=curve.game,
+            extra=extra,
         )
-        if self.concurrent is not None:
-            from asp.concurrent_plan import plan_entries
+        from asp.concurrent_plan import plan_entries
 
-            doc.update(plan_entries(self.concurrent))
-            doc["schedule"].update(
-                chain_bound=self.schedule.chain_bound, load_bound=self.schedule.load_bound
-            )
+        doc.update(plan_entries(self.concurrent))
+        doc["schedule"].update(
+            chain_bound=self.schedule.chain_bound, load_bound=self.schedule.load_bound
+        )
         return doc
 
 
@@ -332,7 +347,11 @@ def part_geometry(source: str | os.PathLike[str], *, units: str | None = None):
 
 
 def state_graph(
-    assembly: Assembly, *, progress: bool = False, max_states: int | None = None
+    assembly: Assembly,
+    *,
+    progress: bool = False,
+    max_states: int | None = None,
+    on_step: Progress | None = None,
 ) -> StateGraph:
     """The assembly state graph: every feasible partial assembly and operation.
 
@@ -347,6 +366,8 @@ def state_graph(
         Show progress on stderr.
     max_states : int, optional
         State limit (default: the spec's ``max_states``, else 20,000,000).
+    on_step : callable, optional
+        Called with a line for each round of automatic subassemblies.
 
     Returns
     -------
@@ -356,7 +377,9 @@ def state_graph(
     from asp.units import build_with_units
 
     spec = reduce_interchangeable(assembly.spec, assembly.relations)
-    return build_with_units(spec, assembly.relations, progress=progress, max_states=max_states)
+    return build_with_units(
+        spec, assembly.relations, on_unit=on_step, progress=progress, max_states=max_states
+    )
 
 
 def game(graph: StateGraph, *, cost: str | None = None) -> GameDAG:
@@ -507,7 +530,7 @@ def plan(
     assembly = source if isinstance(source, Assembly) else load(source, progress=True, on_step=say)
     summary = relations_summary(assembly.relations) if assembly.relations is not None else []
     say("[2/5] building the assembly state graph ...")
-    graph = state_graph(assembly, max_states=max_states)
+    graph = state_graph(assembly, max_states=max_states, on_step=on_step)
     if graph.spec is not assembly.spec:  # subassemblies found: their insertions are operations
         assembly = Assembly(graph.spec, assembly.relations)
     sequences = graph.count_sequences()

@@ -207,9 +207,22 @@ def _moves_kernel(
 
 
 def policy_document(
-    dag: GameDAG, solution: Solution, describe: StateDescriber | None, table: PolicyTable
+    dag: GameDAG,
+    solution: Solution,
+    describe: StateDescriber | None,
+    table: PolicyTable,
+    *,
+    game=None,
 ) -> dict:
-    """The ``policy`` object of the plan file (columnar, see the module docstring)."""
+    """The ``policy`` object of the plan file (columnar, see the module docstring).
+
+    ``game``: the :class:`asp.concurrent.ConcurrentGame` whose DAG ``dag`` is (turn model
+    ``concurrent``); its states and moves are named by :mod:`asp.concurrent`
+    (``state_description``, ``commit_description``, ``move_starts``) and ``describe`` is
+    not used.
+    """
+    if game is not None:
+        return _concurrent_policy(game, solution, table)
     op_names = _operation_names(dag, describe)
     op_index = {op: k for k, op in enumerate(op_names)}
     agent_names = sorted(set(dag.agents or ()))
@@ -224,13 +237,53 @@ def policy_document(
         move_op[moves] = edge_op[table.edge[moves]]
         move_agent[moves] = edge_agent[table.edge[moves]]
     move_cost[moves] = rules.move_costs(dag)[table.edge[moves]]
+    states = _state_columns(table, describe or _anonymous, op_index, agent_index)
 
+    robots: list[list] = []
+    instruction: list = []
+    for i, t in enumerate(table.turn.tolist()):
+        lo = int(table.ptr[i])
+        if t == ROBOT and table.ptr[i + 1] > lo and move_op[lo] >= 0:
+            robots.append([[int(move_op[lo]), int(move_agent[lo])]])
+        else:
+            robots.append([])
+        j = int(table.instruction[i])
+        instruction.append(None if j < 0 else [int(move_op[j]), int(move_agent[j])])
+    states.update(robots=robots, instruction=instruction)
+    return {
+        **_policy_head(dag, table, op_names, agent_names, states.pop("_tools")),
+        "states": {"node": [plain(dag.node_ids[v]) for v in table.node.tolist()], **states},
+        "moves": {
+            "ptr": table.ptr.tolist(),
+            "operation": move_op.tolist(),
+            "agent": move_agent.tolist(),
+            "cost": _numbers(move_cost),
+            "next": table.next.tolist(),
+        },
+    }
+
+
+def _policy_head(dag, table, op_names, agent_names, tools, turn_model=None) -> dict:
+    return {
+        "turn_model": turn_model or dag.turn_model,
+        "cost": dag.cost_model,
+        "operations": op_names,
+        "agents": agent_names,
+        "tools": tools,
+        "start": 0,
+        "n_states": int(table.node.size),
+        "n_moves": int(table.edge.size),
+    }
+
+
+def _state_columns(table: PolicyTable, describe, op_index: dict, agent_index: dict) -> dict:
+    """``turn``, ``done``, ``tools``, ``running``, ``bound`` (and ``_tools``: tool -> values)."""
     tools: dict[str, list[str]] = {}
     done_col, tools_col, running_col = [], [], []
     cache: dict[int, tuple] = {}
     for v in table.node.tolist():
         if v not in cache:
-            state = describe(v) if describe is not None else _anonymous(v)
+            state = describe(v)
             mask = 0
             for op in state["done"]:
                 mask |= 1 << op_index[op]
@@ -246,45 +299,84 @@ def policy_document(
         done_col.append(mask_hex)
         tools_col.append(values)
         running_col.append(running)
+    return {
+        "turn": np.array(TURN_NAMES, dtype=object)[table.turn].tolist(),
+        "done": done_col,
+        "tools": tools_col,
+        "running": running_col,
+        "bound": _numbers(table.bound),
+        "_tools": tools,
+    }
 
-    turn_names = np.array(TURN_NAMES, dtype=object)[table.turn].tolist()
-    robots: list[list] = []
-    instruction: list = []
-    for i, t in enumerate(table.turn.tolist()):
-        lo = int(table.ptr[i])
-        if t == ROBOT and table.ptr[i + 1] > lo and move_op[lo] >= 0:
-            robots.append([[int(move_op[lo]), int(move_agent[lo])]])
+
+def _concurrent_policy(game, solution: Solution, table: PolicyTable) -> dict:
+    """The policy of the concurrent game (turn model ``concurrent``, module docstring).
+
+    A robot state's one move is the robot side's commitment (``robots``: the operations the
+    robots start; ``instruction``: what each free person is told); a human state's moves are
+    every reply of the human side (``moves.starts``: the operations the people start, with
+    the durations they take; ``moves.deviations``), each followed by the wait for the next
+    completion (``moves.cost``, the time until it).
+    """
+    from asp.concurrent import commit_description, move_starts, state_description
+
+    dag = game.dag
+    op_names = list(game.model.spec.op_ids)
+    op_index = {op: k for k, op in enumerate(op_names)}
+    agent_names = [w.name for w in game.model.workers]
+    agent_index = {a: k for k, a in enumerate(agent_names)}
+    described: dict[int, dict] = {}
+
+    def describe(v: int) -> dict:
+        if v not in described:
+            described[v] = state_description(game, v)
+        return described[v]
+
+    states = _state_columns(table, describe, op_index, agent_index)
+    edges = table.edge.tolist()
+    starts_col, deviations = [], []
+    for e in edges:
+        if e < 0:
+            starts_col.append([])
+            deviations.append(0)
+            continue
+        starts, dev = move_starts(game, e)
+        starts_col.append([[op_index[o], agent_index[a], _number(d)] for o, a, d in starts])
+        deviations.append(dev)
+
+    def told(instruct: dict) -> list | None:
+        if not instruct:
+            return None
+        return [[-1 if o == "wait" else op_index[o], agent_index[h]] for h, o in instruct.items()]
+
+    robots, instruction, budget = [], [], []
+    for i, (v, t) in enumerate(zip(table.node.tolist(), table.turn.tolist(), strict=True)):
+        lo, hi = int(table.ptr[i]), int(table.ptr[i + 1])
+        state = describe(v)
+        budget.append(state.get("budget"))
+        if t == ROBOT and hi > lo and edges[lo] >= 0:
+            robots.append([s[:2] for s in starts_col[lo]])
+            instruction.append(told(commit_description(game, edges[lo])["instruct"]))
         else:
             robots.append([])
-        j = int(table.instruction[i])
-        instruction.append(None if j < 0 else [int(move_op[j]), int(move_agent[j])])
+            instruction.append(told(state.get("instructions", {})))
+    states.update(robots=robots, instruction=instruction, budget=budget)
     return {
-        "turn_model": dag.turn_model,
-        "cost": dag.cost_model,
-        "operations": op_names,
-        "agents": agent_names,
-        "tools": tools,
-        "start": 0,
-        "n_states": int(table.node.size),
-        "n_moves": int(table.edge.size),
-        "states": {
-            "node": [plain(dag.node_ids[v]) for v in table.node.tolist()],
-            "turn": turn_names,
-            "done": done_col,
-            "tools": tools_col,
-            "running": running_col,
-            "bound": _numbers(table.bound),
-            "robots": robots,
-            "instruction": instruction,
-        },
+        **_policy_head(dag, table, op_names, agent_names, states.pop("_tools"), "concurrent"),
+        "states": {"node": table.node.tolist(), **states},
         "moves": {
             "ptr": table.ptr.tolist(),
-            "operation": move_op.tolist(),
-            "agent": move_agent.tolist(),
-            "cost": _numbers(move_cost),
+            "starts": starts_col,
+            "deviations": deviations,
+            "cost": _numbers(rules.move_costs(dag)[np.maximum(table.edge, 0)] * (table.edge >= 0)),
             "next": table.next.tolist(),
         },
     }
+
+
+def _number(x: float):
+    x = float(x)
+    return int(x) if x == round(x) else round(x, 6)
 
 
 def _operation_names(dag: GameDAG, describe: StateDescriber | None) -> list[str]:
@@ -309,16 +401,40 @@ def _numbers(arr: np.ndarray) -> list:
 # --------------------------------------------------------------------------- lines
 
 
+def move_starts(policy: dict, j: int) -> list[list]:
+    """The operations move ``j`` starts: ``[operation index, agent index, duration]`` each.
+
+    Turn model ``alternate``: the move's one operation (none for a pass); ``concurrent``:
+    ``policy.moves.starts[j]``.
+    """
+    moves = policy["moves"]
+    if "starts" in moves:
+        return moves["starts"][j]
+    if moves["operation"][j] < 0:
+        return []
+    return [[moves["operation"][j], moves["agent"][j], moves["cost"][j]]]
+
+
 def line_steps(policy: dict, follow: str, operations: dict[str, dict]) -> list[dict]:
     """A line through the policy from the start, as readable steps.
 
-    ``follow="plan"``: the person follows the instruction (the principal line);
-    ``follow="worst"``: the person takes a move that keeps the bound highest (the worst line).
+    ``follow="plan"``: the person follows the instruction (the principal line; in the
+    concurrent game, of the durations its range allows, the worst); ``follow="worst"``: the
+    person takes a move that keeps the bound highest (the worst line). A step of the
+    concurrent game starts several operations at once: ``operation`` and ``agent`` join
+    them with commas and ``starts`` lists them.
     """
     states, moves = policy["states"], policy["moves"]
     op_names, agent_names = policy["operations"], policy["agents"]
     steps: list[dict] = []
     i, total = policy["start"], 0.0
+
+    def worst(candidates) -> int:
+        return max(
+            candidates,
+            key=lambda m: (moves["cost"][m] + states["bound"][moves["next"][m]], -m),
+        )
+
     while True:
         lo, hi = moves["ptr"][i], moves["ptr"][i + 1]
         if lo == hi:
@@ -326,33 +442,35 @@ def line_steps(policy: dict, follow: str, operations: dict[str, dict]) -> list[d
         turn = states["turn"][i]
         if turn == "robot" or hi - lo == 1:
             j = lo
-        elif follow == "plan":
-            j = _instruction_move(policy, i)
+        elif follow != "plan":
+            j = worst(range(lo, hi))
+        elif "deviations" in moves:
+            j = worst([m for m in range(lo, hi) if moves["deviations"][m] == 0] or range(lo, hi))
         else:
-            j = max(
-                range(lo, hi),
-                key=lambda m: (moves["cost"][m] + states["bound"][moves["next"][m]], -m),
-            )
-        op = op_names[moves["operation"][j]] if moves["operation"][j] >= 0 else ""
-        agent = agent_names[moves["agent"][j]] if moves["agent"][j] >= 0 else ""
+            j = _instruction_move(policy, i)
+        started = [(op_names[o], agent_names[a], d) for o, a, d in move_starts(policy, j)]
         options = []
         if turn == "human":
-            options = [
-                f"{op_names[moves['operation'][m]]} {agent_names[moves['agent'][m]]}"
-                for m in range(lo, hi)
-                if moves["operation"][m] >= 0
-            ]
+            options = list(
+                dict.fromkeys(
+                    " ".join((op_names[o], agent_names[a]))
+                    for m in range(lo, hi)
+                    for o, a, _ in move_starts(policy, m)
+                )
+            )
         cost = moves["cost"][j]
         total += cost
-        info = operations.get(op, {})
+        infos = [operations.get(op, {}) for op, _, _ in started]
+        idle = "pass" if "starts" not in moves else "wait"
         steps.append(
             {
                 "step": len(steps) + 1,
                 "player": turn,
-                "operation": op,
-                "agent": agent,
-                "description": info.get("description", "") if op else "pass",
-                "parts": list(info.get("parts", [])) if op else [],
+                "operation": ",".join(op for op, _, _ in started),
+                "agent": ",".join(a for _, a, _ in started),
+                "description": "; ".join(x.get("description", "") for x in infos) or idle,
+                "parts": [p for x in infos for p in x.get("parts", [])],
+                "starts": [{"operation": op, "agent": a, "duration": d} for op, a, d in started],
                 "cost": cost,
                 "elapsed": total,
                 "bound": states["bound"][moves["next"][j]],
@@ -385,14 +503,17 @@ def plan_document(
     solution: Solution,
     describe: StateDescriber | None = None,
     extra: dict | None = None,
+    game=None,
 ) -> dict:
     """The whole plan file: policy, lines, metrics, operations and parts, plus ``extra``.
 
     ``extra`` holds the keys computed elsewhere (relations, state graph sizes, ``schedule``);
-    they are kept as given.
+    they are kept as given. ``game``: the :class:`asp.concurrent.ConcurrentGame` whose DAG
+    ``dag`` is (turn model ``concurrent``; ``solution`` its exact solution, the policy that
+    of its start, the largest budget).
     """
     table = policy_table(dag, solution)
-    policy = policy_document(dag, solution, describe, table)
+    policy = policy_document(dag, solution, describe, table, game=game)
     operations = {
         op.id: {
             "description": op.description,
@@ -408,7 +529,7 @@ def plan_document(
         "format": FORMAT,
         "assembly": spec.name,
         "source": spec.source,
-        "turn_model": dag.turn_model,
+        "turn_model": policy["turn_model"],
         "cost": dag.cost_model,
         "game_nodes": dag.n_nodes,
         "game_edges": dag.n_edges,
@@ -485,8 +606,10 @@ def check_plan(doc: dict, where: str = "plan") -> None:
             raise FormatError(f"{where}: policy.states.{key}: expected {n} entries")
     if len(policy["moves"]["ptr"]) != n + 1:
         raise FormatError(f"{where}: policy.moves.ptr: expected {n + 1} entries")
-    for key in ("operation", "agent", "cost", "next"):
-        if len(policy["moves"][key]) != m:
+    concurrent = policy.get("turn_model") == "concurrent"
+    keys = ("starts", "deviations") if concurrent else ("operation", "agent")
+    for key in (*keys, "cost", "next"):
+        if len(policy["moves"].get(key, ())) != m:
             raise FormatError(f"{where}: policy.moves.{key}: expected {m} entries")
 
 

@@ -1046,6 +1046,36 @@ def commit_description(game: ConcurrentGame, e: int) -> dict:
     return out
 
 
+def move_starts(game: ConcurrentGame, e: int) -> tuple[list[tuple[str, str, float]], int]:
+    """The operations edge ``e`` starts and the deviations it costs.
+
+    Returns
+    -------
+    starts : list of (op id, worker name, duration)
+        A robot edge: the robots' operations (their durations with any tool change); a human
+        edge: the humans' operations with the durations the human side picked.
+    deviations : int
+        Deviations from the instructions (0 for a robot edge).
+    """
+    model = game.model
+    ids = model.spec.op_ids
+    action = game.actions[e]
+    if isinstance(action, Commit):
+        running = game.nodes[int(game.dag.targets[e])][2]
+        starts = [
+            (ids[o], model.workers[w].name, model.time(running[w][1]))
+            for w, o in enumerate(action.ops)
+            if o is not None and o != WAIT and model.workers[w].side == ROBOT
+        ]
+        return starts, 0
+    starts = [
+        (ids[o], model.workers[w].name, model.time(action.durations[w]))
+        for w, o in enumerate(action.ops)
+        if o is not None and o != WAIT
+    ]
+    return starts, int(action.deviations)
+
+
 @dataclass(frozen=True)
 class Bar:
     """One operation on the time axis: who did it, when, and whether it was a deviation."""

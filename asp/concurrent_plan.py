@@ -12,35 +12,27 @@
 
 :func:`robustness_table` and :func:`plan_entries` turn it into text and ``plan.json``
 keys; :func:`asmplan.report.gantt.write_figures` draws the PNGs ``robustness.png``,
-``gantt_cooperative.png`` and ``gantt_worst.png``. :func:`policy_table` is the robust policy
-state by state.
+``gantt_cooperative.png`` and ``gantt_worst.png``.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numpy as np
-
 from asp.concurrent import (
     DEFAULT_MAX_K,
     DEFAULT_MAX_NODES,
-    ROBOT,
     Bar,
-    ConcurrentGame,
     Robustness,
     assembly_makespan,
     certified_worst_case,
-    commit_description,
     concurrent_model,
     policy_array,
     robustness,
     schedule_rule,
-    state_description,
     timeline,
 )
 from asp.numbers import json_number
-from asp.solve import Solution
 
 
 @dataclass(frozen=True, eq=False)
@@ -176,17 +168,16 @@ def timeline_text(bars: list[Bar], makespan: float) -> str:
     return "\n".join(lines)
 
 
-def plan_entries(plan: ConcurrentPlan, *, policy_limit: int = 20_000) -> dict:
+def plan_entries(plan: ConcurrentPlan) -> dict:
     """The ``plan.json`` keys of the concurrent plan.
 
     ``turn_model``, ``schedule`` (the CP-SAT result, ``objective`` and ``status``),
     ``robustness`` (``[{"k": 0, "bound": ...}, ..., {"k": None, ...}]``) and ``concurrent``:
-    the CP-SAT schedule's certified worst case, the two timelines, the game's size and the
-    robust policy (:func:`policy_table`, when at most ``policy_limit`` states).
+    the CP-SAT schedule's certified worst case, the two timelines and the game's size. The
+    robust policy itself is the plan file's ``policy`` (:mod:`asmplan.planfile`).
     """
     curve = plan.curve
     game = curve.game
-    table = policy_table(game, curve.solution, limit=policy_limit)
     return {
         "turn_model": "concurrent",
         "schedule": {**plan.schedule.to_dict(), "lower_bound": plan.lower_bound},
@@ -203,7 +194,6 @@ def plan_entries(plan: ConcurrentPlan, *, policy_limit: int = 20_000) -> dict:
             "game_edges": game.dag.n_edges,
             "unbounded_game_nodes": curve.adversary.dag.n_nodes,
             "seconds": round(curve.seconds, 3),
-            "policy": table,
         },
     }
 
@@ -226,48 +216,3 @@ def _line(bars: list[Bar], makespan: float) -> dict:
             for b in bars
         ],
     }
-
-
-def policy_table(game: ConcurrentGame, solution: Solution, *, limit: int = 20_000):
-    """The robust policy at every robot state it can reach against any person.
-
-    Returns
-    -------
-    list of dict or None
-        ``{"node", "state", "bound", "robots"}`` per robot node, ``state`` as
-        :func:`asp.concurrent.state_description`, ``robots`` as
-        :func:`asp.concurrent.commit_description`, ``bound`` the guaranteed makespan from
-        there; None when more than ``limit`` states.
-    """
-    dag = game.dag
-    policy = solution.robot_policy
-    start = game.starts[game.budgets[-1]]
-    seen = np.zeros(dag.n_nodes, dtype=bool)
-    seen[start] = True
-    stack, out = [start], []
-    while stack:
-        v = stack.pop()
-        if v == dag.end:
-            continue
-        kind = game.nodes[v][0]
-        if kind == "R":
-            e = int(policy[v])
-            out.append(
-                {
-                    "node": v,
-                    "state": state_description(game, v),
-                    "bound": _plain(solution.value[v, ROBOT]),
-                    "robots": commit_description(game, e),
-                }
-            )
-            if len(out) > limit:
-                return None
-            nexts = [int(dag.targets[e])]
-        else:
-            nexts = [int(dag.targets[e]) for e in dag.out_edges(v)]
-        for w in nexts:
-            if not seen[w]:
-                seen[w] = True
-                stack.append(w)
-    out.sort(key=lambda r: r["node"])
-    return out

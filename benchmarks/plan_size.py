@@ -1,7 +1,9 @@
-"""Plan file size and write/read times for Scholl's precedence graphs (the largest plans).
+"""Plan file size and write/read times for the largest plans, both turn models.
 
-Usage: python benchmarks/plan_size.py [NAME.IN2 ...]   (default: SAWYER30 and KILBRID)
-Prints, per graph: game nodes, policy states and moves, build / write / read seconds, MB.
+Usage: python benchmarks/plan_size.py [--concurrent] [NAME.IN2 | ASSEMBLY ...]
+(default: SAWYER30 and KILBRID; with ``--concurrent``: the pump with the person's ranges,
+MITCHELL and SAWYER30 in the concurrent game, budgets 0..2).
+Prints, per plan: game nodes, policy states and moves, solve / plan / write / read seconds, MB.
 Data: Scholl (1993), read from ../shared/data/salbp (never copied into the repository).
 """
 
@@ -15,21 +17,56 @@ from pathlib import Path
 from asmplan.planfile import alternate_states, plan_document, read_plan, write_plan
 from asp.game import game_dag
 from asp.solve import solve
-from asp.spec import load_spec
 from asp.state_graph import build_state_graph
 
-DATA = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "salbp"
+REPO = Path(__file__).resolve().parents[1]
+DATA = REPO.parent / "shared" / "data" / "salbp"
 
 
-def main(names: list[str]) -> None:
-    for name in names or ["SAWYER30.IN2", "KILBRID.IN2"]:
-        spec = load_spec(DATA / name)
+def _spec(name: str):
+    from asp.generate import load_any
+
+    path = Path(name)
+    if not path.exists():
+        path = DATA / name if name.endswith(".IN2") else REPO / "examples" / name
+    return load_any(path)
+
+
+def _alternate(spec):
+    graph = build_state_graph(spec)
+    dag = game_dag(graph, labels=False)
+    sol = solve(dag)
+    return dag, lambda: plan_document(
+        spec=spec, dag=dag, solution=sol, describe=alternate_states(graph, dag)
+    )
+
+
+def _concurrent(spec):
+    from asp.concurrent import concurrent_model, robustness
+
+    graph = build_state_graph(spec)
+    curve = robustness(concurrent_model(spec, graph), max_k=2)
+    game = curve.game
+    return game.dag, lambda: plan_document(
+        spec=spec, dag=game.dag, solution=curve.solution, game=game
+    )
+
+
+def main(args: list[str]) -> None:
+    concurrent = "--concurrent" in args
+    names = [a for a in args if a != "--concurrent"]
+    if not names:
+        names = (
+            ["vacuum_pump_ranges", "MITCHELL.IN2", "SAWYER30.IN2"]
+            if concurrent
+            else ["SAWYER30.IN2", "KILBRID.IN2"]
+        )
+    for name in names:
+        spec = _spec(name)
         t0 = time.perf_counter()
-        graph = build_state_graph(spec)
-        dag = game_dag(graph, labels=False)
-        sol = solve(dag)
+        dag, document = (_concurrent if concurrent else _alternate)(spec)
         t1 = time.perf_counter()
-        doc = plan_document(spec=spec, dag=dag, solution=sol, describe=alternate_states(graph, dag))
+        doc = document()
         t2 = time.perf_counter()
         with tempfile.TemporaryDirectory() as tmp:
             path = write_plan(Path(tmp) / "plan.json", doc)
@@ -39,9 +76,10 @@ def main(names: list[str]) -> None:
             t4 = time.perf_counter()
         pol = doc["policy"]
         print(
-            f"{name}: {dag.n_nodes:,} game nodes, policy {pol['n_states']:,} states, "
-            f"{pol['n_moves']:,} moves; solve {t1 - t0:.2f} s, plan {t2 - t1:.2f} s, "
-            f"write {t3 - t2:.2f} s, read {t4 - t3:.2f} s, {size / 1e6:.1f} MB",
+            f"{name} ({pol['turn_model']}): {dag.n_nodes:,} game nodes, policy "
+            f"{pol['n_states']:,} states, {pol['n_moves']:,} moves; solve {t1 - t0:.2f} s, "
+            f"plan {t2 - t1:.2f} s, write {t3 - t2:.2f} s, read {t4 - t3:.2f} s, "
+            f"{size / 1e6:.2f} MB",
             flush=True,
         )
 

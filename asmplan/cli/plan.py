@@ -45,15 +45,18 @@ def plan_summary(result) -> list[str]:
         lines.append(robustness_table(plan))
         lines.append(f"robust plan (k = {plan.curve.k}), the person following it:")
         lines.append(timeline_text(*plan.cooperative))
-        lines.append(f"robust plan (k = {plan.curve.k}) against the worst person:")
+        lines.append(f"worst line: the robust plan (k = {plan.curve.k}) against the worst person:")
         lines.append(timeline_text(*plan.worst))
         return lines
     unit = cost_unit(dag.cost_model)
+    doc = result.to_dict()
     lines += [
         f"game DAG ({dag.cost_model}): {dag.n_nodes} nodes, {dag.n_edges} edges",
         f"TCT (cooperative) {solution.tct:g}{unit}, W* (robust) {solution.minimax:g}{unit}",
-        "robust plan (robust robot vs a delaying human):",
-        plan_text(list(result.steps)),
+        f"robust plan (the person following it; {doc['metrics']['w0']:g}{unit}):",
+        plan_text(doc["robust_plan"]),
+        f"worst line (the robust plan against a delaying person; {solution.minimax:g}{unit}):",
+        plan_text(doc["worst_line"]),
     ]
     sched = result.schedule
     if sched.result.objective is None:

@@ -169,6 +169,8 @@ def report_html(plan: dict, figures: dict[str, bytes] | None = None) -> str:
     unit = "" if plan.get("cost") == "steps" else " s"
     m = plan.get("metrics", {})
     sched = plan.get("schedule") or {}
+    # The plan's game: the policy, lines and metrics are those of its turn model.
+    game = "concurrent game" if plan.get("turn_model") == "concurrent" else "alternating game"
     rows = [
         ("assembly", plan.get("assembly", "")),
         ("turn model / cost", f"{plan.get('turn_model', '')} / {plan.get('cost', '')}"),
@@ -178,9 +180,9 @@ def report_html(plan: dict, figures: dict[str, bytes] | None = None) -> str:
         ),
         ("feasible sequences", plan.get("sequences", "-")),
         ("game nodes / edges", f"{plan.get('game_nodes', '-')} / {plan.get('game_edges', '-')}"),
-        ("TCT (alternating game, cooperative minimum)", f"{plan.get('tct', 0):g}{unit}"),
-        ("W* (alternating game, against any human)", f"{plan.get('minimax', 0):g}{unit}"),
-        ("the person follows the plan (alternating game)", f"{m.get('w0', 0):g}{unit}"),
+        (f"TCT ({game}, cooperative minimum)", f"{plan.get('tct', 0):g}{unit}"),
+        (f"W* ({game}, against any human)", f"{plan.get('minimax', 0):g}{unit}"),
+        (f"the person follows the plan ({game})", f"{m.get('w0', 0):g}{unit}"),
         ("adversarial tax W*/TCT", f"{m.get('adversarial_tax', 1):.2f}"),
         ("policy states / moves", f"{m.get('policy_states', '-')} / {m.get('policy_moves', '-')}"),
     ]

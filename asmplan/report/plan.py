@@ -6,17 +6,23 @@ from asp.numbers import cost_text
 from asp.plan import PlanStep
 
 
-def plan_text(steps: list[PlanStep]) -> str:
-    """The step list as aligned text lines."""
+def plan_text(steps: list) -> str:
+    """The step list as aligned text lines (:class:`~asp.plan.PlanStep` or the plan file's
+    step dicts, ``robust_plan`` / ``worst_line``)."""
     lines = []
     for s in steps:
-        if not s.operation:
-            what = "passes (nothing it may do)"
+        s = s.to_dict() if isinstance(s, PlanStep) else s
+        if not s["operation"]:
+            what = "passes (nothing it may do)" if s["description"] == "pass" else "waits"
+            if s["cost"]:
+                what += f"  [{cost_text(s['cost'])}]"
         else:
-            what = f"{s.operation:5s} {s.agent:3s} {s.description}  [{cost_text(s.cost)}]"
-        line = f"{s.step:3d}. {s.player:5s} {what}"
-        others = [o for o in s.human_options if not o.startswith(f"{s.operation} ")]
-        if s.player == "human" and others:
+            what = (
+                f"{s['operation']:5s} {s['agent']:3s} {s['description']}  [{cost_text(s['cost'])}]"
+            )
+        line = f"{s['step']:3d}. {s['player']:5s} {what}"
+        others = [o for o in s["human_options"] if not o.startswith(f"{s['operation']} ")]
+        if s["player"] == "human" and others:
             line += f"   (human may instead: {', '.join(others)})"
         lines.append(line)
     return "\n".join(lines)

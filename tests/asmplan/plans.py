@@ -49,3 +49,25 @@ def cell_plan(cost: str | None = None) -> dict:
     return plan_document(
         spec=spec, dag=dag, solution=solution, describe=alternate_states(graph, dag)
     )
+
+
+def concurrent_cell(data: dict | None = None, *, max_k: int = 2, step: float | None = 1.0):
+    """(spec, curve) of a job in the concurrent game (default: the small cell), budgets
+    ``0..max_k`` (:func:`asp.concurrent.robustness`)."""
+    from asp.concurrent import concurrent_model, robustness
+
+    spec = spec_from_dict(data or CELL, source="cell.yaml")
+    graph = build_state_graph(spec)
+    return spec, robustness(concurrent_model(spec, graph, step=step), max_k=max_k)
+
+
+def concurrent_plan(data: dict | None = None, *, max_k: int = 2, step: float | None = 1.0):
+    """The plan document of a job in the concurrent game (no CP-SAT schedule)."""
+    spec, curve = concurrent_cell(data, max_k=max_k, step=step)
+    return plan_document(
+        spec=spec,
+        dag=curve.game.dag,
+        solution=curve.solution,
+        game=curve.game,
+        extra={"robustness": curve.to_list()},
+    )

@@ -38,14 +38,17 @@ def test_pump_concurrent_plan(tmp_path):
     assert [r["k"] for r in rows[:-1]] == list(range(len(rows) - 1))
     bounds = [r["bound"] for r in rows]
     assert bounds == sorted(bounds)
-    policy = plan["concurrent"]["policy"]
-    assert policy[0]["state"] == {
-        "done": [],
-        "tools": {"R1.bit": "hex"},
-        "running": [],
-        "budget": plan["concurrent"]["plan_budget"],
-        "turn": "robot",
-    }
+    policy = plan["policy"]  # one policy table for both turn models
+    assert policy["turn_model"] == "concurrent" and "policy" not in plan["concurrent"]
+    states, start = policy["states"], policy["start"]
+    assert states["done"][start] == "0"
+    assert policy["tools"] == {"R1.bit": ["hex", "cross"]}
+    assert states["tools"][start] == [0]  # R1.bit = hex
+    assert states["running"][start] == []
+    assert states["budget"][start] == plan["concurrent"]["plan_budget"]
+    assert states["turn"][start] == "robot"
+    assert plan["minimax"] == 215 and plan["metrics"]["w0"] == 215
+    assert plan["robust_plan"][-1]["elapsed"] == 215
 
 
 def small_spec(**changes) -> dict:

@@ -18,7 +18,7 @@ from asmplan.planfile import (
 from asp.checker import check_line, plan_operations
 from asp.dag import HUMAN, ROBOT
 from asp.solve import evaluate_policy
-from tests.asmplan.plans import cell_game, cell_plan
+from tests.asmplan.plans import CELL, cell_game, cell_plan, concurrent_cell, concurrent_plan
 
 
 @pytest.mark.parametrize("cost", ["time", "steps"])
@@ -142,3 +142,65 @@ def test_salbp_plan(shared_data, tmp_path):
     validate_plan(doc)
     assert doc["policy"]["agents"] == ["any"]
     assert doc["robust_plan"][-1]["bound"] == 0
+
+
+# --------------------------------------------------------------------------- concurrent
+
+
+RANGES = {
+    **CELL,
+    "operations": [
+        {**op, "agents": {a: ([d, d + 2] if a == "H" else d) for a, d in op["agents"].items()}}
+        for op in CELL["operations"]
+    ],
+}
+
+
+@pytest.mark.parametrize("data", [CELL, RANGES], ids=["fixed", "ranges"])
+def test_concurrent_plan_validates_and_round_trips(tmp_path, data):
+    doc = concurrent_plan(data)
+    validate_plan(doc)
+    assert doc["turn_model"] == doc["policy"]["turn_model"] == "concurrent"
+    path = write_plan(tmp_path / "plan.json", doc)
+    assert read_plan(tmp_path) == json.loads(path.read_text())
+    broken = json.loads(path.read_text())
+    del broken["policy"]["moves"]["starts"]
+    with pytest.raises(ValueError, match="starts"):
+        validate_plan(broken)
+
+
+@pytest.mark.parametrize("data", [CELL, RANGES], ids=["fixed", "ranges"])
+def test_concurrent_policy_is_the_games_robust_policy(data):
+    spec, curve = concurrent_cell(data)
+    game, sol = curve.game, curve.solution
+    doc = concurrent_plan(data)
+    pol = doc["policy"]
+    states, moves = pol["states"], pol["moves"]
+    n = pol["n_states"]
+    assert pol["agents"] == ["R1", "R2", "H"]  # the game's workers, robots first
+    assert states["node"][pol["start"]] == game.starts[curve.k]
+    assert states["budget"][pol["start"]] == curve.k
+    assert all(0 <= j < n for j in moves["next"])
+    for i in range(n):
+        v = states["node"][i]
+        lo, hi = moves["ptr"][i], moves["ptr"][i + 1]
+        assert states["bound"][i] == pytest.approx(sol.value[v, states["turn"][i] == "human"])
+        if states["turn"][i] == "robot" and lo < hi:  # the robots' one planned commitment
+            assert hi - lo == 1
+            assert [s[:2] for s in moves["starts"][lo]] == states["robots"][i]
+            assert moves["deviations"][lo] == 0 and moves["cost"][lo] == 0
+            # every free person is told something while the budget is finite
+            running = {a for a, _, _ in states["running"][i]}
+            free = [a for a in ("H",) if a not in running]
+            told = {pol["agents"][a] for _, a in states["instruction"][i] or []}
+            assert told == set(free)
+        elif states["turn"][i] == "human":
+            assert hi - lo == len(game.dag.out_edges(v))  # every reply of the person
+            for m in range(lo, hi):  # deviations only while the budget lasts
+                assert moves["deviations"][m] <= states["budget"][i]
+    # The lines: the worst ends at the guaranteed bound; following the plan never costs more.
+    assert doc["minimax"] == pytest.approx(curve.bounds[-1])
+    assert doc["worst_line"][-1]["elapsed"] == pytest.approx(doc["minimax"])
+    assert curve.bounds[0] - 1e-9 <= doc["metrics"]["w0"] <= doc["minimax"] + 1e-9
+    ops = [s["operation"] for line in (doc["robust_plan"],) for st in line for s in st["starts"]]
+    assert sorted(ops) == sorted(doc["operations"])

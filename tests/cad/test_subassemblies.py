@@ -118,3 +118,99 @@ def test_plan_file_shows_the_hierarchy(tower):
     units = [s for s in doc["robust_plan"] if s["operation"] in doc["subassemblies"]]
     assert [s["parts"] for s in units] == [[s["operation"]] for s in units] and len(units) == 2
     check_line(result.assembly.spec, tower, plan_operations(doc))
+
+
+# --------------------------------------------------------------------------- gusseted box
+
+GUSSET_Z = (40.0, 46.0)
+
+
+def gusseted_box() -> dict:
+    """The finger-jointed box with a gusset in each upper corner, as a real laser-cut box
+    has: each gusset's two tabs sit in blind pockets of the two walls of its corner, so it
+    leaves a wall only straight away from it, through the opposite wall and the gusset
+    across; whichever gusset comes last, the other three and the walls hold it."""
+    from tests.cad.real_shapes import BOX_L, BOX_W, PANEL, finger_box
+
+    parts = finger_box()
+    t, size = PANEL, 20.0
+    z0, z1 = GUSSET_Z
+    corners = {
+        "fl": (t, t, 1, 1),
+        "fr": (BOX_L - t, t, -1, 1),
+        "bl": (t, BOX_W - t, 1, -1),
+        "br": (BOX_L - t, BOX_W - t, -1, -1),
+    }
+    walls = {"f": "front", "b": "back", "l": "left", "r": "right"}
+    pockets: dict[str, list] = {w: [] for w in walls.values()}
+
+    def span(a, b):
+        return min(a, b), max(a, b)
+
+    for name, (x, y, sx, sy) in corners.items():
+        (xa, xb), (ya, yb) = span(x, x + sx * size), span(y, y + sy * size)
+        plate = box((xa, ya, z0), (xb, yb, z1))
+        (xa, xb), (ya, yb) = span(x + sx * 6, x + sx * 14), span(y, y - sy * t / 2)
+        tab_y = box((xa, ya, z0 + 1), (xb, yb, z1 - 1))  # into the front or back wall
+        (xa, xb), (ya, yb) = span(x, x - sx * t / 2), span(y + sy * 6, y + sy * 14)
+        tab_x = box((xa, ya, z0 + 1), (xb, yb, z1 - 1))  # into the left or right wall
+        parts[f"gusset_{name}"] = union(plate, tab_y, tab_x)
+        pockets[walls[name[0]]].append(tab_y)
+        pockets[walls[name[1]]].append(tab_x)
+    for wall, cut in pockets.items():
+        parts[wall] = difference(parts[wall], *cut)
+    return parts
+
+
+@pytest.fixture(scope="module")
+def gusset_box():
+    return compute_relations(Assembly.from_meshes(gusseted_box()))
+
+
+def box_spec(rel):
+    ops = [{"id": p, "agents": {"H": 2, "R": 3}, "part": p} for p in rel.parts if p != "bottom"]
+    return spec_from_dict(
+        {
+            "parts": [{"id": p, "file": f"{p}.stl"} for p in rel.parts],
+            "agents": {"H": {"side": "human"}, "R": {"side": "robot"}},
+            "base_part": "bottom",
+            "operations": ops,
+        },
+        source="box.yaml",
+    )
+
+
+def test_the_last_gusset_is_always_held(gusset_box):
+    free = {
+        p: {d for d in range(6) if gusset_box.tt[k, :, d].sum() == len(gusset_box.parts) - 1}
+        for k, p in enumerate(gusset_box.parts)
+    }
+    assert all(not free[p] for p in free if p.startswith("gusset"))
+    with pytest.raises(ValueError, match="every order ends in a dead end"):
+        build_state_graph(box_spec(gusset_box), gusset_box)
+
+
+def test_walls_enter_with_their_gussets(gusset_box):
+    lines = []
+    graph = build_with_units(box_spec(gusset_box), gusset_box, on_unit=lines.append)
+    units = sorted(map(sorted, dict(graph.spec.subassemblies).values()))
+    # each gusset goes with one wall of its corner, and both units with parallel walls
+    assert units in (
+        [["back", "gusset_bl", "gusset_br"], ["front", "gusset_fl", "gusset_fr"]],
+        [["gusset_bl", "gusset_fl", "left"], ["gusset_br", "gusset_fr", "right"]],
+    )
+    assert lines and "subassemblies" in lines[0]
+    seqs = graph.sequences(limit=100)
+    assert seqs
+    for seq in seqs:
+        check_line(graph.spec, gusset_box, seq)
+
+
+def test_gusseted_box_plans_with_defaults(gusset_box):
+    from asmplan import pipeline
+    from asp.checker import plan_operations
+
+    result = pipeline.plan(pipeline.Assembly(box_spec(gusset_box), gusset_box), time_limit=5)
+    doc = result.to_dict()
+    assert len(doc["subassemblies"]) == 2
+    check_line(result.assembly.spec, gusset_box, plan_operations(doc))
