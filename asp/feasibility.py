@@ -731,11 +731,17 @@ def load_relations(spec: AssemblySpec, *, progress: bool = False):
     """Compute the cad relations of ``spec``'s parts (``None`` when it has no geometry).
 
     Reads the meshes of the spec's parts (``cad.loading.load_parts``, as
-    :func:`asp.generate.spec_geometry` does).
+    :func:`asp.generate.spec_geometry` does), with the spec's ``contact_tol`` and
+    ``penetration_tol`` (None: the per-part rule).
     """
     if not spec.has_geometry:
         return None
     import cad
     from cad.loading import load_parts
 
-    return cad.compute_relations(load_parts(spec.parts, spec.folder, spec.units), progress=progress)
+    return cad.compute_relations(
+        load_parts(spec.parts, spec.folder, spec.units),
+        contact_tol=spec.contact_tol,
+        penetration_tol=spec.penetration_tol,
+        progress=progress,
+    )

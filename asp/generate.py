@@ -323,17 +323,27 @@ def generated_spec(path: str | Path) -> AssemblySpec:
     return replace(spec, generated=True, source=str(path))
 
 
-def spec_text(path: str | Path, spec_folder: str | Path | None = None) -> str:
+def spec_text(
+    path: str | Path,
+    spec_folder: str | Path | None = None,
+    *,
+    contact_tol: float | None = None,
+    penetration_tol: float | None = None,
+) -> str:
     """The generated spec of a CAD file or folder as a commented ``assembly.yaml``.
 
-    Part files are relative to ``spec_folder``, where the file will be written.
+    Part files are relative to ``spec_folder``, where the file will be written. Tolerances
+    given (mm) are written as the spec's ``contact_tol`` / ``penetration_tol`` and used for
+    the ``held`` marks; else both keys are written commented out.
     """
     from dataclasses import replace
 
     import cad
 
     data, assembly = spec_data(path, spec_folder)
-    relations = cad.compute_relations(assembly)
+    relations = cad.compute_relations(
+        assembly, contact_tol=contact_tol, penetration_tol=penetration_tol
+    )
     generated = replace(spec_from_dict(data, source=str(path)), generated=True)
     spec, rebased = workable_base(generated, relations)
     if rebased:
@@ -393,6 +403,8 @@ def spec_text(path: str | Path, spec_folder: str | Path | None = None) -> str:
         "constraints: {topological: true, stability: true, functional: true}",
         "turn_model: alternate",
         "cost: time                 # or steps (1 per operation)",
+        _tolerance_line("contact_tol", contact_tol, "largest gap that counts as touching"),
+        _tolerance_line("penetration_tol", penetration_tol, "largest overlap that still touches"),
         "",
         "operations:   # one placement per part: base first, then from the lowest part up",
     ]
@@ -406,6 +418,13 @@ def spec_text(path: str | Path, spec_folder: str | Path | None = None) -> str:
             f"agents: {{{agents}}}, part: {op['part']}" + (", held: true}" if hold else "}")
         )
     return "\n".join(lines) + "\n"
+
+
+def _tolerance_line(key: str, value: float | None, meaning: str) -> str:
+    """``key: value`` with a comment, or commented out when the default rule applies."""
+    if value is None:
+        return f"# {key}: 0.1   # mm, {meaning} (default: per part, cad/tolerances.py)"
+    return f"{key}: {json_number(float(value))}   # mm, {meaning}, every pair"
 
 
 def _scalar(value) -> str:
