@@ -45,6 +45,54 @@ __all__ = [
 ]
 
 
+class CodedLabels(Sequence):
+    """Edge labels stored as an integer code per edge and a table of names.
+
+    A game DAG of an assembly has tens of millions of edges and a few dozen operation ids
+    and agents: a tuple of strings would take gigabytes. Reads like a tuple of str (index,
+    slice, iterate, ``len``, compare with a tuple).
+
+    Attributes
+    ----------
+    codes : (m,) int
+        Index into ``names`` of each edge's label.
+    names : tuple of str
+    """
+
+    __slots__ = ("codes", "names")
+
+    def __init__(self, codes, names):
+        self.codes = np.asarray(codes)
+        self.names = tuple(str(x) for x in names)
+
+    def __len__(self) -> int:
+        return int(self.codes.shape[0])
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return tuple(self.names[c] for c in self.codes[i].tolist())
+        return self.names[int(self.codes[i])]
+
+    def __iter__(self):
+        names, step = self.names, 1 << 16
+        for lo in range(0, len(self), step):
+            yield from (names[c] for c in self.codes[lo : lo + step].tolist())
+
+    def __eq__(self, other) -> bool:
+        if isinstance(other, CodedLabels | tuple | list):
+            return len(self) == len(other) and all(a == b for a, b in zip(self, other, strict=True))
+        return NotImplemented
+
+    __hash__ = None
+
+    def take(self, order: np.ndarray) -> CodedLabels:
+        """The labels of the edges ``order`` (an index array), in that order."""
+        return CodedLabels(self.codes[order], self.names)
+
+    def __repr__(self) -> str:
+        return f"CodedLabels({len(self)} edges, names={self.names!r})"
+
+
 @dataclass(frozen=True, eq=False)
 class GameDAG:
     """A validated game DAG.
@@ -63,7 +111,7 @@ class GameDAG:
         Who may take each edge: ``ROBOT``, ``HUMAN`` or ``ANY``.
     start, end : int
         Start and end node indices.
-    operations, agents : tuple of str or None, length m
+    operations, agents : tuple of str, :class:`CodedLabels` or None, length m
         Optional edge labels (operation id, agent name).
     node_labels : tuple of str or None, length n
         Optional human-readable node descriptions.
@@ -284,8 +332,7 @@ def from_arrays(
     order = np.argsort(src, kind="stable")
     if m and np.any(order != np.arange(m)):
         src, dst, costs, sides = src[order], dst[order], costs[order], sides[order]
-        operations = None if operations is None else tuple(operations[i] for i in order)
-        agents = None if agents is None else tuple(agents[i] for i in order)
+        operations, agents = (_reorder(x, order) for x in (operations, agents))
     indptr = np.zeros(n + 1, dtype=np.int64)
     np.cumsum(np.bincount(src, minlength=n), out=indptr[1:])
     if start is None:
@@ -311,6 +358,15 @@ def from_arrays(
     if validate:
         validate_dag(dag)
     return dag
+
+
+def _reorder(labels, order: np.ndarray):
+    """Edge labels (a tuple or :class:`CodedLabels`, or None) in the order ``order``."""
+    if labels is None:
+        return None
+    if isinstance(labels, CodedLabels):
+        return labels.take(order)
+    return tuple(labels[i] for i in order)
 
 
 def _unique_node(candidates: np.ndarray, node_ids: Sequence, what: str, lacking: str) -> int:

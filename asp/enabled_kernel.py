@@ -1,4 +1,8 @@
-"""The enabled-operations test compiled with numba (:meth:`asp.feasibility.OperationModel.enabled`).
+"""The state graph's inner loops compiled with numba.
+
+The enabled-operations test (:meth:`asp.feasibility.OperationModel.enabled`), stuck states,
+duplicate successor keys (:func:`asp.state_graph.build_state_graph`) and the sequence count
+(:meth:`asp.state_graph.StateGraph.count_sequences`).
 
 One pass over the states: for each state and operation, the key tests (not done, explicit
 predecessors done, tools ready) and then the geometric test of the part it places (touches
@@ -11,6 +15,22 @@ from __future__ import annotations
 
 import numba
 import numpy as np
+
+
+@numba.njit(cache=True, nogil=True)
+def _free(parts, s, blocked, p, directions):
+    """Whether part ``p`` is free from state ``s``'s parts along some allowed direction."""
+    for d in range(6):
+        if not directions[d]:
+            continue
+        clear = True
+        for w in range(parts.shape[1]):
+            if parts[s, w] & blocked[p, d, w]:
+                clear = False
+                break
+        if clear:
+            return True
+    return False
 
 
 @numba.njit(cache=True, nogil=True)
@@ -84,20 +104,7 @@ def enabled_single(
                             touch = True
                         if parts[s, w] & support[p, w]:
                             rest = True
-                    free = False
-                    if touch and rest:
-                        for d in range(6):
-                            if not directions[d]:
-                                continue
-                            clear = True
-                            for w in range(pw):
-                                if parts[s, w] & blocked[p, d, w]:
-                                    clear = False
-                                    break
-                            if clear:
-                                free = True
-                                break
-                    ok = touch and rest and free
+                    ok = touch and rest and _free(parts, s, blocked, p, directions)
             out[s, i] = ok
 
 
@@ -155,7 +162,6 @@ def stuck(keys, parts, op_word, op_bit, part_of, blocked, directions):
     Same arrays as :func:`enabled_single`.
     """
     k = keys.shape[0]
-    pw = parts.shape[1]
     n_ops = op_word.shape[0]
     zero = np.uint64(0)
     out = np.zeros(k, dtype=np.bool_)
@@ -164,19 +170,25 @@ def stuck(keys, parts, op_word, op_bit, part_of, blocked, directions):
             p = part_of[i]
             if p < 0 or (keys[s, op_word[i]] & op_bit[i]) != zero:
                 continue
-            free = False
-            for d in range(6):
-                if not directions[d]:
-                    continue
-                clear = True
-                for w in range(pw):
-                    if parts[s, w] & blocked[p, d, w]:
-                        clear = False
-                        break
-                if clear:
-                    free = True
-                    break
-            if not free:
+            if not _free(parts, s, blocked, p, directions):
                 out[s] = True
                 break
     return out
+
+
+@numba.njit(cache=True, nogil=True)
+def add_counts(src, dst, src_lo, dst_lo, counts, primes, out):
+    """``out[dst - dst_lo] += counts[src - src_lo]`` modulo each prime, edge by edge.
+
+    ``counts`` (a, P) and ``out`` (b, P) uint64 residues below ``primes`` (P,), each below
+    ``2**63``; the sum of two residues fits uint64.
+    """
+    n_primes = primes.shape[0]
+    for e in range(src.shape[0]):
+        s = src[e] - src_lo
+        d = dst[e] - dst_lo
+        for k in range(n_primes):
+            v = out[d, k] + counts[s, k]
+            if v >= primes[k]:
+                v -= primes[k]
+            out[d, k] = v

@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 
 from asp import rules
-from asp.dag import ANY, HUMAN, ROBOT, GameDAG, from_arrays
+from asp.dag import ANY, HUMAN, ROBOT, CodedLabels, GameDAG, from_arrays
 from asp.errors import GameError
 from asp.state_graph import StateGraph
 
@@ -99,8 +99,6 @@ def game_dag(
             costs += (changed @ change)[base]
     src = new_id[e_src][base]
     dst = new_id[e_dst][base]
-    op_ids = np.array(spec.op_ids, dtype=object)
-    names = np.array(agent_names, dtype=object)
     if labels is None:
         labels = n <= LABEL_LIMIT
     node_labels = None
@@ -129,8 +127,8 @@ def game_dag(
         sides,
         start=0,
         end=n - 1,
-        operations=tuple(op_ids[e_op[base]].tolist()),
-        agents=tuple(names[agent_idx].tolist()),
+        operations=CodedLabels(e_op[base], spec.op_ids),
+        agents=CodedLabels(agent_idx, agent_names),
         node_labels=node_labels,
         cost_model=cost,
         metadata=meta,

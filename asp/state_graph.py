@@ -114,6 +114,8 @@ class StateGraph:
 
     def count_sequences(self) -> int:
         """Exact number of feasible complete operation sequences (a Python int)."""
+        from asp.enabled_kernel import add_counts
+
         done = self.complete
         if not done.any():
             return 0
@@ -127,14 +129,10 @@ class StateGraph:
         for layer in range(len(ptr) - 2):
             lo, hi = bounds[layer], bounds[layer + 1]
             nxt = np.zeros((int(ptr[layer + 2] - ptr[layer + 1]), len(primes)), dtype=np.uint64)
-            if lo < hi:
-                d = self.dst[lo:hi] - ptr[layer + 1]
-                order = np.argsort(d, kind="stable")
-                d_sorted = d[order]
-                vals = counts[self.src[lo:hi][order] - ptr[layer]]
-                starts = np.flatnonzero(np.r_[True, d_sorted[1:] != d_sorted[:-1]])
-                # Each term < p < 2**bits, at most n_ops terms: the sum fits uint64.
-                nxt[d_sorted[starts]] = np.add.reduceat(vals, starts, axis=0) % mods
+            if lo < hi:  # compiled: residues added edge by edge
+                add_counts(
+                    self.src[lo:hi], self.dst[lo:hi], ptr[layer], ptr[layer + 1], counts, mods, nxt
+                )
             counts = nxt
         rows = counts[done[ptr[-2] : ptr[-1]]]  # complete states are all in the last layer
         sums = rows.astype(object).sum(axis=0)
