@@ -329,8 +329,8 @@ def from_arrays(
     sides = np.full(m, ANY, np.int8) if sides is None else np.asarray(sides, dtype=np.int8)
     if m and (min(src.min(), dst.min()) < 0 or max(src.max(), dst.max()) >= n):
         raise GraphError(f"edge endpoints: expected node indices in [0, {n}), got out of range")
-    order = np.argsort(src, kind="stable")
-    if m and np.any(order != np.arange(m)):
+    if m and np.any(src[1:] < src[:-1]):
+        order = np.argsort(src, kind="stable")
         src, dst, costs, sides = src[order], dst[order], costs[order], sides[order]
         operations, agents = (_reorder(x, order) for x in (operations, agents))
     indptr = np.zeros(n + 1, dtype=np.int64)

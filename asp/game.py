@@ -87,16 +87,14 @@ def game_dag(
         base = np.repeat(np.arange(e_op.shape[0]), reps)
         within = np.arange(base.shape[0]) - np.repeat(np.cumsum(reps) - reps, reps)
         slot = op_first[e_op[base]] + within
-    agent_idx = flat_agent[slot]
+    agent_idx = flat_agent[slot].astype(np.int16)
     sides = agent_side[agent_idx]
-    if cost == "steps":
-        costs = np.ones(slot.shape[0])
-    else:
-        costs = flat_time[slot].copy()
-        if model.tool_names:
-            change = np.array([spec.tool(t).change_time for t in model.tool_names])
-            changed = model.tool_changes(graph.keys[e_src], e_op)
-            costs += (changed @ change)[base]
+    costs = np.ones(slot.shape[0]) if cost == "steps" else flat_time[slot]
+    del slot
+    if cost != "steps" and model.tool_names:
+        change = np.array([spec.tool(t).change_time for t in model.tool_names])
+        changed = model.tool_changes(graph.keys[e_src], e_op)
+        costs += (changed @ change)[base]
     src = new_id[e_src][base]
     dst = new_id[e_dst][base]
     if labels is None:
@@ -119,6 +117,10 @@ def game_dag(
     if spec.credit:
         meta["credit"] = spec.credit
     meta.update(metadata or {})
+    if not alive[0]:
+        raise GameError(f"{spec.source}: no complete sequence: the game has no path to the end")
+    if src.size and not (np.all(src < dst) and np.all(np.isfinite(costs)) and costs.min() >= 0):
+        raise GameError(f"{spec.source}: internal: the game DAG is not in topological order")
     return from_arrays(
         list(range(n)),
         src,
@@ -127,9 +129,10 @@ def game_dag(
         sides,
         start=0,
         end=n - 1,
-        operations=CodedLabels(e_op[base], spec.op_ids),
+        operations=CodedLabels(e_op.astype(np.int16)[base], spec.op_ids),
         agents=CodedLabels(agent_idx, agent_names),
         node_labels=node_labels,
         cost_model=cost,
         metadata=meta,
+        validate=False,  # checked below: the construction makes it a DAG in topological order
     )

@@ -245,6 +245,8 @@ def build_state_graph(
                 live = keep[inv]
                 si, oi, inv = si[live], oi[live], (np.cumsum(keep) - 1)[inv[live]]
                 uniq, new_parts = uniq[keep], new_parts[keep]
+                if uniq.shape[0] == 0:  # every successor is stuck: no complete sequence
+                    break
         if total + uniq.shape[0] > max_states:
             raise _too_many(model, uniq, max_states, f"{total + uniq.shape[0]:,}", layer)
         del si_l, oi_l
