@@ -26,6 +26,7 @@ def init_command(
     from asp.atomic import write_text
     from asp.generate import spec_text
     from asp.spec import spec_from_dict
+    from asp.units import cad_units
     from cad.yamlfile import DecimalsAsText
 
     if not source.exists():
@@ -33,7 +34,7 @@ def init_command(
     check_output(output, folder=False)
     if output.exists() and not force:
         raise ValueError(f"{output} exists (use --force to overwrite it)")
-    text = spec_text(source, spec_folder=output.parent)
+    text = spec_text(source, spec_folder=output.parent, decide_units=cad_units)
     # the text must read back as a valid spec before it is written
     spec = spec_from_dict(yaml.load(text, Loader=DecimalsAsText), source=str(output))  # noqa: S506
     write_text(output, text)
