@@ -257,17 +257,23 @@ def relations(spec: AssemblySpec, *, progress: bool = False) -> Relations | None
 
 
 def load(
-    source: str | os.PathLike[str], *, progress: bool = False, on_step: Progress | None = None
+    source: str | os.PathLike[str],
+    *,
+    progress: bool = False,
+    on_step: Progress | None = None,
+    contact_tol: float | None = None,
+    penetration_tol: float | None = None,
 ) -> Assembly:
     """:func:`load_assembly` and, when the spec has meshes, its :func:`relations`.
 
     A generated spec (no ``assembly.yaml``) is announced through ``on_step``, else as a
     warning; its placements of parts nothing can keep from falling become ``held``
-    (:func:`asp.generate.hold_unsupported`), named in a second note.
+    (:func:`asp.generate.hold_unsupported`), named in a second note. ``contact_tol`` and
+    ``penetration_tol`` (mm) replace the spec's tolerances when given.
     """
     from asp.generate import HELD_REASON, hold_unsupported
 
-    spec = load_assembly(source)
+    spec = with_tolerances(load_assembly(source), contact_tol, penetration_tol)
 
     def note(text: str) -> None:
         if on_step is not None:
@@ -292,6 +298,22 @@ def load(
         if held:
             note(f"generated spec: held: true for {', '.join(held)} ({HELD_REASON})")
     return Assembly(spec=spec, relations=rel)
+
+
+def with_tolerances(
+    spec: AssemblySpec, contact_tol: float | None = None, penetration_tol: float | None = None
+) -> AssemblySpec:
+    """``spec`` with the tolerances given (mm) in place of its own; None keeps the spec's."""
+    from dataclasses import replace
+
+    from cad.tolerances import checked_tolerance
+
+    changes = {
+        key: checked_tolerance(value, key)
+        for key, value in (("contact_tol", contact_tol), ("penetration_tol", penetration_tol))
+        if value is not None
+    }
+    return replace(spec, **changes) if changes else spec
 
 
 def part_relations(
@@ -324,12 +346,26 @@ def part_relations(
     """
     import cad
 
+    spec = _spec_file(source)
+    if spec is not None:  # the spec's own tolerances unless others are given
+        contact_tol = spec.contact_tol if contact_tol is None else contact_tol
+        penetration_tol = spec.penetration_tol if penetration_tol is None else penetration_tol
     return cad.compute_relations(
         part_geometry(source, units=units),
         contact_tol=contact_tol,
         penetration_tol=penetration_tol,
         progress=progress,
     )
+
+
+def _spec_file(source: str | os.PathLike[str]) -> AssemblySpec | None:
+    """The spec of a YAML file or of a folder holding ``assembly.yaml`` (else None)."""
+    from asp.spec import SPEC_FILE, load_spec
+
+    path = Path(source)
+    if path.suffix.lower() in (".yaml", ".yml") or (path.is_dir() and (path / SPEC_FILE).is_file()):
+        return load_spec(path)
+    return None
 
 
 def part_geometry(source: str | os.PathLike[str], *, units: str | None = None):
@@ -342,13 +378,11 @@ def part_geometry(source: str | os.PathLike[str], *, units: str | None = None):
 
     import cad
     from asp.generate import spec_geometry
-    from asp.spec import SPEC_FILE, load_spec
 
-    path = Path(source)
-    if path.suffix.lower() in (".yaml", ".yml") or (path.is_dir() and (path / SPEC_FILE).is_file()):
-        spec = load_spec(path)
+    spec = _spec_file(source)
+    if spec is not None:
         return spec_geometry(spec if units is None else replace(spec, units=units))
-    return cad.load_assembly(path, units=units)
+    return cad.load_assembly(Path(source), units=units)
 
 
 def state_graph(
@@ -463,12 +497,14 @@ def schedule(
     time_limit: float = 30.0,
     workers: int = 1,
     seed: int = 0,
+    sequence: list[str] | None = None,
 ) -> Schedule:
     """CP-SAT minimum makespan with the agents working in parallel, physically feasible.
 
     Every schedule is replayed through the state graph and cut until one passes
     (:func:`asp.concurrent.assembly_makespan`); the status is ``OPTIMAL`` only for a
-    proven optimum that passed.
+    proven optimum that passed, ``FEASIBLE`` for the best passing schedule when time ran
+    out (a list schedule along a state-graph path is always there to fall back on).
 
     Parameters
     ----------
@@ -481,6 +517,9 @@ def schedule(
         CP-SAT workers (1: repeatable).
     seed : int
         CP-SAT random seed.
+    sequence : list of str, optional
+        A complete sequence of operation ids along the state graph (the robust plan's
+        line): a list schedule along it is one more starting point.
 
     Returns
     -------
@@ -489,7 +528,12 @@ def schedule(
     from asp.concurrent import assembly_makespan
 
     sched, result = assembly_makespan(
-        assembly.spec, graph, time_limit=time_limit, workers=workers, seed=seed
+        assembly.spec,
+        graph,
+        time_limit=time_limit,
+        workers=workers,
+        seed=seed,
+        sequence=sequence,
     )
     return Schedule(result, sched.lower_bound, sched.chain_bound, sched.load_bound)
 
@@ -505,6 +549,8 @@ def plan(
     duration_step: float | None = 1.0,
     on_step: Progress | None = None,
     max_states: int | None = None,
+    contact_tol: float | None = None,
+    penetration_tol: float | None = None,
 ) -> AssemblyPlan:
     """Plan an assembly end to end, as ``asmplan plan`` does.
 
@@ -530,6 +576,9 @@ def plan(
         Called with one line before each step (progress for a person).
     max_states : int, optional
         State graph limit (default: the spec's ``max_states``, else 20,000,000).
+    contact_tol, penetration_tol : float, optional
+        Tolerances in mm for every pair (default: the spec's, else the per-part rule of
+        :mod:`cad.tolerances`); ignored when ``source`` is an :class:`Assembly`.
 
     Returns
     -------
@@ -540,7 +589,17 @@ def plan(
 
     say = on_step or (lambda _message: None)
     say("[1/5] reading the assembly and computing part relations ...")
-    assembly = source if isinstance(source, Assembly) else load(source, progress=True, on_step=say)
+    assembly = (
+        source
+        if isinstance(source, Assembly)
+        else load(
+            source,
+            progress=True,
+            on_step=say,
+            contact_tol=contact_tol,
+            penetration_tol=penetration_tol,
+        )
+    )
     summary = relations_summary(assembly.relations) if assembly.relations is not None else []
     say("[2/5] building the assembly state graph ...")
     graph = state_graph(assembly, max_states=max_states, on_step=on_step)
@@ -555,7 +614,8 @@ def plan(
     solution = solve_game(the_game.dag)
     steps = robust_plan(the_game, solution)
     say("[4/5] CP-SAT minimum-makespan schedule ...")
-    sched = schedule(assembly, graph, time_limit=time_limit, seed=seed)
+    line = [step.operation for step in steps if step.operation]
+    sched = schedule(assembly, graph, time_limit=time_limit, seed=seed, sequence=line)
     turn = assembly.spec.turn_model if turn_model is None else turn_model
     concurrent = None
     from asp.spec import TURN_MODELS

@@ -14,7 +14,15 @@ import typer
 
 from asmplan.cli.app import app, choices
 from asmplan.cli.graph import say
-from asmplan.cli.options import SEED_MAX, TIME_LIMIT_MAX, CostModel, check_output, finite_or_none
+from asmplan.cli.options import (
+    SEED_MAX,
+    TIME_LIMIT_MAX,
+    CostModel,
+    check_output,
+    contact_tol_option,
+    finite_or_none,
+    penetration_tol_option,
+)
 from asp.spec import TURN_MODELS
 
 TurnModel = choices("TurnModel", TURN_MODELS, "Turn model of the game.")
@@ -60,11 +68,16 @@ def plan_summary(result) -> list[str]:
         plan_text(doc["worst_line"]),
     ]
     sched = result.schedule
+    note = sched.result.detail.get("status_note", "")
     if sched.result.objective is None:
-        why = sched.result.detail.get("replay", "no schedule found within the time limit")
-        found = f"none: {why} ({sched.result.status}; --time-limit raises it)"
+        found = f"none ({sched.result.status}: {note}; --time-limit raises it)"
+    elif sched.result.status == "OPTIMAL":
+        found = f"{sched.result.objective:g} s ({sched.result.status}: {note})"
     else:
-        found = f"{sched.result.objective:g} s ({sched.result.status})"
+        found = (
+            f"{sched.result.objective:g} s ({sched.result.status}: {note}; --time-limit gives "
+            "CP-SAT more time)"
+        )
     lines.append(
         f"CP-SAT makespan (agents in parallel): {found}; "
         f"state-graph lower bound {sched.lower_bound:g} s"
@@ -121,6 +134,8 @@ def plan_command(
     max_states: int | None = typer.Option(
         None, "--max-states", min=1, help="State graph limit (default: spec's, else 20,000,000)."
     ),
+    contact_tol: float | None = contact_tol_option(),
+    penetration_tol: float | None = penetration_tol_option(),
 ) -> None:
     """Plan an assembly end to end: relations, state graph, game, robust plan, CP-SAT."""
     from asmplan import pipeline
@@ -137,6 +152,8 @@ def plan_command(
         duration_step=duration_step or None,
         on_step=say,
         max_states=max_states,
+        contact_tol=contact_tol,
+        penetration_tol=penetration_tol,
     )
     for line in plan_summary(result):
         typer.echo(line)
