@@ -146,6 +146,9 @@ class AssemblyPlan:
     concurrent : asp.concurrent_plan.ConcurrentPlan or None
         With the turn model ``concurrent``: the curve ``W*(k)``, the CP-SAT schedule's
         certified worst case, the timelines.
+    units : list of dict
+        Every unit used and every sub-assembly of the CAD file, used or why not
+        (:func:`asp.units.units_report`; ``plan.json``'s ``units``).
     """
 
     assembly: Assembly
@@ -157,6 +160,7 @@ class AssemblyPlan:
     relations_summary: list[dict]
     schedule: Schedule
     concurrent: ConcurrentPlan | None = None
+    units: list[dict] = field(default_factory=list)
 
     @property
     def dag(self) -> GameDAG:
@@ -177,6 +181,7 @@ class AssemblyPlan:
             "transitions": self.graph.n_transitions,
             "sequences": self.sequences,
             "schedule": self.schedule.to_dict(),
+            "units": self.units,
         }
         if self.concurrent is None:
             return plan_document(
@@ -393,13 +398,15 @@ def state_graph(
 ) -> StateGraph:
     """The assembly state graph: every feasible partial assembly and operation.
 
-    The spec is first reduced (:func:`asp.symmetry.reduced_state_graph`: the precedences
-    every complete sequence keeps, interchangeable parts in a fixed order or, for blocks of
-    parts that cannot be, only the first of equal blocks moving; same TCT and W*, far fewer
-    states). When that has no complete sequence, a part can never be inserted
-    alone: subassemblies are added automatically to the spec as given, its exactly alike parts
-    in a fixed order (:func:`asp.units.build_with_units`). The graph's ``spec`` holds what
-    was used.
+    A spec generated from a CAD file builds the file's sub-assemblies that can be built
+    and inserted as units (:func:`asp.units.cad_units`). Without such units the spec is first
+    reduced (:func:`asp.symmetry.reduced_state_graph`: the precedences every complete
+    sequence keeps, interchangeable parts in a fixed order or, for blocks of parts that
+    cannot be, only the first of equal blocks moving; same TCT and W*, far fewer states).
+    With units, or when that has no complete sequence, exactly alike parts are placed in a
+    fixed order (:func:`asp.symmetry.reduce_exact`) and, when a part can never be inserted
+    alone, subassemblies are added automatically
+    (:func:`asp.units.build_with_units`); the graph's ``spec`` holds all of it.
 
     Parameters
     ----------
@@ -417,18 +424,25 @@ def state_graph(
     """
     from asp.errors import SpecError
     from asp.symmetry import reduce_exact, reduced_state_graph
-    from asp.units import build_with_units
+    from asp.units import build_with_units, cad_units
 
     spec, rel = assembly.spec, assembly.relations
-    try:
-        graph = reduced_state_graph(spec, rel, progress=progress, max_states=max_states)
-        if graph is not None:
-            return graph
-    except SpecError as exc:
-        if "infeasible assembly" not in str(exc):
-            raise
+    if not (spec.generated and any(u.used for u in cad_units(spec, rel))):
+        try:
+            graph = reduced_state_graph(spec, rel, progress=progress, max_states=max_states)
+            if graph is not None:
+                return graph
+        except SpecError as exc:
+            if "infeasible assembly" not in str(exc):
+                raise
     return build_with_units(
-        reduce_exact(spec, rel), rel, on_unit=on_step, progress=progress, max_states=max_states
+        spec,
+        rel,
+        hierarchy=spec.generated,
+        prepare=lambda with_units: reduce_exact(with_units, rel),
+        on_unit=on_step,
+        progress=progress,
+        max_states=max_states,
     )
 
 
@@ -606,6 +620,9 @@ def plan(
     summary = relations_summary(assembly.relations) if assembly.relations is not None else []
     say("[2/5] building the assembly state graph ...")
     graph = state_graph(assembly, max_states=max_states, on_step=on_step)
+    from asp.units import units_report
+
+    units = units_report(assembly.spec, assembly.relations, graph.spec.subassemblies)
     if graph.spec is not assembly.spec:  # subassemblies found: their insertions are operations
         assembly = Assembly(graph.spec, assembly.relations)
     sequences = graph.count_sequences()
@@ -637,7 +654,7 @@ def plan(
             schedule=(sched.result, sched.lower_bound),
         )
     return AssemblyPlan(
-        assembly, graph, sequences, the_game, solution, steps, summary, sched, concurrent
+        assembly, graph, sequences, the_game, solution, steps, summary, sched, concurrent, units
     )
 
 
