@@ -646,11 +646,17 @@ def operation_model(spec: AssemblySpec, relations=None, *, _min_words: int = 1) 
 def load_relations(spec: AssemblySpec, *, progress: bool = False):
     """Compute the cad relations of ``spec``'s parts (``None`` when it has no geometry).
 
-    Reads the meshes of the spec's parts (:func:`asp.generate.spec_geometry`).
+    Reads the meshes of the spec's parts (:func:`asp.generate.spec_geometry`), with the
+    spec's ``contact_tol`` and ``penetration_tol`` (None: the per-part rule).
     """
     if not spec.has_geometry:
         return None
     import cad
     from asp.generate import spec_geometry
 
-    return cad.compute_relations(spec_geometry(spec), progress=progress)
+    return cad.compute_relations(
+        spec_geometry(spec),
+        contact_tol=spec.contact_tol,
+        penetration_tol=spec.penetration_tol,
+        progress=progress,
+    )
