@@ -153,8 +153,10 @@ def load_scene_file(path: Path) -> trimesh.Scene:
             ) from None
     if path.stat().st_size == 0:
         raise GeometryError(f"empty mesh file {path}")
+    # an OBJ's objects (``o name``) are its parts: one file may hold a whole assembly
+    split = {"split_objects": True} if path.suffix.lower() == ".obj" else {}
     try:
-        scene = trimesh.load(str(path), force="scene")
+        scene = trimesh.load(str(path), force="scene", **split)
     except Exception as exc:  # trimesh raises many types for bad files
         raise GeometryError(f"unreadable mesh file {path}: {type(exc).__name__}: {exc}") from None
     if not isinstance(scene, trimesh.Scene):  # pragma: no cover - force="scene"

@@ -203,6 +203,31 @@ def test_occ_label_nodes_take_their_parents_names(tmp_path):
     ]  # fmt: skip
 
 
+def test_one_obj_file_with_several_objects_is_an_assembly(tmp_path):
+    """An OBJ exported with one ``o`` object per part: each object is a part (it was read
+    as one merged part); a part file of a folder with several objects stays one part."""
+    scene = trimesh.Scene()
+    scene.add_geometry(
+        shapes.box_between((0, 0, 0), (40, 40, 5)), node_name="Base Plate", geom_name="Base Plate"
+    )
+    scene.add_geometry(
+        shapes.box_between((5, 5, 5), (15, 15, 15)), node_name="Block", geom_name="Block"
+    )
+    path = tmp_path / "pair.obj"
+    scene.export(path)
+    assembly = load_assembly(path)
+    assert sorted(assembly.ids) == ["base_plate", "block"]
+    assert all(p.mesh.is_watertight for p in assembly.parts)
+    folder = tmp_path / "parts"
+    folder.mkdir()
+    path.rename(folder / "pair.obj")
+    (folder / "other.stl").write_bytes(
+        shapes.box_between((0, 0, 5), (4, 4, 9)).export(file_type="stl")
+    )
+    parts = load_assembly(folder)
+    assert parts.ids == ("other", "pair") and len(parts.parts[1].mesh.faces) == 24
+
+
 def test_gltf_names_and_hierarchy(tmp_path):
     path = write_named_glb(tmp_path / "pump.glb")
     scene = read_scene(path)
