@@ -8,8 +8,10 @@ Part ids are the names the file gives, cleaned into short unique ids (:func:`cle
 :func:`unique_ids`): ``"Hex Nut M6<2>"`` -> ``hex_nut_m6``, numbered when a name repeats
 (``nut_1``, ``nut_2``), in the file's order. Instance paths and numbers
 (``bearing#1:23:2:16``, ``Bolt:1``, ``Part1<3>``) are cut off; names that say nothing
-(``NAUO7``, ``12``, ``Open CASCADE STEP translator 7.8 1.1``, ``mesh_0``) give way to the
-mesh's name or the nearest named parent, else ``part``.
+(``NAUO7``, ``12``, ``Open CASCADE STEP translator 7.8 1.1``, ``mesh_0``, and OCCT's
+reference labels ``=>[0:1:1:7]`` that cascadio gives the shape nodes of Pro/E and Creo
+exports) give way to the mesh's name or the nearest named parent (``L-BRACKET`` ->
+``l_bracket_1``), else ``part``. A part's display name comes from the same node.
 """
 
 from __future__ import annotations
@@ -34,8 +36,11 @@ _EXTENSIONS = r"\.(stp|step|sldprt|sldasm|ipt|iam|prt|asm|stl|obj|glb|gltf|3mf)$
 
 _GENERIC = re.compile(
     r"^((nauo|solid|body|mesh|shape|geometry|node|object|component|compound|part|g)_?\d*|"
-    r"\d+|unnamed\w*|noname\w*|default\w*|world|root|scene|open_cascade_step_translator\w*)$"
+    r"(p_)?\d+(_\d+)*|unnamed\w*|noname\w*|default\w*|world|root|scene|open_cascade_step_translator\w*)$"
 )
+
+_REFERENCE_LABEL = re.compile(r"=>\[[\d:]*\]")
+"""OCCT's label of a referred shape (``=>[0:1:1:7]``): an instance path, never a name."""
 
 
 def clean_name(raw: str) -> str:
@@ -44,7 +49,7 @@ def clean_name(raw: str) -> str:
     Instance suffixes (``#...``, ``:1``, ``<2>``, ``(3)``) and file extensions are cut off,
     everything but letters and digits becomes ``_``, at most :data:`MAX_ID_LENGTH` chars.
     """
-    name = str(raw).strip()
+    name = _REFERENCE_LABEL.sub("", str(raw)).strip()
     name = re.split(r"[#<]", name, maxsplit=1)[0]
     name = re.sub(r":\d+$", "", name)
     name = re.sub(r"\(\d+\)$", "", name)
@@ -71,11 +76,13 @@ def is_generic(name: str) -> bool:
 
 def best_name(candidates: list[str], fallback: str = "part") -> str:
     """The first meaningful cleaned name among ``candidates`` (raw names), else ``fallback``."""
-    for raw in candidates:
-        name = clean_name(raw)
-        if not is_generic(name):
-            return name
-    return fallback
+    raw = best_raw_name(candidates)
+    return fallback if raw is None else clean_name(raw)
+
+
+def best_raw_name(candidates: list[str]) -> str | None:
+    """The first of ``candidates`` (raw names) whose cleaned name is meaningful, else None."""
+    return next((raw for raw in candidates if not is_generic(clean_name(raw))), None)
 
 
 def unique_ids(names: list[str], taken: set[str] | None = None) -> list[str]:
@@ -153,10 +160,39 @@ def load_scene_file(path: Path) -> trimesh.Scene:
     try:
         scene = trimesh.load(str(path), force="scene")
     except Exception as exc:  # trimesh raises many types for bad files
+        if external_references(path):
+            raise empty_scene_error(path) from None
         raise GeometryError(f"unreadable mesh file {path}: {type(exc).__name__}: {exc}") from None
     if not isinstance(scene, trimesh.Scene):  # pragma: no cover - force="scene"
         scene = trimesh.Scene(scene)
     return scene
+
+
+def empty_scene_error(path: Path) -> GeometryError:
+    """The one-line error for a file with no triangles; names the files a STEP refers to
+    (``DOCUMENT_FILE``: an assembly whose parts live in other files, which OCCT does not
+    follow)."""
+    referred = external_references(path)
+    if referred:
+        shown = ", ".join(referred[:6]) + (", ..." if len(referred) > 6 else "")
+        return GeometryError(
+            f"{path} holds no geometry of its own: it references external files ({shown}); "
+            "export the assembly as one STEP file with its parts embedded"
+        )
+    return GeometryError(f"unreadable mesh file {path}: no triangles could be read (empty mesh)")
+
+
+def external_references(path: Path) -> tuple[str, ...]:
+    """The files a STEP file's ``DOCUMENT_FILE`` entities name, in order, without repeats
+    (empty for other formats)."""
+    if path.suffix.lower() not in (".step", ".stp"):
+        return ()
+    try:
+        text = path.read_text(encoding="latin-1")
+    except OSError:
+        return ()
+    found = re.findall(r"DOCUMENT_FILE\s*\(\s*'([^']+)'", text, flags=re.IGNORECASE)
+    return tuple(dict.fromkeys(found))
 
 
 def declared_units(path: Path, scene: trimesh.Scene) -> str | None:
@@ -227,15 +263,14 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
     # the node holding every part (the product itself) is not a group
     group_nodes = [(g, b) for g, b in group_nodes if len(b) < len(part_nodes)]
 
-    names, meshes = [], []
-    for node, _ in part_nodes:
+    names, meshes, bases = [], [], []
+    for node, anc in part_nodes:
         transform, geom_name = graph[node]
         meshes.append(scene.geometry[geom_name].copy().apply_transform(transform))
-        names.append(display_name(original(node)))
-    bases = [
-        best_name([original(node), str(graph[node][1]), *[original(a) for a in anc]])
-        for node, anc in part_nodes
-    ]
+        own = original(node)
+        raw = best_raw_name([own, str(geom_name), *[original(a) for a in anc]])
+        bases.append("part" if raw is None else clean_name(raw))
+        names.append(display_name(own if _REFERENCE_LABEL.search(own) is None else raw or own))
     ids = unique_ids(bases)
     id_of = {node: pid for (node, _), pid in zip(part_nodes, ids, strict=True)}
     group_ids = unique_ids(

@@ -28,6 +28,7 @@ DATA = Path(__file__).parent / "data"
         ("Side Panel.SLDPRT", "side_panel"),
         ("608-2RS bearing", "p_608_2rs_bearing"),
         ("NAUO7", "nauo7"),
+        ("=>[0:1:1:7]_1", "1"),
         (
             "a-very-long-name-of-a-part-that-goes-on-and-on-forever",
             "a_very_long_name_of_a_part_that",
@@ -41,7 +42,8 @@ def test_clean_name(raw, clean):
 @pytest.mark.parametrize(
     ("name", "generic"),
     [("nauo7", True), ("12", True), ("open_cascade_step_translator_7_8_1_1", True),
-     ("mesh_0", True), ("mesh0", True), ("g3", True), ("bolt", False), ("", True)],
+     ("mesh_0", True), ("mesh0", True), ("g3", True), ("bolt", False), ("", True),
+     ("p_0_1_1_7_1", True), ("0_1_1_7", True), ("p_608_2rs_bearing", False)],
 )  # fmt: skip
 def test_generic_names(name, generic):
     assert is_generic(name) == generic
@@ -188,3 +190,27 @@ def test_gltf_names_and_hierarchy(tmp_path):
     assert np.allclose(assembly.parts[2].mesh.extents, [40, 40, 5], atol=1e-4)
     classes = shape_classes(assembly.parts)
     assert classes[0] == classes[1] == "bearing" and classes[2] == "bottom_plate"
+
+
+def test_occt_reference_labels_give_way_to_the_product_name(tmp_path):
+    """Pro/E STEP through cascadio: shape nodes ``=>[0:1:1:7]`` under ``L-BRACKET``."""
+    scene = trimesh.Scene()
+    scene.graph.update(frame_from="world", frame_to="AS1_PE_ASM")
+    nodes = {
+        "L-BRACKET": ("=>[0:1:1:7]", shapes.box_between((0, 0, 0), (40, 40, 5))),
+        "L-BRACKET_1": ("=>[0:1:1:7]_1", shapes.box_between((0, 0, 5), (40, 40, 10))),
+        "PLATE": ("=>[0:1:1:3]", shapes.box_between((0, 0, 10), (40, 40, 15))),
+    }
+    for k, (parent, (node, mesh)) in enumerate(nodes.items()):
+        scene.graph.update(frame_from="AS1_PE_ASM", frame_to=parent)
+        scene.add_geometry(
+            mesh.copy().apply_scale(0.001),
+            node_name=node,
+            geom_name=f"SOLID_{k}",
+            parent_node_name=parent,
+        )
+    path = tmp_path / "brackets.glb"
+    scene.export(path)
+    parts = read_scene(path)
+    assert parts.ids == ("l_bracket_1", "l_bracket_2", "plate")
+    assert parts.names == ("L-BRACKET", "L-BRACKET", "PLATE")
