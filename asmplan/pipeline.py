@@ -257,10 +257,13 @@ def load(
     """:func:`load_assembly` and, when the spec has meshes, its :func:`relations`.
 
     A generated spec (no ``assembly.yaml``) is announced through ``on_step``, else as a
-    warning; its placements of parts nothing can keep from falling become ``held``
-    (:func:`asp.generate.hold_unsupported`), named in a second note.
+    warning; its gravity is chosen from the relations (:mod:`asp.gravity`: the format's
+    own down unless another direction is clearly better), said in a note; its placements
+    of parts nothing can keep from falling become ``held``
+    (:func:`asp.generate.hold_unsupported`), named in a further note.
     """
-    from asp.generate import HELD_REASON, hold_unsupported
+    from asp.feasibility import load_relations
+    from asp.generate import HELD_REASON, hold_unsupported, orient_generated, spec_geometry
 
     spec = load_assembly(source)
 
@@ -282,7 +285,11 @@ def load(
     if spec.has_geometry:
         if on_step is not None:
             on_step(f"computing part relations of {len(spec.parts)} parts ...")
-        rel = relations(spec, progress=progress)
+        geometry = spec_geometry(spec)
+        rel = load_relations(spec, progress=progress, geometry=geometry)
+        spec, choice = orient_generated(spec, rel, geometry)
+        if choice is not None:
+            note(f"generated spec: gravity {choice.gravity}: {choice.reason}")
         spec, held = hold_unsupported(spec, rel)
         if held:
             note(f"generated spec: held: true for {', '.join(held)} ({HELD_REASON})")

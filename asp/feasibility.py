@@ -643,14 +643,16 @@ def operation_model(spec: AssemblySpec, relations=None, *, _min_words: int = 1) 
     )
 
 
-def load_relations(spec: AssemblySpec, *, progress: bool = False):
+def load_relations(spec: AssemblySpec, *, progress: bool = False, geometry=None):
     """Compute the cad relations of ``spec``'s parts (``None`` when it has no geometry).
 
-    Reads the meshes of the spec's parts (:func:`asp.generate.spec_geometry`).
+    Reads the meshes of the spec's parts (:func:`asp.generate.spec_geometry`) unless
+    ``geometry`` (that ``cad.Assembly``, already read) is given.
     """
     if not spec.has_geometry:
         return None
     import cad
     from asp.generate import spec_geometry
 
-    return cad.compute_relations(spec_geometry(spec), progress=progress)
+    geometry = spec_geometry(spec) if geometry is None else geometry
+    return cad.compute_relations(geometry, progress=progress)

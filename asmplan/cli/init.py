@@ -33,7 +33,9 @@ def init_command(
     check_output(output, folder=False)
     if output.exists() and not force:
         raise ValueError(f"{output} exists (use --force to overwrite it)")
-    text = spec_text(source, spec_folder=output.parent)
+    text = spec_text(
+        source, spec_folder=output.parent, on_note=lambda line: typer.echo(line, err=True)
+    )
     # the text must read back as a valid spec before it is written
     spec = spec_from_dict(yaml.load(text, Loader=DecimalsAsText), source=str(output))  # noqa: S506
     write_text(output, text)
