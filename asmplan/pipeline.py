@@ -457,12 +457,14 @@ def schedule(
     time_limit: float = 30.0,
     workers: int = 1,
     seed: int = 0,
+    sequence: list[str] | None = None,
 ) -> Schedule:
     """CP-SAT minimum makespan with the agents working in parallel, physically feasible.
 
     Every schedule is replayed through the state graph and cut until one passes
     (:func:`asp.concurrent.assembly_makespan`); the status is ``OPTIMAL`` only for a
-    proven optimum that passed.
+    proven optimum that passed, ``FEASIBLE`` for the best passing schedule when time ran
+    out (a list schedule along a state-graph path is always there to fall back on).
 
     Parameters
     ----------
@@ -475,6 +477,9 @@ def schedule(
         CP-SAT workers (1: repeatable).
     seed : int
         CP-SAT random seed.
+    sequence : list of str, optional
+        A complete sequence of operation ids along the state graph (the robust plan's
+        line): a list schedule along it is one more starting point.
 
     Returns
     -------
@@ -483,7 +488,12 @@ def schedule(
     from asp.concurrent import assembly_makespan
 
     sched, result = assembly_makespan(
-        assembly.spec, graph, time_limit=time_limit, workers=workers, seed=seed
+        assembly.spec,
+        graph,
+        time_limit=time_limit,
+        workers=workers,
+        seed=seed,
+        sequence=sequence,
     )
     return Schedule(result, sched.lower_bound, sched.chain_bound, sched.load_bound)
 
@@ -546,7 +556,8 @@ def plan(
     solution = solve_game(the_game.dag)
     steps = robust_plan(the_game, solution)
     say("[4/5] CP-SAT minimum-makespan schedule ...")
-    sched = schedule(assembly, graph, time_limit=time_limit, seed=seed)
+    line = [step.operation for step in steps if step.operation]
+    sched = schedule(assembly, graph, time_limit=time_limit, seed=seed, sequence=line)
     turn = assembly.spec.turn_model if turn_model is None else turn_model
     concurrent = None
     from asp.spec import TURN_MODELS

@@ -332,15 +332,25 @@ def min_makespan(
     workers: int = 1,
     seed: int = 0,
     replay=None,
+    incumbent: list[dict] | None = None,
 ) -> BaselineResult:
     """Minimum-makespan schedule with CP-SAT.
 
     ``replay`` (optional) checks a schedule: ``replay(rows)`` returns ``None`` when the
     schedule is physically feasible, else a cut, a list of ``(y, x)`` task-index pairs of
     which at least one must become a precedence (``end[y] <= start[x]``) in every feasible
-    schedule. The model is then solved again with the cut (lazy constraints) until a schedule
-    passes; a schedule that does not pass is never reported, and the status is ``OPTIMAL``
-    only for a proven optimum that passed (see :func:`assembly_makespan`).
+    schedule. Every solution CP-SAT finds is replayed as it comes; the first that fails
+    stops the solve, its cut is added (a lazy constraint) and CP-SAT solves again, hinted
+    with the best schedule that passed and bound to beat it (:class:`_ReplayLoop`). A
+    schedule that does not pass is never reported. The status is ``OPTIMAL`` only when a
+    solve with every cut proves that no shorter schedule exists; ``FEASIBLE`` is the best
+    schedule that passed within ``time_limit`` (``bound`` is then a proven lower bound).
+
+    ``incumbent`` (optional): rows ``{"task", "agent", "start", "end"}`` of a schedule to
+    start from, e.g. :func:`list_schedule` along a state-graph path (replayed like any
+    other; kept only if it passes). With it a result never lacks a schedule.
+    ``detail["found_by"]`` says which schedule is reported (``CP-SAT`` or the incumbent's
+    source), ``detail["cuts"]`` and ``detail["solves"]`` how the loop went.
 
     Tool states as sequence-dependent setups: for a tool ``T``, a *setter* is a task that
     sets ``T`` and a *user* a task that requires a value of ``T``. Every setter is ordered
@@ -443,67 +453,207 @@ def min_makespan(
     model.add_max_equality(makespan, end)
     model.minimize(makespan)
 
-    # Solve, replay, cut, until a schedule passes (or time runs out).
-    t0 = time.perf_counter()
-    detail: dict = {"tasks": len(tasks), "scale": scale}
-    prec: dict[tuple[int, int], object] = {}
-
-    def precedes(y: int, x: int):
-        if (y, x) not in prec:
-            lit = model.new_bool_var(f"prec_{tasks[y].id}_{tasks[x].id}")
-            model.add(end[y] <= start[x]).only_enforce_if(lit)
-            prec[y, x] = lit
-        return prec[y, x]
-
-    cuts = 0
-    while True:
-        left = time_limit - (time.perf_counter() - t0)
-        solver = _solver(max(left, 0.01), workers, seed)
-        status = solver.solve(model)
-        name, found = _status(solver, status)
-        objective = bound = None
-        rows = []
-        if found:
-            objective = solver.objective_value / scale
-            bound = solver.best_objective_bound / scale
-            for i, t in enumerate(tasks):
-                m = next(m for m, lit in enumerate(present[i]) if solver.boolean_value(lit))
-                rows.append(
-                    {
-                        "task": t.id,
-                        "agent": t.modes[m][0],
-                        "start": json_number(solver.value(start[i]) / scale, 6),
-                        "end": json_number(solver.value(end[i]) / scale, 6),
-                    }
-                )
-            rows.sort(key=lambda r: (r["start"], r["end"], r["task"]))
-        cut = replay(rows) if (found and replay is not None) else None
-        if cut is None:
-            break
-        cuts += 1
-        if not cut or time.perf_counter() - t0 >= time_limit:
-            # No cut left to add, or no time: the schedule found is not feasible.
-            name, objective, rows = "UNKNOWN", None, []
-            detail["replay"] = "no physically feasible schedule found within the time limit"
-            break
-        model.add_bool_or([precedes(y, x) for y, x in cut])
-    wall = time.perf_counter() - t0
-    if replay is not None:
-        detail["cuts"] = cuts
-        if rows:
-            detail["replay"] = "passed"
-    if rows:
-        detail["schedule"] = rows
+    # Solve, replay, cut (see the docstring).
+    loop = _ReplayLoop(
+        model=model,
+        tasks=tasks,
+        scale=scale,
+        start=start,
+        end=end,
+        present=present,
+        makespan=makespan,
+        replay=replay,
+    )
+    if incumbent:
+        loop.offer(incumbent, source="list schedule along a state-graph path")
+    status, detail_loop, wall = loop.run(time_limit, workers, seed)
+    detail: dict = {"tasks": len(tasks), "scale": scale, **detail_loop}
+    best = loop.best
+    objective = None if best is None else best[0] / scale
+    bound = None if loop.bound is None else loop.bound / scale
+    if objective is not None and bound is not None:
+        bound = min(bound, objective)
+    if best is not None:
+        detail["schedule"] = best[1]
     return BaselineResult(
         kind="schedule",
         name=problem.name,
-        status=name,
+        status=status,
         objective=objective,
         bound=bound,
         wall_s=wall,
         detail=detail,
         credit=problem.credit,
     )
+
+
+class _ReplayLoop:
+    """CP-SAT with lazy cuts from a replay, keeping the best schedule that passes.
+
+    Each solution CP-SAT finds is replayed as it comes (a solution callback). One that
+    passes becomes the incumbent (when shorter); the first that fails stops the search,
+    its cut is added and CP-SAT solves again, hinted with the incumbent and bound to beat
+    it (``makespan <= incumbent - 1``). Without a replay every solution passes. An
+    incumbent given beforehand (:meth:`offer`) is the fallback and, after the first cut,
+    the hint.
+
+    Status: ``OPTIMAL`` when a solve ends proven (OPTIMAL, or INFEASIBLE below the
+    incumbent) without a failing solution: cuts only remove infeasible schedules, so the
+    incumbent is then the optimum of the physically feasible ones. ``FEASIBLE`` when time
+    runs out with an incumbent; ``INFEASIBLE`` when the model has no schedule at all, else
+    ``UNKNOWN`` (no schedule). Every reported schedule passed the replay.
+    """
+
+    def __init__(self, *, model, tasks, scale, start, end, present, makespan, replay):
+        self.model, self.tasks, self.scale = model, tasks, scale
+        self.start, self.end, self.present, self.makespan = start, end, present, makespan
+        self.replay = replay
+        self.best: tuple[int, list[dict]] | None = None  # (scaled makespan, rows)
+        self.source = ""
+        self.bound: int | None = None
+        self.cuts = 0
+        self.solves = 0
+        self.failed = 0  # schedules that failed the replay
+        self.prec: dict[tuple[int, int], object] = {}
+        self.modes: list[int] | None = None  # the incumbent's mode per task
+
+    def rows(self, value, boolean) -> tuple[list[dict], list[int]]:
+        """The schedule rows of a solution (``value``/``boolean`` read it) and its modes."""
+        rows, modes = [], []
+        for i, t in enumerate(self.tasks):
+            m = next(m for m, lit in enumerate(self.present[i]) if boolean(lit))
+            modes.append(m)
+            rows.append(
+                {
+                    "task": t.id,
+                    "agent": t.modes[m][0],
+                    "start": json_number(value(self.start[i]) / self.scale, 6),
+                    "end": json_number(value(self.end[i]) / self.scale, 6),
+                }
+            )
+        rows.sort(key=lambda r: (r["start"], r["end"], r["task"]))
+        return rows, modes
+
+    def offer(self, rows: list[dict], *, source: str, modes=None) -> list | None:
+        """Replay ``rows``; keep them when they pass and beat the incumbent; the cut if not."""
+        cut = self.replay(rows) if self.replay is not None else None
+        if cut is not None:
+            self.failed += 1
+            return cut
+        span = round(max((float(r["end"]) for r in rows), default=0.0) * self.scale)
+        if self.best is None or span < self.best[0]:
+            if modes is None:
+                agent = {r["task"]: r["agent"] for r in rows}
+                modes = [[a for a, _ in t.modes].index(agent[t.id]) for t in self.tasks]
+            self.best, self.source, self.modes = (span, rows), source, list(modes)
+        return None
+
+    def precedes(self, y: int, x: int):
+        if (y, x) not in self.prec:
+            lit = self.model.new_bool_var(f"prec_{self.tasks[y].id}_{self.tasks[x].id}")
+            self.model.add(self.end[y] <= self.start[x]).only_enforce_if(lit)
+            self.prec[y, x] = lit
+        return self.prec[y, x]
+
+    def hint(self) -> None:
+        self.model.clear_hints()
+        if self.best is None:
+            return
+        by_task = {r["task"]: r for r in self.best[1]}
+        for i, t in enumerate(self.tasks):
+            r = by_task[t.id]
+            self.model.add_hint(self.start[i], round(float(r["start"]) * self.scale))
+            self.model.add_hint(self.end[i], round(float(r["end"]) * self.scale))
+            if len(self.present[i]) > 1:
+                for m, lit in enumerate(self.present[i]):
+                    self.model.add_hint(lit, m == self.modes[i])
+
+    def run(self, time_limit: float, workers: int, seed: int) -> tuple[str, dict, float]:
+        from ortools.sat.python import cp_model
+
+        loop = self
+        t0 = time.perf_counter()
+        proven = infeasible = False
+        last = "UNKNOWN"
+        while True:
+            left = time_limit - (time.perf_counter() - t0)
+            if left <= 0:
+                break
+            if self.solves and self.best is not None:
+                # After a cut: only a shorter schedule is of use now, and the best one so
+                # far is CP-SAT's hint. (The first solve is plain CP-SAT, so a job it solves
+                # outright gets the optimum it always got.)
+                self.model.add(self.makespan <= self.best[0] - 1)
+                self.hint()
+
+            class Replayed(cp_model.CpSolverSolutionCallback):
+                def __init__(self):
+                    super().__init__()
+                    self.cut = None
+
+                def on_solution_callback(self):
+                    rows, modes = loop.rows(self.value, self.boolean_value)
+                    cut = loop.offer(rows, source="CP-SAT", modes=modes)
+                    if cut is not None:
+                        self.cut = cut
+                        self.stop_search()
+
+            callback = Replayed()
+            solver = _solver(left, workers, seed)
+            status = solver.solve(self.model, callback)
+            self.solves += 1
+            last = solver.status_name(status)
+            if status in (cp_model.OPTIMAL, cp_model.FEASIBLE):
+                bound = int(round(solver.best_objective_bound))
+                if self.best is not None:
+                    bound = min(bound, self.best[0])
+                self.bound = bound if self.bound is None else max(self.bound, bound)
+            if callback.cut is None:
+                proven = status in (cp_model.OPTIMAL, cp_model.INFEASIBLE)
+                infeasible = status == cp_model.INFEASIBLE and self.best is None
+                break
+            if not callback.cut:
+                break  # a failure no precedence can mend: nothing more to try
+            self.cuts += 1
+            self.model.add_bool_or([self.precedes(y, x) for y, x in callback.cut])
+        wall = time.perf_counter() - t0
+        if self.best is not None and proven:
+            status_name = "OPTIMAL"
+            self.bound = self.best[0]
+        elif self.best is not None:
+            status_name = "FEASIBLE"
+        else:
+            status_name = "INFEASIBLE" if infeasible else last
+            if status_name in ("OPTIMAL", "FEASIBLE", "INFEASIBLE"):
+                status_name = "UNKNOWN"  # stopped by a cut, or proven only below a bound
+        detail: dict = {}
+        if self.replay is not None:
+            detail["cuts"] = self.cuts
+            detail["solves"] = self.solves
+            if self.best is not None:
+                detail["replay"] = "passed"
+                detail["found_by"] = self.source
+            elif status_name == "UNKNOWN":
+                detail["replay"] = "no physically feasible schedule found within the time limit"
+        detail["status_note"] = self.note(status_name, time_limit)
+        return status_name, detail, wall
+
+    def note(self, status: str, time_limit: float) -> str:
+        """One line saying what the status means for this result."""
+        checked = " that replays through the state graph" if self.replay is not None else ""
+        cuts = f", {self.cuts} cuts" if self.replay is not None else ""
+        if status == "OPTIMAL":
+            return f"proven optimal: no shorter schedule{checked} exists{cuts}"
+        if status == "FEASIBLE":
+            low = f"; the optimum is at least {self.bound / self.scale:g}" if self.bound else ""
+            replayed = ", replayed through the state graph" if self.replay is not None else ""
+            return (
+                f"not proven optimal within {time_limit:g} s: the best schedule found "
+                f"(by {self.source}{cuts}){replayed}{low}"
+            )
+        if status == "INFEASIBLE":
+            return "no schedule satisfies the constraints"
+        return f"no schedule{checked} found within {time_limit:g} s{cuts}"
 
 
 def _tool_constraints(model, problem: ScheduleProblem, start, end) -> None:
@@ -728,47 +878,147 @@ def schedule_violation(model, rows: list[dict]) -> tuple[str, list[tuple[int, in
     for r in rows:
         if r["agent"] not in workers:
             return f"operation {r['task']}: unknown agent {r['agent']!r}", []
-
-    def cut(done: set[int], b: int) -> list[tuple[int, int]]:
-        first = done | {b}
-        return [(y, x) for x in sorted(first) for y in range(n) if y not in done and y != x]
-
-    def name(done: set[int]) -> str:
-        return "{" + " ".join(ids[i] for i in sorted(done)) + "}" if done else "the start"
-
     state, done = 0, set()
     by_end = sorted(range(n), key=lambda i: (end[i], start[i]))
-    for t in sorted(set(start.values())):
+    for t in [*sorted(set(start.values())), math.inf]:
         for i in by_end:
             if end[i] <= t and i not in done:
                 nxt = model.succ.get((state, i))
                 if nxt is None:
-                    return f"operation {ids[i]} cannot follow {name(done)}", cut(done, i)
+                    return _cannot_follow(model, done, i)
                 state = nxt[0]
                 done.add(i)
         running = sorted(i for i in range(n) if start[i] <= t < end[i])
-        for a in running:
-            for b in running:
-                if a < b and model.conflict[a, b]:
-                    return (
-                        f"operations {ids[a]} and {ids[b]} overlap but share a tool",
-                        [(a, b), (b, a)],
-                    )
-        reached = {0: (state, set(done))}
-        for mask in range(1 << len(running)):
-            cur, cur_done = reached[mask]
-            for k, b in enumerate(running):
-                if mask >> k & 1:
-                    continue
-                nxt = model.succ.get((cur, b))
-                if nxt is None:
-                    return f"operation {ids[b]} cannot follow {name(cur_done)}", cut(cur_done, b)
-                reached[mask | 1 << k] = (nxt[0], cur_done | {b})
-    for i in by_end:
-        if i not in done:
-            nxt = model.succ.get((state, i))
-            if nxt is None:
-                return f"operation {ids[i]} cannot follow {name(done)}", cut(done, i)
-            state = nxt[0]
-            done.add(i)
+        found = _together_violation(model, state, done, running)
+        if isinstance(found, tuple):
+            a, b = found
+            return f"operations {ids[a]} and {ids[b]} overlap but share a tool", [(a, b), (b, a)]
+        if found is not None:
+            return _cannot_follow(model, *found)
     return None
+
+
+def _cannot_follow(model, done: set[int], b: int) -> tuple[str, list[tuple[int, int]]]:
+    """The violation "``b`` cannot follow the done set" and its cut (see
+    :func:`schedule_violation`): some operation outside ``done`` precedes one of
+    ``done + {b}``, or a shorter cut from ``model.cuts`` (:class:`asp.concurrent.PlacementCuts`)."""
+    ids = model.spec.op_ids
+    where = "{" + " ".join(ids[i] for i in sorted(done)) + "}" if done else "the start"
+    short = getattr(model, "cuts", None)
+    cut = short.cut(done, b) if short is not None else None
+    if cut is None:
+        first = done | {b}
+        cut = [(y, x) for x in sorted(first) for y in range(len(ids)) if y not in done and y != x]
+    return f"operation {ids[b]} cannot follow {where}", cut
+
+
+def _together_violation(model, state: int, done: set[int], running: list[int]):
+    """Whether the operations ``running`` may run together from ``state`` (``done`` done).
+
+    Returns
+    -------
+    None, tuple or list
+        None if they may; ``(a, b)``: two of them share a tool; ``[done set, b]``: ``b``
+        cannot follow that done set (some order of the running ones reaches it).
+    """
+    for a in running:
+        for b in running:
+            if a < b and model.conflict[a, b]:
+                return (a, b)
+    reached = {0: (state, set(done))}
+    for mask in range(1 << len(running)):
+        cur, cur_done = reached[mask]
+        for k, b in enumerate(running):
+            if mask >> k & 1:
+                continue
+            nxt = model.succ.get((cur, b))
+            if nxt is None:
+                return [cur_done, b]
+            reached[mask | 1 << k] = (nxt[0], cur_done | {b})
+    return None
+
+
+def list_schedule(model, problem: ScheduleProblem, sequence=None) -> list[dict] | None:
+    """A physically feasible schedule built along a path of the state graph (list scheduling).
+
+    The operations are taken one at a time in an order that is a path of the state graph:
+    ``sequence`` (operation ids, e.g. the robust plan's principal line), else greedily the
+    enabled operation that can finish first. Each starts no earlier than the one before it,
+    on the allowed agent that finishes it first, at the earliest time (that start, or a
+    completion after it) where it may run next to the operations still running
+    (:func:`schedule_violation`'s rule). Once everything before it has ended it always may
+    (it is the path's next step), so the schedule always exists; it is replayed once more
+    at the end.
+
+    Parameters
+    ----------
+    model
+        What :func:`schedule_violation` takes (``spec``, ``workers``, ``succ``, ``conflict``).
+    problem : ScheduleProblem
+        Its tasks are the spec's operations (same ids), with their modes and durations.
+
+    Returns
+    -------
+    list of dict or None
+        Rows ``{"task", "agent", "start", "end"}`` sorted by start; None when ``sequence``
+        is not a path of the state graph or the result fails the replay (zero durations).
+    """
+    ids = model.spec.op_ids
+    index = {oid: i for i, oid in enumerate(ids)}
+    scale = integer_scale([d for t in problem.tasks for _, d in t.modes] or [1])
+    modes = {index[t.id]: [(a, round(d * scale)) for a, d in t.modes] for t in problem.tasks}
+    n = len(ids)
+    order = None
+    if sequence is not None:
+        order = [index.get(o, -1) for o in sequence]
+        if sorted(order) != list(range(n)):
+            return None  # not a complete sequence of these operations
+    start: dict[int, int] = {}  # times in units of 1 / scale
+    end: dict[int, int] = {}
+    agent_of: dict[int, str] = {}
+    free: dict[str, int] = {}
+    state, last = 0, 0
+
+    def fits(x: int, t: int, d: int) -> bool:
+        done = sorted((i for i in start if end[i] <= t), key=lambda i: (end[i], start[i]))
+        cur = 0
+        for i in done:
+            nxt = model.succ.get((cur, i))
+            if nxt is None:
+                return False
+            cur = nxt[0]
+        running = sorted([i for i in start if start[i] <= t < end[i]] + ([x] if d > 0 else []))
+        return _together_violation(model, cur, set(done), running) is None
+
+    for step in range(n):
+        cands = [order[step]] if order is not None else [o for o in range(n) if o not in start]
+        best = None
+        for o in cands:
+            nxt = model.succ.get((state, o))
+            if nxt is None:
+                if order is not None:
+                    return None
+                continue
+            for agent, d in modes[o]:
+                lo = max(last, free.get(agent, 0))
+                times = [lo, *sorted({e for e in end.values() if e > lo})]
+                t = next(t for t in times if fits(o, t, d))
+                key = (t + d, t, o, agent, nxt[0])
+                best = key if best is None or key < best else best
+        if best is None:
+            return None
+        _, t, o, agent, state = best
+        _, d = next(m for m in modes[o] if m[0] == agent)
+        start[o], end[o], agent_of[o] = t, t + d, agent
+        free[agent], last = t + d, t
+    rows = [
+        {
+            "task": ids[i],
+            "agent": agent_of[i],
+            "start": json_number(start[i] / scale, 6),
+            "end": json_number(end[i] / scale, 6),
+        }
+        for i in range(n)
+    ]
+    rows.sort(key=lambda r: (r["start"], r["end"], r["task"]))
+    return rows if schedule_violation(model, rows) is None else None

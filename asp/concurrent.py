@@ -63,6 +63,7 @@ from asp.baseline import (
     BaselineResult,
     assembly_schedule,
     integer_scale,
+    list_schedule,
     min_makespan,
     schedule_violation,
 )
@@ -279,15 +280,86 @@ class GraphSteps:
         return (t, 0) if self.alive[t] else None
 
 
+class PlacementCuts:
+    """Short cuts for the CP-SAT replay loop, read off the state graph.
+
+    When a schedule places operation ``b`` right after the done set ``I`` and the state
+    graph has no such step, the general cut (:func:`asp.baseline.schedule_violation`) has
+    about ``|I| x (n - |I|)`` literals. Two shorter ones hold whenever the state graph says
+    so, over ``B``, the done sets of the co-reachable states with a step ``b`` into a
+    co-reachable state:
+
+    - *needs one of* ``Y``: every set in ``B`` contains an operation of ``Y`` (``Y`` starts
+      as the operations outside ``I``). Then every feasible schedule has some ``y`` of ``Y``
+      ending by the time ``b`` starts: the placement order "all operations ended by then,
+      ``b``, the rest" is consistent with the schedule, so its done set before ``b`` is in
+      ``B``. Cut: ``y -> b`` for ``y`` in ``Y``.
+    - *before one of* ``X``: no set in ``B`` contains all of ``X`` (``X`` starts as ``I``).
+      Then some ``x`` of ``X`` starts after ``b`` ends: else the order "every operation not
+      starting after ``b`` ends, ``b``, the rest" places ``b`` after all of ``X``. Cut:
+      ``b -> x`` for ``x`` in ``X``.
+
+    Each set is shrunk greedily (an operation is dropped while the condition still holds),
+    so the cut names a few operations: the supports a part waits for, or the parts that
+    would block it.
+    """
+
+    def __init__(self, graph: StateGraph):
+        self.graph = graph
+        alive = graph.coreachable()
+        keep = alive[graph.src] & alive[graph.dst]
+        self.src = graph.src[keep]
+        self.op = graph.op[keep]
+        self.n = graph.model.n_ops
+        self._rows: dict[int, np.ndarray] = {}
+
+    def rows(self, b: int) -> np.ndarray:
+        """(k, n_ops) bool: the done sets ``B`` of operation ``b`` (class docstring)."""
+        if b not in self._rows:
+            states = np.unique(self.src[self.op == b])
+            self._rows[b] = self.graph.model.done_matrix(self.graph.keys[states])
+        return self._rows[b]
+
+    def cut(self, done: set[int], b: int) -> list[tuple[int, int]] | None:
+        """The shortest of the two cuts (class docstring) for ``b`` after ``done``, or None."""
+        rows = self.rows(b)
+
+        def needs(ys: list[int]) -> bool:
+            return bool(rows[:, ys].any(axis=1).all()) if ys else not rows.shape[0]
+
+        def blocks(xs: list[int]) -> bool:
+            return not bool(rows[:, xs].all(axis=1).any()) if xs else not rows.shape[0]
+
+        found = []
+        ys = [y for y in range(self.n) if y not in done and y != b]
+        if needs(ys):
+            found.append([(y, b) for y in _shrink(ys, needs)])
+        xs = sorted(done)
+        if blocks(xs):
+            found.append([(b, x) for x in _shrink(xs, blocks)])
+        return min(found, key=len, default=None)
+
+
+def _shrink(items: list[int], holds) -> list[int]:
+    """Drop items one by one while ``holds(rest)`` stays true."""
+    out = list(items)
+    for x in items:
+        rest = [y for y in out if y != x]
+        if holds(rest):
+            out = rest
+    return out
+
+
 @dataclass(frozen=True, eq=False)
 class ReplayModel:
     """What a schedule replay needs of the concurrent rules: the spec, the workers, the
-    state graph's transitions and the tool conflicts (built in time linear in the spec)."""
+    state graph's transitions, the tool conflicts and (optionally) the short cuts."""
 
     spec: AssemblySpec
     workers: tuple[Worker, ...]
     succ: GraphSteps
     conflict: np.ndarray
+    cuts: PlacementCuts | None = None
 
 
 def concurrent_model(
@@ -1145,27 +1217,51 @@ def timeline(game: ConcurrentGame, robot_policy: np.ndarray, human: str = "worst
 
 
 def assembly_makespan(
-    spec, graph, *, time_limit: float = 60.0, workers: int = 1, seed: int = 0
+    spec,
+    graph,
+    *,
+    time_limit: float = 60.0,
+    workers: int = 1,
+    seed: int = 0,
+    sequence: Sequence[str] | None = None,
 ) -> tuple[AssemblySchedule, BaselineResult]:
     """The minimum-makespan schedule of an assembly that respects the state graph.
 
     Exact by lazy cuts: CP-SAT solves the schedule with the precedences the state graph
-    implies (:func:`asp.baseline.assembly_schedule`); each schedule is replayed through the
-    state graph (:func:`asp.baseline.schedule_violation`, the concurrent game's rule); a
-    schedule that fails adds its cut and CP-SAT solves again. Cuts only remove infeasible
-    schedules, so the first
-    proven optimum that passes is the optimum of the physically feasible schedules; the
-    status is ``OPTIMAL`` only then, ``FEASIBLE`` for a passing schedule found within the
-    time limit, else ``UNKNOWN`` with no schedule. ``detail`` holds ``cuts`` and ``replay``.
+    implies (:func:`asp.baseline.assembly_schedule`); each schedule it finds is replayed
+    through the state graph (:func:`asp.baseline.schedule_violation`, the concurrent game's
+    rule); one that fails adds its cut and CP-SAT solves again (:func:`asp.baseline.min_makespan`).
+    Cuts only remove infeasible schedules, so a solve that proves no shorter schedule with
+    every cut makes the best passing one ``OPTIMAL``.
+
+    It starts from a list schedule along a path of the state graph
+    (:func:`asp.baseline.list_schedule`, greedy, and along ``sequence`` too when given, e.g.
+    the robust plan's principal line; the shorter one): physically feasible by
+    construction, it is CP-SAT's hint and the fallback. So on a large state graph, where
+    CP-SAT cannot prove an optimum in ``time_limit``, the result is still a replayed
+    schedule, with status ``FEASIBLE`` and the proven lower bound. ``detail`` holds
+    ``cuts``, ``solves``, ``replay`` and ``found_by``.
     """
     sched = assembly_schedule(spec, graph)
-    model = ReplayModel(spec, spec_workers(spec), GraphSteps(graph), tool_conflicts(spec))
+    model = ReplayModel(
+        spec, spec_workers(spec), GraphSteps(graph), tool_conflicts(spec), PlacementCuts(graph)
+    )
 
     def replay(rows):
         found = schedule_violation(model, rows)
         return None if found is None else found[1]
 
+    starts = [list_schedule(model, sched.problem)]
+    if sequence is not None:
+        starts.append(list_schedule(model, sched.problem, sequence))
+    starts = [rows for rows in starts if rows]
+    incumbent = min(starts, key=lambda rows: max(float(r["end"]) for r in rows), default=None)
     result = min_makespan(
-        sched.problem, time_limit=time_limit, workers=workers, seed=seed, replay=replay
+        sched.problem,
+        time_limit=time_limit,
+        workers=workers,
+        seed=seed,
+        replay=replay,
+        incumbent=incumbent,
     )
     return sched, result

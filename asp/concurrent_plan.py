@@ -133,7 +133,8 @@ def robustness_table(plan: ConcurrentPlan) -> str:
     res = plan.schedule
     lines = [
         f"CP-SAT makespan (agents in parallel, replayed through the state graph): "
-        f"{_fmt(res.objective)} ({res.status}); state-graph lower bound {plan.lower_bound:g}",
+        f"{_fmt(res.objective)} ({res.status}: {res.detail.get('status_note', '')}); "
+        f"state-graph lower bound {plan.lower_bound:g}",
         "deviations k | robust plan W*(k) | CP-SAT schedule, certified worst case",
     ]
     worst = {r["k"]: r["bound"] for r in plan.schedule_worst}

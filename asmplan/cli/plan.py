@@ -59,11 +59,16 @@ def plan_summary(result) -> list[str]:
         plan_text(doc["worst_line"]),
     ]
     sched = result.schedule
+    note = sched.result.detail.get("status_note", "")
     if sched.result.objective is None:
-        why = sched.result.detail.get("replay", "no schedule found within the time limit")
-        found = f"none: {why} ({sched.result.status}; --time-limit raises it)"
+        found = f"none ({sched.result.status}: {note}; --time-limit raises it)"
+    elif sched.result.status == "OPTIMAL":
+        found = f"{sched.result.objective:g} s ({sched.result.status}: {note})"
     else:
-        found = f"{sched.result.objective:g} s ({sched.result.status})"
+        found = (
+            f"{sched.result.objective:g} s ({sched.result.status}: {note}; --time-limit gives "
+            "CP-SAT more time)"
+        )
     lines.append(
         f"CP-SAT makespan (agents in parallel): {found}; "
         f"state-graph lower bound {sched.lower_bound:g} s"
