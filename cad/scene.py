@@ -22,6 +22,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
+import numpy as np
 import trimesh
 
 from cad.errors import GeometryError
@@ -31,6 +32,9 @@ SCENE_SUFFIXES = (".glb", ".gltf", ".3mf", ".step", ".stp", ".3dxml")
 """Files that hold several parts (one per mesh node)."""
 DECLARED_METRES = (".glb", ".gltf", ".step", ".stp")
 """Formats whose unit is the metre (STEP through cascadio, glTF by definition)."""
+MAX_INCH_ASSEMBLY_M = 3.0
+"""A STEP declaring inches whose parts span more than this (metres, 118 in) has millimetre
+numbers under an inch label (Pro/E exports of metric models do this); it is read in mm."""
 MAX_ID_LENGTH = 32
 _EXTENSIONS = r"\.(stp|step|sldprt|sldasm|ipt|iam|prt|asm|stl|obj|glb|gltf|3mf)$"
 
@@ -263,10 +267,12 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
     # the node holding every part (the product itself) is not a group
     group_nodes = [(g, b) for g, b in group_nodes if len(b) < len(part_nodes)]
 
+    inch_as_mm = _millimetres_labelled_inches(file, scene)
     names, meshes, bases = [], [], []
     for node, anc in part_nodes:
         transform, geom_name = graph[node]
-        meshes.append(scene.geometry[geom_name].copy().apply_transform(transform))
+        mesh = scene.geometry[geom_name].copy().apply_transform(transform)
+        meshes.append(mesh.apply_scale(1.0 / 25.4) if inch_as_mm else mesh)
         own = original(node)
         raw = best_raw_name([own, str(geom_name), *[original(a) for a in anc]])
         bases.append("part" if raw is None else clean_name(raw))
@@ -287,6 +293,54 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
         groups=groups,
         units=declared_units(file, scene),
     )
+
+
+def step_length_unit(path: Path) -> str | None:
+    """The length unit of a STEP file's first ``GLOBAL_UNIT_ASSIGNED_CONTEXT`` (``"in"``,
+    ``"mm"``, ``"m"``, ...), read from the text; None when there is none or it is unknown.
+
+    The unit is a ``CONVERSION_BASED_UNIT('INCH' | 'FOOT', ...)`` or an
+    ``SI_UNIT(prefix, .METRE.)``, among the context's units the one that is a
+    ``LENGTH_UNIT``.
+    """
+    if path.suffix.lower() not in (".step", ".stp"):
+        return None
+    try:
+        text = path.read_text(encoding="latin-1")
+    except OSError:
+        return None
+    context = re.search(r"GLOBAL_UNIT_ASSIGNED_CONTEXT\s*\(\s*\(([^)]*)\)", text)
+    for ref in re.findall(r"#\d+", context.group(1)) if context else []:
+        entity = re.search(rf"{ref}\s*=([^;]*);", text)
+        if entity is None or "LENGTH_UNIT" not in entity.group(1):
+            continue
+        body = entity.group(1)
+        named = re.search(r"CONVERSION_BASED_UNIT\s*\(\s*'([A-Za-z ]+)'", body)
+        if named:
+            return {"inch": "in", "foot": "ft"}.get(named.group(1).strip().lower())
+        si = re.search(r"SI_UNIT\s*\(\s*(\$|\.\w+\.)\s*,\s*\.METRE\.", body)
+        if si:
+            prefix = si.group(1).strip(".").upper()
+            return {"$": "m", "MILLI": "mm", "CENTI": "cm", "MICRO": "um"}.get(prefix)
+    return None
+
+
+def _millimetres_labelled_inches(path: Path, scene: trimesh.Scene) -> bool:
+    """True (and a warning) for a STEP declaring inches whose parts, read so, would span
+    more than :data:`MAX_INCH_ASSEMBLY_M`: its numbers are millimetres."""
+    if step_length_unit(path) != "in" or scene.bounds is None:
+        return False
+    size = float(np.linalg.norm(np.ptp(scene.bounds, axis=0)))  # metres (cascadio)
+    if size <= MAX_INCH_ASSEMBLY_M:
+        return False
+    import warnings
+
+    warnings.warn(
+        f"{path.name} declares inches, but read so it is {size:.3g} m across: its numbers "
+        f"are taken as millimetres ({size / 25.4 * 1000:.0f} mm across; rule in cad/scene.py)",
+        stacklevel=2,
+    )
+    return True
 
 
 def _3dxml_groups(file: Path, nodes: list[str]) -> list[tuple[str, list[str]]]:

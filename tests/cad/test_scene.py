@@ -214,3 +214,39 @@ def test_occt_reference_labels_give_way_to_the_product_name(tmp_path):
     parts = read_scene(path)
     assert parts.ids == ("l_bracket_1", "l_bracket_2", "plate")
     assert parts.names == ("L-BRACKET", "L-BRACKET", "PLATE")
+
+
+def _scaled_step(source: Path, target: Path, factor: float) -> Path:
+    """``source`` with every coordinate and length (points, vector magnitudes) times
+    ``factor``, its units unchanged."""
+    import re
+
+    def points(match: re.Match) -> str:
+        values = ",".join(f"{float(v) * factor:.9g}" for v in match.group(2).split(","))
+        return f"{match.group(1)}({values})"
+
+    text = source.read_text()
+    text = re.sub(r"(CARTESIAN_POINT\('[^']*',)\(([^)]*)\)", points, text)
+    text = re.sub(
+        r"(VECTOR\('[^']*',#\d+,)([-\d.Ee+]+)\)",
+        lambda m: f"{m.group(1)}{float(m.group(2)) * factor:.9g})",
+        text,
+    )
+    target.write_text(text)
+    return target
+
+
+def test_millimetre_numbers_under_an_inch_label_are_read_as_millimetres(tmp_path):
+    """A Pro/E-style STEP: the unit says INCH, the numbers are millimetres (a 400 x 400 mm
+    plate that, read in inches, would be 10 m wide)."""
+    pytest.importorskip("cascadio")
+    from cad.scene import step_length_unit
+
+    path = _scaled_step(DATA / "table_frame_in.step", tmp_path / "frame_mm_as_in.step", 100.0)
+    assert step_length_unit(path) == "in"
+    with pytest.warns(UserWarning, match=r"declares inches, but read so it is .* m across"):
+        assembly = load_assembly(path)
+    assert np.allclose(assembly.parts[0].mesh.extents, [400, 400, 50], atol=1e-2)
+    # a true inch file stays in inches (4 in = 101.6 mm)
+    assert step_length_unit(DATA / "table_frame_in.step") == "in"
+    assert step_length_unit(DATA / "two_boxes.step") == "mm"
