@@ -11,10 +11,25 @@ move that is not the plan's, a finish of an operation that is not running) raise
 Turn model ``alternate``: one operation runs at a time, by the side on turn. A ``finished``
 event of an operation that was not seen to start counts as its start and finish (a sensor
 may only see completions). Passes (a side with nothing it may do) are taken automatically.
+
+Turn model ``concurrent`` (:class:`ConcurrentAdvisor`, which ``Advisor(plan)`` returns for
+such a plan): decisions are taken at events, as in the game (``asp/concurrent.py``). At the
+start and after every completion the robots commit first: the advisor takes the plan's
+commitment at once (the robots' next operations, ``robots``; a robot's ``started`` event
+confirms it, any other robot start is refused) and says what each free person is asked to do
+(``instruction``). The people's ``started`` events are their reply; a ``finished`` event is
+the next completion: it picks the plan's move with those starts in which that operation
+finishes, and time advances by that move's cost. Operations that finish at the same instant
+are reported one after the other. A person's duration given as a range is seen only when the
+operation finishes, so the advisor follows every move the observations leave possible (an
+event's optional ``time``, seconds since the start, keeps those whose completion is nearest
+to it) and answers for the worst of them; the robots do what it answered, which removes the
+moves whose commitment differs.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass, field
 
 from asmplan.errors import GameError
@@ -29,11 +44,16 @@ class ObservationError(GameError):
 
 @dataclass(frozen=True)
 class Event:
-    """An observation: ``kind`` (``started`` / ``finished``) of ``operation`` by ``agent``."""
+    """An observation: ``kind`` (``started`` / ``finished``) of ``operation`` by ``agent``,
+    optionally at ``time`` (seconds since the start) and, for a start, the ``duration`` the
+    agent will take (a person's duration given as a range; the concurrent game's robots know
+    it when she starts)."""
 
     kind: str
     operation: str
     agent: str
+    time: float | None = None
+    duration: float | None = None
 
     @classmethod
     def parse(cls, event) -> Event:
@@ -48,7 +68,18 @@ class Event:
         kind = str(event["kind"])
         if kind not in EVENT_KINDS:
             raise ObservationError(f"event kind {kind!r}: expected 'started' or 'finished'")
-        return cls(kind, str(event["operation"]), str(event["agent"]))
+        numbers = []
+        for key in ("time", "duration"):
+            x = event.get(key)
+            if x is not None:
+                try:
+                    x = float(x)
+                except (TypeError, ValueError):
+                    raise ObservationError(f"event {key} {x!r}: expected a number") from None
+                if not math.isfinite(x) or x < 0:
+                    raise ObservationError(f"event {key} {x!r}: expected a number >= 0")
+            numbers.append(x)
+        return cls(kind, str(event["operation"]), str(event["agent"]), *numbers)
 
 
 @dataclass(frozen=True)
@@ -84,6 +115,20 @@ class Advice:
         Remaining guaranteed cost (the robust robot's worst case from here).
     finished : bool
         The assembly is complete.
+    deviations : int
+        The person's deviations from the instructions so far.
+    turn_model : str
+        ``alternate`` or ``concurrent``.
+    instructions : list of dict
+        Concurrent: what each free person is asked to do (``{"agent", "operation",
+        "description"}``, ``operation`` None: wait).
+    finishes : list of dict
+        Concurrent: the completions the plan can explain next, given the people's starts so
+        far (``{"operation", "agent", "time", "worst"}``: the operation finishing, at which
+        time, and the guaranteed makespan after it); empty while a free person must still
+        start something.
+    budget : int or None
+        Concurrent: deviations the person may still make (None: unbounded).
     """
 
     state: int
@@ -98,6 +143,11 @@ class Advice:
     elapsed: float
     bound: float
     finished: bool
+    deviations: int = 0
+    turn_model: str = "alternate"
+    instructions: list = field(default_factory=list)
+    finishes: list = field(default_factory=list)
+    budget: int | None = None
 
     @property
     def total_bound(self) -> float:
@@ -116,6 +166,7 @@ class _Cursor:
     elapsed: float = 0.0
     running: int = -1  # move index of the running operation, or -1
     history: list = field(default_factory=list)
+    deviations: int = 0
 
 
 class Advisor:
@@ -127,12 +178,23 @@ class Advisor:
         A plan document (``asmplan-plan/2``), as read by :func:`asmplan.planfile.read_plan`.
     """
 
+    def __new__(cls, plan: dict):
+        turn = plan.get("policy", {}).get("turn_model") if isinstance(plan, dict) else None
+        if cls is Advisor and turn == "concurrent":
+            return super().__new__(ConcurrentAdvisor)
+        return super().__new__(cls)
+
     def __init__(self, plan: dict):
+        self._read(plan, "alternate")
+        self._cursor = _Cursor(self._policy["start"])
+        self._cursor.state = self._skip_passes(self._cursor.state)
+
+    def _read(self, plan: dict, turn_model: str) -> None:
+        """Check the plan and index its policy's operations and agents."""
         check_plan(plan)
-        if plan["policy"]["turn_model"] != "alternate":
-            raise ValueError(
-                f"advisor: turn model {plan['policy']['turn_model']!r} is not supported yet"
-            )
+        if plan["policy"]["turn_model"] != turn_model:
+            got = plan["policy"]["turn_model"]
+            raise ValueError(f"advisor: expected a plan of turn model {turn_model}, got {got!r}")
         self.plan = plan
         self._policy = plan["policy"]
         self._ops = self._policy["operations"]
@@ -140,8 +202,6 @@ class Advisor:
         self._agents = self._policy["agents"]
         self._agent_index = {a: k for k, a in enumerate(self._agents)}
         self._operations = plan.get("operations", {})
-        self._cursor = _Cursor(self._policy["start"])
-        self._cursor.state = self._skip_passes(self._cursor.state)
 
     # ------------------------------------------------------------------ queries
     @property
@@ -159,12 +219,7 @@ class Advisor:
         states, moves = self._policy["states"], self._policy["moves"]
         i = c.state
         done = self._done(i)
-        tools = {
-            name: values[k]
-            for (name, values), k in zip(
-                self._policy["tools"].items(), states["tools"][i], strict=False
-            )
-        }
+        tools = self._tools(i)
         running = [
             {"agent": a, "operation": op, "remaining": r} for a, op, r in states["running"][i]
         ]
@@ -207,6 +262,7 @@ class Advisor:
             elapsed=c.elapsed,
             bound=bound,
             finished=self.finished,
+            deviations=c.deviations,
         )
 
     # ------------------------------------------------------------------ observing
@@ -219,16 +275,7 @@ class Advisor:
             The plan cannot explain the observation (the state is unchanged).
         """
         ev = Event.parse(event)
-        if ev.operation not in self._op_index:
-            raise ObservationError(f"unknown operation {ev.operation!r}")
-        if ev.agent not in self._agent_index:
-            raise ObservationError(f"unknown agent {ev.agent!r}")
-        allowed = self._operations.get(ev.operation, {}).get("agents")
-        if allowed is not None and ev.agent not in allowed:
-            raise ObservationError(
-                f"agent {ev.agent} may not do operation {ev.operation} "
-                f"(allowed: {', '.join(allowed)})"
-            )
+        self._check(ev)
         c = self._cursor
         if self.finished:
             raise ObservationError(f"{ev.kind} {ev.operation} by {ev.agent}: the game is over")
@@ -247,6 +294,10 @@ class Advisor:
             self._finish(c.running)
         else:
             j = self._find_move(ev)
+            told = self._policy["states"]["instruction"][c.state]
+            moves = self._policy["moves"]
+            if told is not None and [moves["operation"][j], moves["agent"][j]] != told:
+                c.deviations += 1
             if ev.kind == "started":
                 c.running = j
             else:
@@ -286,6 +337,31 @@ class Advisor:
         raise ObservationError(f"{what}: operation {ev.operation} is not enabled in this state")
 
     # ------------------------------------------------------------------ helpers
+    def _check(self, ev: Event) -> tuple[int, int]:
+        """The operation and agent indices of ``ev``; an error naming an unknown one or an
+        agent the operation does not allow (a worker ``A:human`` is agent ``A``)."""
+        if ev.operation not in self._op_index:
+            raise ObservationError(f"unknown operation {ev.operation!r}")
+        if ev.agent not in self._agent_index:
+            raise ObservationError(
+                f"unknown agent {ev.agent!r} (agents: {', '.join(self._agents)})"
+            )
+        allowed = self._operations.get(ev.operation, {}).get("agents")
+        if allowed is not None and ev.agent.split(":")[0] not in allowed:
+            raise ObservationError(
+                f"agent {ev.agent} may not do operation {ev.operation} "
+                f"(allowed: {', '.join(allowed)})"
+            )
+        return self._op_index[ev.operation], self._agent_index[ev.agent]
+
+    def _tools(self, i: int) -> dict:
+        return {
+            name: values[k]
+            for (name, values), k in zip(
+                self._policy["tools"].items(), self._policy["states"]["tools"][i], strict=False
+            )
+        }
+
     def _moves(self, i: int) -> range:
         ptr = self._policy["moves"]["ptr"]
         return range(ptr[i], ptr[i + 1])
@@ -322,3 +398,349 @@ class Advisor:
         for ev in events:
             advisor.observe(ev)
         return advisor
+
+
+# --------------------------------------------------------------------------- concurrent
+
+
+@dataclass(frozen=True)
+class _Branch:
+    """One way the concurrent game may stand given the observations (module docstring).
+
+    ``state`` is a human state of the policy (the robots' commitment taken) or the end
+    state; ``commit`` the robots' starts and the instructions of that commitment;
+    ``confirmed`` the robot starts seen; ``unreported`` the operations that finished with
+    the last completion and are not reported yet.
+    """
+
+    state: int
+    elapsed: float
+    commit: tuple = ()
+    told: tuple = ()
+    confirmed: frozenset = frozenset()
+    unreported: frozenset = frozenset()
+    pending: tuple = ()  # (op, agent): the people's starts since the last completion
+    fixed: tuple = ()  # (op, agent, duration) of the starts observed with their duration
+
+
+class ConcurrentAdvisor(Advisor):
+    """The runtime advisor of a concurrent plan (module docstring); ``Advisor(plan)`` returns
+    one for a plan of turn model ``concurrent``."""
+
+    def __init__(self, plan: dict):
+        self._read(plan, "concurrent")
+        sides = plan.get("agents", {})
+        self._robot = [_worker_side(a, sides) == "robot" for a in self._agents]
+        self._events: list[Event] = []
+        self._deviations = 0
+        self._branches = [self._commit(self._policy["start"], 0.0)]
+
+    # ------------------------------------------------------------------ queries
+    @property
+    def history(self) -> list[Event]:
+        return list(self._events)
+
+    @property
+    def finished(self) -> bool:
+        b = self._branches[0]
+        return len(self._moves(b.state)) == 0 and not b.unreported
+
+    def advice(self) -> Advice:
+        states = self._policy["states"]
+        b = self._branches[0]
+        i = b.state
+        told = {a: o for o, a in b.told if a not in self._busy(b)}
+        instructions = [
+            {
+                "agent": self._agents[a],
+                "operation": None if o < 0 else self._ops[o],
+                "description": "wait" if o < 0 else self._description(o),
+            }
+            for a, o in told.items()
+        ]
+        instruction = next(
+            (self._op_dict(o, a) for a, o in told.items() if o >= 0 and not self.finished), None
+        )
+        running = [
+            {"agent": a, "operation": op, "remaining": r} for a, op, r in states["running"][i]
+        ]
+        for o, a in b.pending:
+            durations = [
+                d
+                for br in self._branches
+                for m in self._consistent(br, set(br.pending))
+                for so, sa, d in self._policy["moves"]["starts"][m]
+                if (so, sa) == (o, a)
+            ]
+            running.append(
+                {
+                    "agent": self._agents[a],
+                    "operation": self._ops[o],
+                    "remaining": max(durations, default=0),
+                }
+            )
+        total = max(br.elapsed + self._remaining(br) for br in self._branches)
+        done = self._done(i)
+        return Advice(
+            state=i,
+            turn="end" if self.finished else "human",
+            done=done,
+            parts=[p for op in done for p in self._operations.get(op, {}).get("parts", [])],
+            tools=self._tools(i),
+            running=running,
+            robots=[
+                {**self._op_dict(o, a), "confirmed": (o, a) in b.confirmed} for o, a in b.commit
+            ],
+            instruction=instruction,
+            options=self._options(told),
+            elapsed=b.elapsed,
+            bound=total - b.elapsed,
+            finished=self.finished,
+            deviations=self._deviations,
+            turn_model="concurrent",
+            instructions=instructions,
+            finishes=self._finishes(),
+            budget=states["budget"][i],
+        )
+
+    def _options(self, told: dict) -> list[dict]:
+        """Every operation a free person may start now, with the worst case it leads to."""
+        moves, states = self._policy["moves"], self._policy["states"]
+        worst: dict = {}
+        for br in self._branches:
+            busy = self._busy(br)
+            pending = set(br.pending)
+            for m in self._consistent(br, pending):
+                after = br.elapsed + moves["cost"][m] + states["bound"][moves["next"][m]]
+                for o, a, d in moves["starts"][m]:
+                    if (o, a) in pending or a in busy:
+                        continue
+                    w, dur = worst.get((o, a), (-math.inf, 0))
+                    worst[(o, a)] = (max(w, after), max(dur, d))
+        out = []
+        for (o, a), (w, dur) in sorted(worst.items()):
+            item = self._op_dict(o, a)
+            item.update(cost=dur, worst=w, deviation=a in told and told[a] != o)
+            out.append(item)
+        return out
+
+    def _finishes(self) -> list[dict]:
+        """The completions the plan can explain next (every branch, given the starts)."""
+        moves, states = self._policy["moves"], self._policy["states"]
+        out: dict = {}
+        for br in self._branches:
+            pending = set(br.pending)
+            for o, a in br.unreported:
+                out[(o, a, br.elapsed)] = max(
+                    out.get((o, a, br.elapsed), -math.inf), br.elapsed + self._bound(br.state)
+                )
+            if br.unreported:
+                continue
+            running = self._running(br.state) | pending
+            for m in self._consistent(br, pending, exact=True):
+                t = br.elapsed + moves["cost"][m]
+                after = t + states["bound"][moves["next"][m]]
+                for o, a in running - self._running(moves["next"][m]):
+                    out[(o, a, t)] = max(out.get((o, a, t), -math.inf), after)
+        return [
+            {"operation": self._ops[o], "agent": self._agents[a], "time": t, "worst": w}
+            for (o, a, t), w in sorted(out.items(), key=lambda kv: (kv[0][2], kv[0][:2]))
+        ]
+
+    # ------------------------------------------------------------------ observing
+    def observe(self, event) -> Advice:
+        """Take one observation, as :meth:`Advisor.observe` (the rules: module docstring)."""
+        ev = Event.parse(event)
+        o, a = self._check(ev)
+        what = f"{ev.operation} {ev.kind} by {ev.agent}"
+        if self.finished:
+            raise ObservationError(f"{what}: the game is over")
+        deviations = self._deviations
+        kept, errors = [], []
+        for br in self._branches:
+            try:
+                if ev.kind == "started":
+                    kept += self._start(br, o, a, what, ev.duration)
+                else:
+                    kept += self._finish(br, o, a, what)
+            except ObservationError as exc:
+                errors.append(exc)
+        if not kept:
+            raise errors[0]
+        if ev.kind == "started" and not self._robot[a]:
+            told = dict((x, y) for y, x in self._branches[0].told)
+            if a in told and told[a] != o:
+                deviations += 1
+        if ev.time is not None and ev.kind == "finished":
+            nearest = min(abs(br.elapsed - ev.time) for br in kept)
+            kept = [br for br in kept if abs(br.elapsed - ev.time) <= nearest + 1e-9]
+        # The robots do what the advisor answers (the worst branch's commitment).
+        kept = sorted(
+            set(kept),
+            key=lambda br: (-(br.elapsed + self._remaining(br)), br.state),
+        )
+        head = kept[0]
+        self._branches = [br for br in kept if (br.commit, br.told) == (head.commit, head.told)]
+        self._deviations = deviations
+        self._events.append(ev)
+        return self.advice()
+
+    def _start(
+        self, br: _Branch, o: int, a: int, what: str, duration: float | None = None
+    ) -> list[_Branch]:
+        i = br.state
+        name = self._ops[o]
+        if self._robot[a]:
+            if (o, a) in br.confirmed:
+                raise ObservationError(f"{what}: {name} by {self._agents[a]} is already running")
+            if (o, a) in br.commit:
+                return [_replace(br, confirmed=br.confirmed | {(o, a)})]
+            plan = ", ".join(f"{self._ops[x]} by {self._agents[y]}" for x, y in br.commit)
+            raise ObservationError(
+                f"{what} is not the plan's move (the robots' commitment: {plan or 'wait'})"
+            )
+        if name in self._done(i):
+            raise ObservationError(f"{what}: operation {name} is already done")
+        running = self._running(i) | set(br.pending)
+        for x, y in running:
+            if x == o:
+                raise ObservationError(
+                    f"{what}: operation {name} is already running (by {self._agents[y]})"
+                )
+            if y == a:
+                raise ObservationError(
+                    f"{what}: {self._agents[a]} is busy with operation {self._ops[x]}"
+                )
+        want = set(br.pending) | {(o, a)}
+        fixed = br.fixed if duration is None else (*br.fixed, (o, a, duration))
+        if self._consistent(br, want, fixed=fixed):
+            return [_replace(br, pending=(*br.pending, (o, a)), fixed=fixed)]
+        if duration is not None and self._consistent(br, want):
+            took = sorted(
+                {
+                    d
+                    for m in self._consistent(br, want)
+                    for x, y, d in self._policy["moves"]["starts"][m]
+                    if (x, y) == (o, a)
+                }
+            )
+            raise ObservationError(
+                f"{what}: duration {duration:g} is not one the plan knows "
+                f"({', '.join(f'{d:g}' for d in took)})"
+            )
+        moves = self._policy["moves"]
+        alone = any((o, a) in {(x, y) for x, y, _ in moves["starts"][m]} for m in self._moves(i))
+        budget = self._policy["states"]["budget"][i]
+        told = dict((y, x) for x, y in br.told)
+        if alone:
+            raise ObservationError(
+                f"{what}: operation {name} cannot start together with "
+                + ", ".join(f"{self._ops[x]} by {self._agents[y]}" for x, y in br.pending)
+            )
+        if budget == 0 and a in told and told[a] != o:
+            ask = "wait" if told[a] < 0 else f"do {self._ops[told[a]]}"
+            raise ObservationError(
+                f"{what}: the plan's deviation budget is spent (the person was asked to {ask})"
+            )
+        raise ObservationError(f"{what}: operation {name} is not enabled in this state")
+
+    def _finish(self, br: _Branch, o: int, a: int, what: str) -> list[_Branch]:
+        if (o, a) in br.unreported:
+            return [_replace(br, unreported=br.unreported - {(o, a)})]
+        if br.unreported:
+            left = ", ".join(f"{self._ops[x]} by {self._agents[y]}" for x, y in br.unreported)
+            raise ObservationError(f"{what}: {left} finished at the same time; report it first")
+        moves = self._policy["moves"]
+        i = br.state
+        pending = set(br.pending)
+        running = self._running(i) | pending
+        if (o, a) not in running:
+            now = ", ".join(f"{self._ops[x]} by {self._agents[y]}" for x, y in sorted(running))
+            raise ObservationError(f"{what}: it is not running (running: {now or 'nothing'})")
+        candidates = self._consistent(br, pending, exact=True)
+        if not candidates:
+            raise ObservationError(
+                f"{what}: the plan has no completion before a free person starts an operation "
+                "(a person with something to do does not idle unless asked to wait)"
+            )
+        out = []
+        for m in candidates:
+            nxt = moves["next"][m]
+            ended = running - self._running(nxt)
+            if (o, a) in ended:
+                b = self._commit(nxt, br.elapsed + moves["cost"][m])
+                out.append(_replace(b, unreported=frozenset(ended - {(o, a)})))
+        if not out:
+            raise ObservationError(f"{what}: it cannot finish first in the plan (see finishes)")
+        return out
+
+    # ------------------------------------------------------------------ helpers
+    def _commit(self, i: int, elapsed: float) -> _Branch:
+        """The branch after the robots' commitment at robot state ``i`` (or at the end)."""
+        r = self._moves(i)
+        if len(r) == 0:
+            return _Branch(i, elapsed)
+        j = r.start
+        states, moves = self._policy["states"], self._policy["moves"]
+        commit = tuple((o, a) for o, a, _ in moves["starts"][j])
+        told = tuple(tuple(x) for x in states["instruction"][i] or ())
+        return _Branch(moves["next"][j], elapsed, commit, told)
+
+    def _consistent(
+        self, br: _Branch, starts: set, exact: bool = False, fixed: tuple | None = None
+    ) -> list[int]:
+        """Moves of ``br``'s state that start ``starts`` (and nothing else when ``exact``),
+        with the durations observed (``fixed``, default the branch's)."""
+        moves = self._policy["moves"]
+        fixed = br.fixed if fixed is None else fixed
+        out = []
+        for m in self._moves(br.state):
+            have = {(x, y) for x, y, _ in moves["starts"][m]}
+            if not (have == starts if exact else starts <= have):
+                continue
+            took = {(x, y): d for x, y, d in moves["starts"][m]}
+            if all(abs(took[(x, y)] - d) <= 1e-6 for x, y, d in fixed if (x, y) in took):
+                out.append(m)
+        return out
+
+    def _remaining(self, br: _Branch) -> float:
+        """The guaranteed remaining makespan of a branch given the people's starts."""
+        moves, states = self._policy["moves"], self._policy["states"]
+        pending = set(br.pending)
+        if not pending:
+            return self._bound(br.state)
+        return max(
+            (
+                moves["cost"][m] + states["bound"][moves["next"][m]]
+                for m in self._consistent(br, pending)
+            ),
+            default=self._bound(br.state),
+        )
+
+    def _bound(self, i: int) -> float:
+        return self._policy["states"]["bound"][i]
+
+    def _running(self, i: int) -> set:
+        return {
+            (self._op_index[op], self._agent_index[a])
+            for a, op, _ in self._policy["states"]["running"][i]
+        }
+
+    def _busy(self, br: _Branch) -> set:
+        return {a for _, a in self._running(br.state) | set(br.pending)}
+
+    def _description(self, o: int) -> str:
+        return self._operations.get(self._ops[o], {}).get("description", "")
+
+
+def _replace(br: _Branch, **changes) -> _Branch:
+    from dataclasses import replace
+
+    return replace(br, **changes)
+
+
+def _worker_side(worker: str, sides: dict) -> str:
+    """The side of a worker of the concurrent game (``A:robot`` / ``A:human`` for side ``any``)."""
+    if ":" in worker:
+        return worker.rsplit(":", 1)[1]
+    return sides.get(worker, "")

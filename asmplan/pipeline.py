@@ -252,7 +252,12 @@ def relations(spec: AssemblySpec, *, progress: bool = False) -> Relations | None
 
 
 def load(
-    source: str | os.PathLike[str], *, progress: bool = False, on_step: Progress | None = None
+    source: str | os.PathLike[str],
+    *,
+    progress: bool = False,
+    on_step: Progress | None = None,
+    contact_tol: float | None = None,
+    penetration_tol: float | None = None,
 ) -> Assembly:
     """:func:`load_assembly` and, when the spec has meshes, its :func:`relations`.
 
@@ -260,12 +265,13 @@ def load(
     warning; its gravity is chosen from the relations (:mod:`asp.gravity`: the format's
     own down unless another direction is clearly better), said in a note; its placements
     of parts nothing can keep from falling become ``held``
-    (:func:`asp.generate.hold_unsupported`), named in a further note.
+    (:func:`asp.generate.hold_unsupported`), named in a further note. ``contact_tol`` and
+    ``penetration_tol`` (mm) replace the spec's tolerances when given.
     """
     from asp.feasibility import load_relations
     from asp.generate import HELD_REASON, hold_unsupported, orient_generated, spec_geometry
 
-    spec = load_assembly(source)
+    spec = with_tolerances(load_assembly(source), contact_tol, penetration_tol)
 
     def note(text: str) -> None:
         if on_step is not None:
@@ -294,6 +300,22 @@ def load(
         if held:
             note(f"generated spec: held: true for {', '.join(held)} ({HELD_REASON})")
     return Assembly(spec=spec, relations=rel)
+
+
+def with_tolerances(
+    spec: AssemblySpec, contact_tol: float | None = None, penetration_tol: float | None = None
+) -> AssemblySpec:
+    """``spec`` with the tolerances given (mm) in place of its own; None keeps the spec's."""
+    from dataclasses import replace
+
+    from cad.tolerances import checked_tolerance
+
+    changes = {
+        key: checked_tolerance(value, key)
+        for key, value in (("contact_tol", contact_tol), ("penetration_tol", penetration_tol))
+        if value is not None
+    }
+    return replace(spec, **changes) if changes else spec
 
 
 def part_relations(
@@ -326,12 +348,26 @@ def part_relations(
     """
     import cad
 
+    spec = _spec_file(source)
+    if spec is not None:  # the spec's own tolerances unless others are given
+        contact_tol = spec.contact_tol if contact_tol is None else contact_tol
+        penetration_tol = spec.penetration_tol if penetration_tol is None else penetration_tol
     return cad.compute_relations(
         part_geometry(source, units=units),
         contact_tol=contact_tol,
         penetration_tol=penetration_tol,
         progress=progress,
     )
+
+
+def _spec_file(source: str | os.PathLike[str]) -> AssemblySpec | None:
+    """The spec of a YAML file or of a folder holding ``assembly.yaml`` (else None)."""
+    from asp.spec import SPEC_FILE, load_spec
+
+    path = Path(source)
+    if path.suffix.lower() in (".yaml", ".yml") or (path.is_dir() and (path / SPEC_FILE).is_file()):
+        return load_spec(path)
+    return None
 
 
 def part_geometry(source: str | os.PathLike[str], *, units: str | None = None):
@@ -344,13 +380,11 @@ def part_geometry(source: str | os.PathLike[str], *, units: str | None = None):
 
     import cad
     from asp.generate import spec_geometry
-    from asp.spec import SPEC_FILE, load_spec
 
-    path = Path(source)
-    if path.suffix.lower() in (".yaml", ".yml") or (path.is_dir() and (path / SPEC_FILE).is_file()):
-        spec = load_spec(path)
+    spec = _spec_file(source)
+    if spec is not None:
         return spec_geometry(spec if units is None else replace(spec, units=units))
-    return cad.load_assembly(path, units=units)
+    return cad.load_assembly(Path(source), units=units)
 
 
 def state_graph(
@@ -509,6 +543,8 @@ def plan(
     duration_step: float | None = 1.0,
     on_step: Progress | None = None,
     max_states: int | None = None,
+    contact_tol: float | None = None,
+    penetration_tol: float | None = None,
 ) -> AssemblyPlan:
     """Plan an assembly end to end, as ``asmplan plan`` does.
 
@@ -534,6 +570,9 @@ def plan(
         Called with one line before each step (progress for a person).
     max_states : int, optional
         State graph limit (default: the spec's ``max_states``, else 20,000,000).
+    contact_tol, penetration_tol : float, optional
+        Tolerances in mm for every pair (default: the spec's, else the per-part rule of
+        :mod:`cad.tolerances`); ignored when ``source`` is an :class:`Assembly`.
 
     Returns
     -------
@@ -544,7 +583,17 @@ def plan(
 
     say = on_step or (lambda _message: None)
     say("[1/5] reading the assembly and computing part relations ...")
-    assembly = source if isinstance(source, Assembly) else load(source, progress=True, on_step=say)
+    assembly = (
+        source
+        if isinstance(source, Assembly)
+        else load(
+            source,
+            progress=True,
+            on_step=say,
+            contact_tol=contact_tol,
+            penetration_tol=penetration_tol,
+        )
+    )
     summary = relations_summary(assembly.relations) if assembly.relations is not None else []
     say("[2/5] building the assembly state graph ...")
     graph = state_graph(assembly, max_states=max_states, on_step=on_step)

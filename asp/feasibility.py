@@ -647,12 +647,17 @@ def load_relations(spec: AssemblySpec, *, progress: bool = False, geometry=None)
     """Compute the cad relations of ``spec``'s parts (``None`` when it has no geometry).
 
     Reads the meshes of the spec's parts (:func:`asp.generate.spec_geometry`) unless
-    ``geometry`` (that ``cad.Assembly``, already read) is given.
+    ``geometry`` (that ``cad.Assembly``, already read) is given, with the spec's
+    ``contact_tol`` and ``penetration_tol`` (None: the per-part rule).
     """
     if not spec.has_geometry:
         return None
     import cad
     from asp.generate import spec_geometry
 
-    geometry = spec_geometry(spec) if geometry is None else geometry
-    return cad.compute_relations(geometry, progress=progress)
+    return cad.compute_relations(
+        spec_geometry(spec) if geometry is None else geometry,
+        contact_tol=spec.contact_tol,
+        penetration_tol=spec.penetration_tol,
+        progress=progress,
+    )

@@ -300,23 +300,38 @@ def orient_generated(spec: AssemblySpec, relations, geometry):
     choice = gravity_choice(relations, geometry, spec.gravity)
     if choice.gravity == spec.gravity:
         return spec, choice
+    from dataclasses import replace
+
     with warnings.catch_warnings():  # the same files again: their warnings were given
         warnings.simplefilter("ignore")
-        return generated_spec(spec.source, gravity=choice.gravity), choice
+        turned = generated_spec(spec.source, gravity=choice.gravity)
+    tolerances = {"contact_tol": spec.contact_tol, "penetration_tol": spec.penetration_tol}
+    return replace(turned, **tolerances), choice
 
 
-def spec_text(path: str | Path, spec_folder: str | Path | None = None, on_note=None) -> str:
+def spec_text(
+    path: str | Path,
+    spec_folder: str | Path | None = None,
+    *,
+    contact_tol: float | None = None,
+    penetration_tol: float | None = None,
+    on_note=None,
+) -> str:
     """The generated spec of a CAD file or folder as a commented ``assembly.yaml``.
 
-    Part files are relative to ``spec_folder``, where the file will be written;
-    ``on_note`` (optional) is called with a line saying which gravity was chosen and why.
+    Part files are relative to ``spec_folder``, where the file will be written. Tolerances
+    given (mm) are written as the spec's ``contact_tol`` / ``penetration_tol`` and used for
+    the ``held`` marks; else both keys are written commented out. ``on_note`` (optional) is
+    called with a line saying which gravity was chosen and why.
     """
     import warnings
 
     import cad
 
     data, assembly = spec_data(path, spec_folder)
-    relations = cad.compute_relations(assembly)
+    relations = cad.compute_relations(
+        assembly, contact_tol=contact_tol, penetration_tol=penetration_tol
+    )
     choice = gravity_choice(relations, assembly, data["gravity"])
     if choice.gravity != data["gravity"]:
         with warnings.catch_warnings():
@@ -373,6 +388,8 @@ def spec_text(path: str | Path, spec_folder: str | Path | None = None, on_note=N
         "constraints: {topological: true, stability: true, functional: true}",
         "turn_model: alternate",
         "cost: time                 # or steps (1 per operation)",
+        _tolerance_line("contact_tol", contact_tol, "largest gap that counts as touching"),
+        _tolerance_line("penetration_tol", penetration_tol, "largest overlap that still touches"),
         "",
         "operations:   # one placement per part: base first, then from the lowest part up",
     ]
@@ -386,6 +403,13 @@ def spec_text(path: str | Path, spec_folder: str | Path | None = None, on_note=N
             f"agents: {{{agents}}}, part: {op['part']}" + (", held: true}" if hold else "}")
         )
     return "\n".join(lines) + "\n"
+
+
+def _tolerance_line(key: str, value: float | None, meaning: str) -> str:
+    """``key: value`` with a comment, or commented out when the default rule applies."""
+    if value is None:
+        return f"# {key}: 0.1   # mm, {meaning} (default: per part, cad/tolerances.py)"
+    return f"{key}: {json_number(float(value))}   # mm, {meaning}, every pair"
 
 
 def _scalar(value) -> str:

@@ -19,6 +19,10 @@ An ``assembly.yaml`` names everything the planner needs besides the part geometr
     turn_model: alternate              # or concurrent (asp/concurrent.py)
     cost: steps                        # or time
     max_states: 20000000               # state graph limit (asmplan plan --max-states)
+    contact_tol: 0.1                   # mm, largest gap that counts as touching, every pair
+    penetration_tol: 0.3               # mm, largest overlap that counts as touching
+                                       # (both default to cad/tolerances.py's per-part rule;
+                                       # --contact-tol / --penetration-tol override them)
     subassemblies:                     # built on their own, then inserted as one unit
       motor_unit: [MT, PC]             # an operation "motor_unit" inserting it is added
     operations:
@@ -64,6 +68,7 @@ from asp.dag import MAX_COST
 from asp.rules import COST_MODELS
 from cad.bom import PartRecord, part_records, refuse_unknown_keys
 from cad.directions import DIRECTIONS
+from cad.tolerances import checked_tolerance
 from cad.units import unit_scale
 from cad.yamlfile import read_yaml
 
@@ -74,6 +79,7 @@ SPEC_FILE = "assembly.yaml"
 TOP_KEYS = (
     "name", "units", "parts", "agents", "tools", "base_part", "gravity", "gripper_approach",
     "constraints", "turn_model", "cost", "operations", "credit", "max_states", "subassemblies",
+    "contact_tol", "penetration_tol",
 )  # fmt: skip
 """The top-level keys of ``assembly.yaml``; any other is refused."""
 OPERATION_KEYS = (
@@ -191,6 +197,10 @@ class AssemblySpec:
     generated: bool = False
     subassemblies: tuple[tuple[str, tuple[str, ...]], ...] = ()
     """Units built in their own workspace and inserted whole: (unit id, member part ids)."""
+    contact_tol: float | None = None
+    """Contact tolerance (mm) for every pair; None: the per-part rule of cad.tolerances."""
+    penetration_tol: float | None = None
+    """Penetration tolerance (mm) for every pair; None: the per-part rule of cad.tolerances."""
 
     @property
     def op_ids(self) -> tuple[str, ...]:
@@ -379,6 +389,12 @@ class _Parser:
             isinstance(max_states, bool) or not isinstance(max_states, int) or max_states < 1
         ):
             raise self.fail("max_states", f"expected a positive integer, got {max_states!r}")
+        tols = {}
+        for key in ("contact_tol", "penetration_tol"):
+            try:
+                tols[key] = checked_tolerance(data.get(key), key)
+            except ValueError as exc:
+                raise ValueError(f"{self.source}: {exc}") from None
         spec = AssemblySpec(
             name=str(data.get("name") or Path(self.source).parent.name or "assembly"),
             operations=ops,
@@ -395,6 +411,7 @@ class _Parser:
             units=None if units is None else str(units),
             credit=str(data.get("credit", "")),
             max_states=max_states,
+            **tols,
         )
         raw_units = self.mapping(data.get("subassemblies"), "subassemblies")
         if not raw_units:

@@ -1,17 +1,28 @@
-"""Plan real CAD assemblies with default settings and check every plan independently.
+"""Plan real CAD assemblies as a new user would and check every plan independently.
 
-For each assembly (a CAD file, a folder of part meshes or an ``assembly.yaml``; default: the
-Fabrica assemblies in ``../shared/data/cad/fabrica/`` and the built rod tower, bolted bracket
-and finger box), in a fresh process each: ``asmplan.pipeline.plan`` with defaults, then
-:func:`asp.checker.check_line` on the plan's principal line. Prints one row per assembly:
-parts, units (subassemblies), states, seconds per stage, peak memory, TCT, W*, checker.
+For each assembly (a CAD file, a folder of part meshes or an ``assembly.yaml``), in a child
+process of its own: ``asmplan plan PATH -o OUT`` with default settings (the command line, a
+time limit per assembly), then :func:`asp.checker.check_line` on the plan's principal line
+against relations loaded afresh from the same file. Prints one row per assembly: parts, parts
+``held``, subassemblies, length unit, states, seconds, peak memory of the plan command, TCT,
+W*, the CP-SAT status and the checker's verdict, or the error (the command's last stderr line).
 
-Run: ``.venv/bin/python benchmarks/plan_real_cad.py [PATH ...]``
+Assemblies, by default: the Fabrica assemblies in ``../shared/data/cad/fabrica/``, the built
+rod tower, bolted bracket and finger box (tests/cad), and every public CAD file found under
+the folders of ``$ASMPLAN_REAL_CAD`` (``:``-separated; default ``/tmp/realcad``), skipped when
+absent: STEP, 3DXML, GLB/glTF and 3MF files, and folders of part meshes (OBJ/STL/PLY).
+Public files are never copied into the repository.
+
+Run: ``.venv/bin/python benchmarks/plan_real_cad.py [--timeout S] [--out DIR] [PATH ...]``
+(a PATH that is a folder of CAD files is searched like the default folders).
 """
 
 from __future__ import annotations
 
+import argparse
 import json
+import os
+import re
 import resource
 import subprocess
 import sys
@@ -24,6 +35,21 @@ sys.path.insert(0, str(ROOT))  # run from a checkout
 
 FABRICA = ROOT.parent / "shared" / "data" / "cad" / "fabrica"
 BUILT = ("rod_tower", "bolted_bracket", "finger_box")
+SCENES = {".step", ".stp", ".3dxml", ".glb", ".gltf", ".3mf"}
+MESHES = {".obj", ".stl", ".ply", ".off"}
+COLUMNS = (
+    "parts",
+    "held",
+    "units",
+    "unit",
+    "states",
+    "total_s",
+    "peak_mb",
+    "tct",
+    "w_star",
+    "cpsat",
+    "checker",
+)
 
 
 def built(name: str, folder: Path) -> Path:
@@ -39,65 +65,148 @@ def built(name: str, folder: Path) -> Path:
     return out
 
 
-def plan_one(path: str) -> dict:
-    """Plan ``path`` in this process and return the row (run in a child process)."""
-    from asmplan import pipeline
-    from asp.checker import check_line, plan_operations
+def find_assemblies(folder: Path) -> list[Path]:
+    """Every CAD scene file under ``folder`` and every folder holding two or more part meshes
+    (or an ``assembly.yaml``), sorted."""
+    found: list[Path] = []
+    for here, dirs, files in os.walk(folder):
+        dirs.sort()
+        here_path = Path(here)
+        if "assembly.yaml" in files:
+            found.append(here_path)
+            dirs.clear()
+            continue
+        if sum(Path(f).suffix.lower() in MESHES for f in files) >= 2:
+            found.append(here_path)
+        found.extend(here_path / f for f in sorted(files) if Path(f).suffix.lower() in SCENES)
+    return found
 
+
+def source_unit(path: str) -> str:
+    """The length unit read from the file and the assembly's size in mm (``"m, 120 mm"``)."""
+    from asmplan import pipeline
+
+    try:
+        geometry = pipeline.part_geometry(path)
+        lo = min(p.mesh.bounds[0].min() for p in geometry.parts)
+        hi = max(p.mesh.bounds[1].max() for p in geometry.parts)
+    except Exception as exc:  # noqa: BLE001 - reported in the row
+        return f"? ({str(exc)[:80]})"
+    return f"{geometry.units}, {hi - lo:.0f} mm"
+
+
+def check_plan(path: str, doc: dict) -> str:
+    """``"ok"`` if the independent checker accepts the plan's principal line, else why not."""
+    from asmplan import pipeline
+    from asp.checker import PlanCheckError, check_line, plan_operations
+    from asp.spec import with_subassemblies
+
+    assembly = pipeline.load(path, on_step=lambda _: None)
+    spec = assembly.spec
+    units = doc.get("subassemblies") or {}
+    if units:
+        spec = with_subassemblies(spec, units.items())
+    ops = plan_operations(doc)
+    try:
+        check_line(spec, assembly.relations, ops)
+    except PlanCheckError as exc:
+        return f"REJECTED: {exc}"
+    return "ok"
+
+
+def plan_one(path: str, out: str, timeout: float) -> dict:
+    """Run ``asmplan plan path -o out`` in a child and check its plan (this process is a
+    child of :func:`main`, so its children's peak memory is the plan command's)."""
     row: dict = {"assembly": Path(path).name}
+    cmd = [sys.executable, "-c", "from asmplan.cli import main; main()", "plan", path, "-o", out]
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
     t0 = time.perf_counter()
     try:
-        assembly = pipeline.load(path)
-        t1 = time.perf_counter()
-        graph = pipeline.state_graph(assembly)
-        t2 = time.perf_counter()
-        result = pipeline.plan(pipeline.Assembly(graph.spec, assembly.relations), time_limit=30)
-        t3 = time.perf_counter()
-        doc = result.to_dict()
-        check_line(graph.spec, assembly.relations, plan_operations(doc))
-        row.update(
-            parts=len(graph.spec.part_ids),
-            units=len(graph.spec.subassemblies),
-            states=graph.n_states,
-            relations_s=round(t1 - t0, 2),
-            graph_s=round(t2 - t1, 2),
-            game_cpsat_s=round(t3 - t2, 2),
-            tct=doc["tct"],
-            w_star=doc["minimax"],
-            checker="ok",
-        )
+        run = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout, env=env)
+    except subprocess.TimeoutExpired as exc:
+        row["error"] = f"timeout after {timeout:.0f} s"
+        stderr = exc.stderr.decode() if isinstance(exc.stderr, bytes) else exc.stderr or ""
+        last = [s for s in re.split(r"[\r\n]", stderr) if s.strip()]
+        row["error"] += f" (last: {last[-1][:200]})" if last else ""
+        run = None
+    row["total_s"] = round(time.perf_counter() - t0, 1)
+    row["peak_mb"] = round(resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024)
+    if run is None:
+        return row
+    text = run.stdout + run.stderr
+    held = re.search(r"held: true for ([^(]*)\(", text)
+    row["held"] = len(held.group(1).split(",")) if held else 0
+    row["unit"] = source_unit(path)
+    if run.returncode != 0:
+        lines = [s for s in run.stderr.splitlines() if s.strip()]
+        row["error"] = lines[-1][:400] if lines else f"exit code {run.returncode}"
+        return row
+    doc = json.loads((Path(out) / "plan.json").read_text())
+    sched = doc.get("schedule") or {}
+    row.update(
+        parts=len(doc["parts"]),
+        units=len(doc.get("subassemblies") or {}),
+        states=doc.get("states"),
+        tct=doc["tct"],
+        w_star=doc["minimax"],
+        cpsat=f"{sched.get('status', '')} {sched.get('objective', '')}".strip(),
+    )
+    try:
+        row["checker"] = check_plan(path, doc)
     except Exception as exc:  # noqa: BLE001 - a row per assembly, whatever went wrong
-        row.update(error=str(exc)[:300])
-    row["total_s"] = round(time.perf_counter() - t0, 2)
-    row["peak_mb"] = round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
+        row["checker"] = f"check failed: {str(exc)[:200]}"
     return row
+
+
+def print_row(row: dict) -> None:
+    if "error" in row:
+        cells = [str(row.get(c, "")) for c in ("parts", "held", "units", "unit")]
+        cells += ["", str(row.get("total_s", "")), str(row.get("peak_mb", ""))]
+        print(f"| {row['assembly']} | " + " | ".join(cells) + f" | error: {row['error']} |")
+    else:
+        print(f"| {row['assembly']} | " + " | ".join(str(row.get(c, "")) for c in COLUMNS) + " |")
+    sys.stdout.flush()
 
 
 def main(argv: list[str]) -> None:
     if argv[:1] == ["--one"]:
-        print(json.dumps(plan_one(argv[1])))
+        print(json.dumps(plan_one(argv[1], argv[2], float(argv[3]))))
         return
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("paths", nargs="*", help="assemblies, or folders to search for them")
+    parser.add_argument("--timeout", type=float, default=300.0, help="seconds per assembly")
+    parser.add_argument("--out", default=None, help="keep each plan in OUT/<name> (default: temp)")
+    args = parser.parse_args(argv)
     with tempfile.TemporaryDirectory() as tmp:
-        paths = argv or [
-            *(str(p) for p in sorted(FABRICA.iterdir()) if p.is_dir()),
-            *(str(built(name, Path(tmp))) for name in BUILT),
-        ]
-        cols = ("parts", "units", "states", "total_s", "peak_mb", "tct", "w_star", "checker")
-        print("| assembly | " + " | ".join(cols) + " |")
-        print("|---" * (len(cols) + 1) + "|")
-        for path in paths:
-            out = subprocess.run(
-                [sys.executable, __file__, "--one", path], capture_output=True, text=True
+        if args.paths:
+            paths = []
+            for p in map(Path, args.paths):
+                paths += find_assemblies(p) if p.is_dir() else [p]
+        else:
+            folders = os.environ.get("ASMPLAN_REAL_CAD", "/tmp/realcad").split(":")
+            paths = [p for p in sorted(FABRICA.iterdir()) if p.is_dir()] if FABRICA.is_dir() else []
+            paths += [built(name, Path(tmp)) for name in BUILT]
+            for folder in map(Path, folders):
+                if folder.is_dir():
+                    paths += find_assemblies(folder)
+                else:
+                    print(f"skipped {folder}: not found", file=sys.stderr)
+        out_root = Path(args.out) if args.out else Path(tmp) / "plans"
+        print("| assembly | " + " | ".join(COLUMNS) + " |")
+        print("|---" * (len(COLUMNS) + 1) + "|")
+        for k, path in enumerate(paths):
+            out = out_root / f"{k:03d}_{Path(path).name}"
+            run = subprocess.run(
+                [sys.executable, __file__, "--one", str(path), str(out), str(args.timeout)],
+                capture_output=True,
+                text=True,
             )
             try:
-                row = json.loads(out.stdout.strip().splitlines()[-1])
+                row = json.loads(run.stdout.strip().splitlines()[-1])
             except (IndexError, json.JSONDecodeError):
-                row = {"assembly": Path(path).name, "error": out.stderr.strip()[-300:]}
-            if "error" in row:
-                print(f"| {row['assembly']} | error: {row['error']} |")
-            else:
-                print(f"| {row['assembly']} | " + " | ".join(str(row[c]) for c in cols) + " |")
-            sys.stdout.flush()
+                row = {"assembly": Path(path).name, "error": run.stderr.strip()[-300:]}
+            row["assembly"] = str(path)
+            print_row(row)
 
 
 if __name__ == "__main__":

@@ -20,7 +20,14 @@ Rule
    clearance) is supported; a part with nothing within that distance below falls.
    Faces need not lie flat on each other: inclined faces (a cone, a chamfer, a finger
    flank) stop the fall just as well.
-2. **Threaded on.** i is fitted around j along the gravity axis: j touches i and blocks
+2. **Captured in a hole.** i is fitted in j across the gravity axis (j touches i and
+   blocks it in each of the four directions across ``d``: a pin in a hole, a shaft in a
+   bore) and a fall along ``d`` of at most the *capture travel* ``min(e_i, e_j)``, the
+   shorter of the two parts' extents along ``d``, drives i into j. A dowel drawn a little
+   above the bottom of its blind hole, or a shaft in a bore whose shoulder lies further
+   down, slides along the hole it is guided by and stops on j; it cannot fall away. A pin
+   in a through hole is not captured (nothing of j lies below it).
+3. **Threaded on.** i is fitted around j along the gravity axis: j touches i and blocks
    it in each of the four directions across ``d`` (``TC`` true and ``TT`` false for each:
    a zero-clearance or press fit all round) and j's cross-section at i's mid-height lies
    inside i's (j passes through i). A nut on a bolt, a press-fitted bearing on a
@@ -83,8 +90,12 @@ def support_relation(
     n = len(assembly)
     sp = np.zeros((n, n, 6), dtype=bool)
     travel = SUPPORT_TRAVEL_FACTOR * (tols.shrink[:, None] + tols.shrink[None, :])
+    fitted = [fitted_across(tc, tt, axis) for axis in range(3)]
+    extents = np.array([np.ptp(p.bounds, axis=0) for p in assembly.parts]).reshape(n, 3)
     for axis, a, b, front, back, bounds in facing_pairs(eroded, progress, "support"):
         t = float(travel[a, b])
+        if fitted[axis][a, b]:
+            t = max(t, float(min(extents[a, axis], extents[b, axis])))
         # a falling along +axis is stopped by b (and b falling along -axis by a)
         if bounds[b][0, axis] - bounds[a][1, axis] > t or bounds[b][1, axis] < bounds[a][0, axis]:
             continue
@@ -93,12 +104,17 @@ def support_relation(
             sp[b, a, 2 * axis + 1] = True
     meshes = [p.mesh for p in assembly.parts]
     for axis in range(3):
-        across = [d for d in range(6) if d // 2 != axis]
-        fitted = tc[:, :, across].all(axis=2) & ~tt[:, :, across].any(axis=2)
-        for a, b in zip(*np.nonzero(fitted), strict=True):
+        for a, b in zip(*np.nonzero(fitted[axis]), strict=True):
             if a != b and threaded_on(meshes[a], meshes[b], axis):
                 sp[a, b, 2 * axis] = sp[a, b, 2 * axis + 1] = True
     return sp
+
+
+def fitted_across(tc: np.ndarray, tt: np.ndarray, axis: int) -> np.ndarray:
+    """``(n, n)`` bool: j touches i and blocks it in each of the four directions across
+    ``axis`` (a pin in a hole, a nut on a bolt, a shaft in a bore)."""
+    across = [d for d in range(6) if d // 2 != axis]
+    return tc[:, :, across].all(axis=2) & ~tt[:, :, across].any(axis=2)
 
 
 def threaded_on(outer: trimesh.Trimesh, inner: trimesh.Trimesh, axis: int) -> bool:

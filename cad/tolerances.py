@@ -68,7 +68,9 @@ Support travel
 --------------
 A part is supported if a fall of ``3 x tol(i, j)`` (:data:`cad.support.SUPPORT_TRAVEL_FACTOR`)
 would drive it into a part already there (:mod:`cad.support`): it may stand on that part
-or hang in it across a clearance of up to ``2 x tol(i, j)``.
+or hang in it across a clearance of up to ``2 x tol(i, j)``. A part fitted in a hole of
+that part (a dowel, a screw, a shaft in a bore) may fall further, up to the shorter of the
+two parts' extents along gravity: the hole guides it onto the bottom or the shoulder.
 
 Both tolerances are in millimetres whatever the source unit, because meshes are stored in
 mm; the same parts therefore give the same tables in any unit.
@@ -101,9 +103,38 @@ SHRINK_PER_THICKNESS = 0.1
 """A part is never shrunk by more than this share of its thickness."""
 PENETRATION_TOL_PER_SIZE = SHRINK_PER_SIZE
 """Kept for callers of the old name; see :data:`SHRINK_PER_SIZE`."""
+TOL_LIMIT_MM = 100.0
+"""Largest explicit contact or penetration tolerance (mm) accepted."""
 CONTACT_NORMAL_MIN = 0.25
 """A surface faces direction ``d`` for contact if its normal's component along ``d`` is at
 least this (normal within about 75.5 degrees of ``d``)."""
+
+
+def checked_tolerance(value, name: str) -> float | None:
+    """An explicit tolerance (mm) after the range check; None stays None (the default rule).
+
+    ``name`` is ``contact_tol`` (``0 <= value <= TOL_LIMIT_MM``) or ``penetration_tol``
+    (``0 < value <= TOL_LIMIT_MM``).
+
+    Raises
+    ------
+    GeometryError
+        One line naming the tolerance, the range and the value.
+    """
+    if value is None:
+        return None
+    low = "0" if name == "contact_tol" else "above 0"
+    wanted = f"{name}: expected a number of mm from {low} to {TOL_LIMIT_MM:g}, got {value!r}"
+    if isinstance(value, bool):
+        raise GeometryError(wanted)
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise GeometryError(wanted) from None
+    too_low = number < 0 if name == "contact_tol" else number <= 0
+    if not np.isfinite(number) or too_low or number > TOL_LIMIT_MM:
+        raise GeometryError(wanted)
+    return number
 
 
 def part_thickness(mesh: trimesh.Trimesh) -> float:
@@ -216,7 +247,7 @@ def resolve_tolerances(
     Raises
     ------
     ValueError
-        A negative contact tolerance or a non-positive penetration tolerance.
+        A tolerance out of range (:func:`checked_tolerance`).
     """
     meshes = [p.mesh for p in assembly.parts] if hasattr(assembly, "parts") else list(assembly)
     if isinstance(penetration_tol, Tolerances):
@@ -230,16 +261,12 @@ def resolve_tolerances(
         reach = default_contact_reaches(meshes)
         ctol = _largest_pair_reach(reach)
     else:
-        reach, ctol = None, float(contact_tol)
-        if not np.isfinite(ctol) or ctol < 0:
-            raise GeometryError(f"contact tolerance must be >= 0 mm, got {contact_tol}")
+        reach, ctol = None, checked_tolerance(contact_tol, "contact_tol")
     if explicit_shrink is not None:
         return Tolerances(ctol, explicit_shrink, base.explicit, reach)
     if penetration_tol is None:
         return Tolerances(ctol, default_shrinks(meshes), False, reach)
-    ptol = float(penetration_tol)
-    if not np.isfinite(ptol) or ptol <= 0:
-        raise GeometryError(f"penetration tolerance must be > 0 mm, got {penetration_tol}")
+    ptol = checked_tolerance(penetration_tol, "penetration_tol")
     return Tolerances(ctol, np.full(len(meshes), ptol / 2.0), True, reach)
 
 

@@ -7,7 +7,7 @@ from pathlib import Path
 import typer
 
 from asmplan.cli.app import app
-from asmplan.cli.options import check_output
+from asmplan.cli.options import check_output, contact_tol_option, penetration_tol_option
 
 
 @app.command("init")
@@ -19,6 +19,8 @@ def init_command(
         Path("assembly.yaml"), "--output", "-o", help="Spec file to write."
     ),
     force: bool = typer.Option(False, "--force", help="Overwrite an existing spec file."),
+    contact_tol: float | None = contact_tol_option(),
+    penetration_tol: float | None = penetration_tol_option(),
 ) -> None:
     """Generate assembly.yaml from CAD: parts, a default cell (H, R1), one placement each."""
     import yaml
@@ -34,7 +36,11 @@ def init_command(
     if output.exists() and not force:
         raise ValueError(f"{output} exists (use --force to overwrite it)")
     text = spec_text(
-        source, spec_folder=output.parent, on_note=lambda line: typer.echo(line, err=True)
+        source,
+        spec_folder=output.parent,
+        contact_tol=contact_tol,
+        penetration_tol=penetration_tol,
+        on_note=lambda line: typer.echo(line, err=True),
     )
     # the text must read back as a valid spec before it is written
     spec = spec_from_dict(yaml.load(text, Loader=DecimalsAsText), source=str(output))  # noqa: S506

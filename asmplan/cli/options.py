@@ -25,6 +25,42 @@ WORKERS_MAX = 1_024
 CostModel = choices("CostModel", COST_MODELS, "Cost of a move.")
 
 
+def _tolerance(name: str):
+    def check(value: float | None) -> float | None:
+        from cad.tolerances import checked_tolerance
+
+        try:
+            return checked_tolerance(value, name)
+        except ValueError as exc:
+            raise typer.BadParameter(str(exc).partition(": ")[2]) from None
+
+    return check
+
+
+def contact_tol_option():
+    """``--contact-tol``: one definition for every command that computes relations."""
+    return typer.Option(
+        None,
+        "--contact-tol",
+        callback=_tolerance("contact_tol"),
+        help="Contact tolerance in mm for every pair: the largest gap that counts as touching "
+        "(default: the spec's contact_tol, else per pair 2% of the smaller part's "
+        "bounding-box diagonal, 0.01 to 0.2 mm, so clearance fits touch; cad/tolerances.py).",
+    )
+
+
+def penetration_tol_option():
+    """``--penetration-tol``: one definition for every command that computes relations."""
+    return typer.Option(
+        None,
+        "--penetration-tol",
+        callback=_tolerance("penetration_tol"),
+        help="Penetration tolerance in mm for every pair: the largest overlap that counts as "
+        "touching (default: the spec's penetration_tol, else per part, scaled with its size "
+        "and thickness, a pair gets the sum, at most 0.5 mm; cad/tolerances.py).",
+    )
+
+
 def finite_or_none(value: float | None) -> float | None:
     """Typer callback: a float option must be a finite number >= 0 (``nan``, ``inf`` fail)."""
     if value is not None and not (math.isfinite(value) and value >= 0):

@@ -14,7 +14,15 @@ import typer
 
 from asmplan.cli.app import app, choices
 from asmplan.cli.graph import say
-from asmplan.cli.options import SEED_MAX, TIME_LIMIT_MAX, CostModel, check_output, finite_or_none
+from asmplan.cli.options import (
+    SEED_MAX,
+    TIME_LIMIT_MAX,
+    CostModel,
+    check_output,
+    contact_tol_option,
+    finite_or_none,
+    penetration_tol_option,
+)
 from asp.spec import TURN_MODELS
 
 TurnModel = choices("TurnModel", TURN_MODELS, "Turn model of the game.")
@@ -112,6 +120,8 @@ def plan_command(
     max_states: int | None = typer.Option(
         None, "--max-states", min=1, help="State graph limit (default: spec's, else 20,000,000)."
     ),
+    contact_tol: float | None = contact_tol_option(),
+    penetration_tol: float | None = penetration_tol_option(),
 ) -> None:
     """Plan an assembly end to end: relations, state graph, game, robust plan, CP-SAT."""
     from asmplan import pipeline
@@ -128,6 +138,8 @@ def plan_command(
         duration_step=duration_step or None,
         on_step=say,
         max_states=max_states,
+        contact_tol=contact_tol,
+        penetration_tol=penetration_tol,
     )
     for line in plan_summary(result):
         typer.echo(line)

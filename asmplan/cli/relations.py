@@ -7,8 +7,7 @@ from pathlib import Path
 import typer
 
 from asmplan.cli.app import TableFormat, app
-
-TOL_MAX_MM = 1_000.0
+from asmplan.cli.options import contact_tol_option, penetration_tol_option
 
 
 @app.command("relations")
@@ -17,25 +16,8 @@ def relations_command(
         ..., help="Folder of part meshes, multi-body scene (GLB/glTF/3MF/STEP) or assembly.yaml."
     ),
     fmt: TableFormat = typer.Option(TableFormat.text, "--format", help="Output format."),
-    contact_tol: float | None = typer.Option(
-        None,
-        "--contact-tol",
-        min=0.0,
-        max=TOL_MAX_MM,
-        help=(
-            "Contact tolerance in mm for every pair (default: per pair, 2% of the smaller "
-            "part's bounding-box diagonal, at least 0.01 and at most 0.2 mm, so clearance "
-            "fits touch; see cad/tolerances.py)."
-        ),
-    ),
-    penetration_tol: float | None = typer.Option(
-        None,
-        "--penetration-tol",
-        min=0.0,
-        max=TOL_MAX_MM,
-        help="Penetration tolerance in mm for every pair (default: per part, scaled with its "
-        "size and thickness, see cad/tolerances.py; a pair gets the sum, at most 0.5 mm).",
-    ),
+    contact_tol: float | None = contact_tol_option(),
+    penetration_tol: float | None = penetration_tol_option(),
     units: str | None = typer.Option(
         None, "--units", help="Unit of mesh files that declare none (default mm)."
     ),

@@ -9,8 +9,9 @@ Routes (the OpenAPI document is at ``/openapi.json``, its browsable form at ``/d
 - ``POST /api/sessions`` ``{"plan": id}`` -> 201 and the session with its advice.
 - ``GET /api/sessions``, ``GET /api/sessions/{session}``.
 - ``POST /api/sessions/{session}/events`` ``{"kind": "started"|"finished", "operation",
-  "agent"}`` -> the advice; 409 naming the problem when the plan cannot explain it (the
-  session is unchanged), 404 for an unknown session, 422 for a malformed body.
+  "agent", "time"?, "duration"?}`` -> the advice; 409 naming the problem when the plan
+  cannot explain it (the session is unchanged), 404 for an unknown session, 422 for a
+  malformed body.
 - ``GET /api/questionnaire``; ``POST /api/sessions/{session}/answers`` ``{"answers": {...}}``.
 - ``GET /api/export.csv``: every session, one row each.
 
@@ -54,6 +55,12 @@ class EventIn(BaseModel):
     kind: Literal["started", "finished"]
     operation: str = Field(min_length=1, max_length=64)
     agent: str = Field(min_length=1, max_length=64)
+    time: float | None = Field(
+        None, ge=0, le=1e9, description="seconds since the start (a completion's time)"
+    )
+    duration: float | None = Field(
+        None, ge=0, le=1e9, description="a start: the duration the agent will take"
+    )
 
 
 class SessionIn(BaseModel):
@@ -197,6 +204,7 @@ def create_app(
         """One plan: metrics, operations, parts, agents, the principal and worst lines."""
         plan = _plan(pid)
         keys = ("assembly", "turn_model", "cost", "tct", "minimax", "metrics", "agents")
+        keys += ("robustness",)
         out = {k: plan.get(k) for k in keys}
         out.update(
             id=pid,
@@ -246,7 +254,7 @@ def create_app(
         """Observe an event; 409 naming the problem if the plan cannot explain it."""
         _session(sid)
         try:
-            advice = store.observe(sid, body.model_dump())
+            advice = store.observe(sid, body.model_dump(exclude_none=True))
         except ObservationError as exc:
             raise HTTPException(409, str(exc)) from None
         return advice.to_dict()

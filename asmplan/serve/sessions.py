@@ -52,7 +52,8 @@ class Session:
     id, plan_id : str
     advisor : Advisor
     events : list of dict
-        ``{"kind", "operation", "agent", "t", "by", "deviation", "instruction"}`` per event.
+        ``{"kind", "operation", "agent", "t", "by", "deviation", "instruction", "elapsed",
+        "bound_after"}`` per event (and its ``time`` and ``duration`` when given).
     created : float
         Unix time.
     answers : dict
@@ -89,12 +90,15 @@ class Session:
         if not self.advisor.finished:
             return None
         plan = self.advisor.plan
-        return {
+        out = {
             "cost": self.advisor.advice().elapsed,
             "w0": plan["metrics"]["w0"],
             "minimax": plan["minimax"],
             "deviations": self.deviations,
         }
+        if plan.get("robustness"):  # the concurrent game: W*(k) for each budget k
+            out["robustness"] = plan["robustness"]
+        return out
 
 
 class SessionStore:
@@ -172,23 +176,20 @@ class SessionStore:
             ev = Event.parse(event)
             advice = advisor.observe(ev)
             instruction = before.instruction if before.turn == "human" else None
-            by = self.plans[session.plan_id].get("agents", {}).get(ev.agent, "")
-            deviation = (
-                by == "human"
-                and instruction is not None
-                and (ev.operation, ev.agent) != (instruction["operation"], instruction["agent"])
-                and before.running == []
-            )
             record = {
                 "kind": ev.kind,
                 "operation": ev.operation,
                 "agent": ev.agent,
                 "t": time.time(),
-                "by": by,
-                "deviation": bool(deviation),
+                "by": _side(self.plans[session.plan_id], ev.agent),
+                "deviation": advice.deviations > before.deviations,
                 "instruction": instruction,
+                "elapsed": advice.elapsed,
                 "bound_after": advice.total_bound,
             }
+            for key in ("time", "duration"):
+                if getattr(ev, key) is not None:
+                    record[key] = getattr(ev, key)
             session.events.append(record)
             if advice.finished and session.finished_at is None:
                 session.finished_at = record["t"]
@@ -229,7 +230,21 @@ class SessionStore:
 
 
 def _event(record: dict) -> Event:
-    return Event(record["kind"], record["operation"], record["agent"])
+    return Event(
+        record["kind"],
+        record["operation"],
+        record["agent"],
+        record.get("time"),
+        record.get("duration"),
+    )
+
+
+def _side(plan: dict, agent: str) -> str:
+    """``human`` or ``robot``: the side of an agent (a worker ``A:human`` of the concurrent
+    game's agent ``A`` of side ``any`` says its side)."""
+    if ":" in agent:
+        return agent.rsplit(":", 1)[1]
+    return plan.get("agents", {}).get(agent, "")
 
 
 def _iso(t: float) -> str:

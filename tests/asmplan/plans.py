@@ -35,6 +35,29 @@ CELL = {
     ],
 }
 
+CHOICES = {
+    "name": "choices",
+    "agents": {"H": {"side": "human"}, "R1": {"side": "robot"}},
+    "cost": "time",
+    "operations": [
+        {"id": "p", "description": "place plate", "agents": {"H": 3}},
+        {"id": "q", "description": "place cover", "agents": {"H": 4}},
+        {"id": "r", "description": "place pin", "agents": {"H": 2, "R1": 6}},
+        {"id": "s", "description": "screw plate", "agents": {"R1": 5}, "after": ["p"]},
+        {"id": "t", "description": "screw cover", "agents": {"R1": 4}, "after": ["q"]},
+    ],
+}
+"""A concurrent job where the person has real choices: W*(0) 12, W*(1) 14, W*(2) = W*(inf) 15."""
+
+
+def with_ranges(data: dict, extra: float = 2) -> dict:
+    """The job with every person's duration ``d`` made the range ``[d, d + extra]``."""
+    ops = [
+        {**op, "agents": {a: ([d, d + extra] if a == "H" else d) for a, d in op["agents"].items()}}
+        for op in data["operations"]
+    ]
+    return {**data, "operations": ops}
+
 
 def cell_game(cost: str | None = None):
     """(spec, graph, dag, solution) of the small cell."""

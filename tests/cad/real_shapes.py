@@ -61,6 +61,15 @@ def extrude(contours: list[np.ndarray], z0: float, z1: float) -> trimesh.Trimesh
     )
 
 
+def revolve(profile, sections: int) -> trimesh.Trimesh:
+    """Solid of revolution about z of a closed ``(r, z)`` profile (CCW), a ``sections``-gon."""
+    outline = manifold3d.CrossSection([np.asarray(profile, dtype=float)])
+    mesh = manifold3d.Manifold.revolve(outline, circular_segments=int(sections)).to_mesh()
+    return trimesh.Trimesh(
+        vertices=np.asarray(mesh.vert_properties)[:, :3], faces=np.asarray(mesh.tri_verts)
+    )
+
+
 def _seg(n: float, detail: float) -> int:
     return max(3, int(round(n * detail)))
 

@@ -70,8 +70,9 @@ def test_nut_waits_for_its_bolt():
     # The nut hangs under the base: nothing below it, it is threaded on the bolt.
     assert resting_on(rel, "nut_1") == set()
     assert supported_by(rel, "nut_1") == {"bolt_1"}
-    # The bolt's head stands on its washer; the bolt is not threaded on the plates.
-    assert supported_by(rel, "bolt_1") == {"washer_1"}
+    # The bolt's head stands on its washer; the bolt is not threaded on the plates, but it
+    # is captured in their holes: without the washer it would slide down onto them.
+    assert supported_by(rel, "bolt_1") == {"washer_1", "bracket", "base"}
     graph = build_state_graph(spec_for(rel, "base"), rel)
     seqs = graph.sequences(limit=200)
     assert seqs
