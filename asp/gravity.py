@@ -15,8 +15,9 @@ along ``g``, :func:`base_index`):
   :data:`LARGE_VOLUME` of the largest part's): plates and housings rest on something
   under true gravity, pins and shafts in through holes do not;
 - ``feasible``: a complete insertion sequence exists, base first, with the held parts held
-  (:func:`one_sequence`: depth-first over part sets, at most :data:`SEARCH_BUDGET` sets;
-  ``None`` when it runs out). Subassemblies are not tried here, so ``False`` is a hint,
+  (:func:`one_sequence`: depth-first over part sets, a set dropped as soon as a part left
+  out is blocked along every direction, at most :data:`SEARCH_BUDGET` sets; ``None`` when
+  it runs out). Subassemblies are not tried here, so ``False`` is a hint,
   not a proof, that the full planner fails.
 
 The format's own down ``D`` (``-y`` for glTF/GLB, else ``-z``) is kept unless the best
@@ -172,6 +173,10 @@ def one_sequence(relations, gravity: str, base: int, held: set[int]) -> bool | N
             return False
         return any(not s & blocked[d][p] for d in range(6))
 
+    def stuck(s: int) -> bool:
+        """Some part left out is blocked along every direction: blocking only grows."""
+        return any(not s >> p & 1 and all(s & blocked[d][p] for d in range(6)) for p in range(n))
+
     stack = [1 << base]
     while stack:
         s = stack.pop()
@@ -182,7 +187,8 @@ def one_sequence(relations, gravity: str, base: int, held: set[int]) -> bool | N
         dead.add(s)
         if len(dead) > SEARCH_BUDGET:
             return None
-        stack += [s | 1 << p for p in range(n) if not s >> p & 1 and fits(p, s)]
+        if not stuck(s):
+            stack += [s | 1 << p for p in reversed(range(n)) if not s >> p & 1 and fits(p, s)]
     return False
 
 
