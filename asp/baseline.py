@@ -32,6 +32,7 @@ from asp.dag import GameDAG
 from asp.errors import ScheduleError
 from asp.numbers import json_number, plain
 from asp.rules import HUMAN, ROBOT
+from asp.together import OK, TOOL, first_failure
 
 MAX_SCALE_DIGITS = 6
 
@@ -848,7 +849,7 @@ def _topo(pred: list[set[int]]) -> list[int]:
 def schedule_violation(model, rows: list[dict]) -> tuple[str, list[tuple[int, int]]] | None:
     """Replay a schedule through the state graph; ``None`` if it is physically feasible.
 
-    The rule is the concurrent game's (:meth:`asp.concurrent.ConcurrentModel.compatible`):
+    The rule is the concurrent game's (:func:`asp.together.together`):
     at every start time ``t``, with ``D`` the operations ended by ``t`` and ``A`` those
     running, every ``D + T`` (``T`` a subset of ``A``) is a state of the state graph from
     which every other operation of ``A`` is a transition, and no two running operations
@@ -883,7 +884,7 @@ def schedule_violation(model, rows: list[dict]) -> tuple[str, list[tuple[int, in
     for t in [*sorted(set(start.values())), math.inf]:
         for i in by_end:
             if end[i] <= t and i not in done:
-                nxt = model.succ.get((state, i))
+                nxt = model.steps.get((state, i))
                 if nxt is None:
                     return _cannot_follow(model, done, i)
                 state = nxt[0]
@@ -913,7 +914,8 @@ def _cannot_follow(model, done: set[int], b: int) -> tuple[str, list[tuple[int, 
 
 
 def _together_violation(model, state: int, done: set[int], running: list[int]):
-    """Whether the operations ``running`` may run together from ``state`` (``done`` done).
+    """Whether the operations ``running`` may run together from ``state`` (``done`` done):
+    :func:`asp.together.together`.
 
     Returns
     -------
@@ -921,21 +923,12 @@ def _together_violation(model, state: int, done: set[int], running: list[int]):
         None if they may; ``(a, b)``: two of them share a tool; ``[done set, b]``: ``b``
         cannot follow that done set (some order of the running ones reaches it).
     """
-    for a in running:
-        for b in running:
-            if a < b and model.conflict[a, b]:
-                return (a, b)
-    reached = {0: (state, set(done))}
-    for mask in range(1 << len(running)):
-        cur, cur_done = reached[mask]
-        for k, b in enumerate(running):
-            if mask >> k & 1:
-                continue
-            nxt = model.succ.get((cur, b))
-            if nxt is None:
-                return [cur_done, b]
-            reached[mask | 1 << k] = (nxt[0], cur_done | {b})
-    return None
+    code, x, y = first_failure(model.steps, model.conflict, state, running)
+    if code == OK:
+        return None
+    if code == TOOL:
+        return (running[x], running[y])
+    return [set(done) | {running[k] for k in range(len(running)) if x >> k & 1}, running[y]]
 
 
 def list_schedule(model, problem: ScheduleProblem, sequence=None) -> list[dict] | None:
@@ -953,7 +946,7 @@ def list_schedule(model, problem: ScheduleProblem, sequence=None) -> list[dict] 
     Parameters
     ----------
     model
-        What :func:`schedule_violation` takes (``spec``, ``workers``, ``succ``, ``conflict``).
+        What :func:`schedule_violation` takes (``spec``, ``workers``, ``steps``, ``conflict``).
     problem : ScheduleProblem
         Its tasks are the spec's operations (same ids), with their modes and durations.
 
@@ -983,7 +976,7 @@ def list_schedule(model, problem: ScheduleProblem, sequence=None) -> list[dict] 
         done = sorted((i for i in start if end[i] <= t), key=lambda i: (end[i], start[i]))
         cur = 0
         for i in done:
-            nxt = model.succ.get((cur, i))
+            nxt = model.steps.get((cur, i))
             if nxt is None:
                 return False
             cur = nxt[0]
@@ -994,7 +987,7 @@ def list_schedule(model, problem: ScheduleProblem, sequence=None) -> list[dict] 
         cands = [order[step]] if order is not None else [o for o in range(n) if o not in start]
         best = None
         for o in cands:
-            nxt = model.succ.get((state, o))
+            nxt = model.steps.get((state, o))
             if nxt is None:
                 if order is not None:
                     return None

@@ -19,8 +19,8 @@ Semantics (``../shared/DESIGN.md``, "The concurrent game"):
 - Two operations run at the same time only if each is feasible whichever finishes first:
   with ``D`` done and the set ``A`` running, every ``D + T`` (``T`` a subset of ``A``) is a
   state of the state graph from which each operation of ``A - T`` is an edge
-  (:meth:`ConcurrentModel.compatible`, the one place this rule is written; the compiled
-  builder and the schedule replay repeat it over arrays and are tested against it), and no
+  (:func:`asp.together.together`, the one place this rule is written: both builders and
+  the schedule replay call it), and no
   operation changes a tool another one needs or changes. Every
   state entered must still be completable (the state graph's co-reachable states).
 - The human's duration may be a range ``[min, max]``. The adversary picks it on the grid
@@ -74,6 +74,7 @@ from asp.rules import costs_close
 from asp.solve import Solution, evaluate_policy, solve
 from asp.spec import AssemblySpec
 from asp.state_graph import StateGraph
+from asp.together import OK, LiveSteps, first_failure
 
 UNBOUNDED = -1
 """Budget of the fully adversarial human (no instructions, every reply allowed)."""
@@ -108,9 +109,11 @@ class ConcurrentModel:
     choices : list of list of tuple of int, [worker][op]
         The durations (scaled) worker ``w`` may take for operation ``op`` (empty: not
         allowed). A robot has one; a human with a range has the grid points.
-    succ : dict (state, op) -> (state, change)
+    steps : asp.together.LiveSteps
         Transitions of the state graph between co-reachable states, with the tool-change
         time (scaled) the operation adds there.
+    succ : dict (state, op) -> (state, change)
+        The same as a dictionary (the Python builder's lookups).
     enabled : list of tuple of int
         Per state, the operations with a transition.
     conflict : (n_ops, n_ops) bool
@@ -123,6 +126,7 @@ class ConcurrentModel:
     workers: tuple[Worker, ...]
     scale: int
     choices: list
+    steps: LiveSteps
     succ: dict
     enabled: list
     conflict: np.ndarray
@@ -142,37 +146,14 @@ class ConcurrentModel:
         return [w for w, x in enumerate(self.workers) if x.side == HUMAN]
 
     def compatible(self, state: int, ops: tuple[int, ...]) -> bool:
-        """Whether the operations ``ops`` may run together from ``state`` (module docstring).
-
-        Every subset ``T`` of ``ops`` done on top of ``state`` must be a co-reachable state
-        from which every other operation of ``ops`` is a transition, and no two operations
-        may conflict on a tool.
-        """
+        """Whether the operations ``ops`` may run together from ``state``
+        (:func:`asp.together.together`, the one place this rule is written)."""
         key = (state, ops)
         hit = self._memo.get(key)
-        if hit is not None:
-            return hit
-        ok = True
-        m = len(ops)
-        for i in range(m):
-            for j in range(i + 1, m):
-                if ops[i] == ops[j] or self.conflict[ops[i], ops[j]]:
-                    ok = False
-        if ok:
-            reached = {0: state}
-            for mask in range(1 << m):  # every subset after its smaller subsets
-                cur = reached[mask]
-                for i in range(m):
-                    if not mask >> i & 1:
-                        nxt = self.succ.get((cur, ops[i]))
-                        if nxt is None:
-                            ok = False
-                            break
-                        reached[mask | 1 << i] = nxt[0]
-                if not ok:
-                    break
-        self._memo[key] = ok
-        return ok
+        if hit is None:
+            hit = first_failure(self.steps, self.conflict, state, ops)[0] == OK
+            self._memo[key] = hit
+        return hit
 
     def after(self, state: int, ops) -> int:
         """The state after the operations ``ops`` (compatible) are done on top of ``state``."""
@@ -206,12 +187,7 @@ class ConcurrentModel:
 
     def kernel_arrays(self) -> tuple:
         """The arrays :func:`asp.concurrent_kernel.build_kernel` takes (its docstring)."""
-        n_states, n = self.graph.n_states, self.n_ops
-        nxt = np.full((n_states, n), -1, dtype=np.int64)
-        chg = np.zeros((n_states, n), dtype=np.int64)
-        for (s, o), (t, c) in self.succ.items():
-            nxt[s, o] = t
-            chg[s, o] = c
+        n = self.n_ops
         nw = len(self.workers)
         width = max((len(c) for row in self.choices for c in row), default=1)
         dur = np.zeros((nw, n, max(1, width)), dtype=np.int64)
@@ -220,12 +196,19 @@ class ConcurrentModel:
             for o, c in enumerate(row):
                 ndur[w, o] = len(c)
                 dur[w, o, : len(c)] = c
-        counts = np.array([len(e) for e in self.enabled], dtype=np.int64)
-        en_ptr = np.zeros(n_states + 1, dtype=np.int64)
-        np.cumsum(counts, out=en_ptr[1:])
-        en_ops = np.array([o for e in self.enabled for o in e], dtype=np.int64)
         side = np.array([w.side for w in self.workers], dtype=np.int8)
-        return nxt, chg, dur, ndur, self.conflict, en_ptr, en_ops, self.complete, side
+        steps = self.steps
+        return (
+            steps.indptr,
+            steps.dst.astype(np.int64),
+            steps.op.astype(np.int64),
+            steps.change,
+            dur,
+            ndur,
+            self.conflict,
+            self.complete,
+            side,
+        )
 
 
 def spec_workers(spec: AssemblySpec) -> tuple[Worker, ...]:
@@ -256,30 +239,6 @@ def tool_conflicts(spec: AssemblySpec) -> np.ndarray:
     return conflict
 
 
-class GraphSteps:
-    """``succ``-style lookups straight on the state graph (no dictionary of every transition).
-
-    ``get((state, op))`` is ``(next state, 0)`` when ``op`` is a transition of ``state`` into a
-    co-reachable state, else None: what :func:`asp.baseline.schedule_violation` asks, for a
-    state graph of any size.
-    """
-
-    def __init__(self, graph: StateGraph):
-        self.indptr = graph.indptr
-        self.dst = graph.dst
-        self.op = graph.op
-        self.alive = graph.coreachable()
-
-    def get(self, key):
-        s, o = key
-        lo, hi = int(self.indptr[s]), int(self.indptr[s + 1])
-        hit = np.flatnonzero(self.op[lo:hi] == o)
-        if hit.size == 0:
-            return None
-        t = int(self.dst[lo + int(hit[0])])
-        return (t, 0) if self.alive[t] else None
-
-
 class PlacementCuts:
     """Short cuts for the CP-SAT replay loop, read off the state graph.
 
@@ -304,12 +263,11 @@ class PlacementCuts:
     would block it.
     """
 
-    def __init__(self, graph: StateGraph):
+    def __init__(self, graph: StateGraph, steps: LiveSteps | None = None):
         self.graph = graph
-        alive = graph.coreachable()
-        keep = alive[graph.src] & alive[graph.dst]
-        self.src = graph.src[keep]
-        self.op = graph.op[keep]
+        steps = LiveSteps(graph) if steps is None else steps
+        self.src = steps.src
+        self.op = steps.op
         self.n = graph.model.n_ops
         self._rows: dict[int, np.ndarray] = {}
 
@@ -357,9 +315,16 @@ class ReplayModel:
 
     spec: AssemblySpec
     workers: tuple[Worker, ...]
-    succ: GraphSteps
+    steps: LiveSteps
     conflict: np.ndarray
     cuts: PlacementCuts | None = None
+
+
+def replay_model(spec: AssemblySpec, graph: StateGraph, *, cuts: bool = True) -> ReplayModel:
+    """The :class:`ReplayModel` of a spec and its state graph (with the short cuts)."""
+    steps = LiveSteps(graph)
+    short = PlacementCuts(graph, steps) if cuts else None
+    return ReplayModel(spec, spec_workers(spec), steps, tool_conflicts(spec), short)
 
 
 def concurrent_model(
@@ -424,18 +389,23 @@ def concurrent_model(
                 s = max(1, round(step * scale))
                 out.append(tuple(range(lo, hi, s)) + (hi,))
         choices.append(out)
-    alive = graph.coreachable()
     model = graph.model
     change = np.array([round(spec.tool(t).change_time * scale) for t in model.tool_names])
-    keep = alive[graph.src] & alive[graph.dst]
-    src, dst, op = graph.src[keep], graph.dst[keep], graph.op[keep].astype(np.int64)
-    if model.tool_names and src.size:
-        extra = model.tool_changes(graph.keys[src], op).astype(np.int64) @ change
-    else:
-        extra = np.zeros(src.size, dtype=np.int64)
+
+    def change_time(src, op):
+        return model.tool_changes(graph.keys[src], op).astype(np.int64) @ change
+
+    steps = LiveSteps(graph, change_time if model.tool_names else None)
     succ = {}
     enabled = [[] for _ in range(graph.n_states)]
-    for s, d, o, c in zip(src.tolist(), dst.tolist(), op.tolist(), extra.tolist(), strict=True):
+    pairs = zip(
+        steps.src.tolist(),
+        steps.dst.tolist(),
+        steps.op.tolist(),
+        steps.change.tolist(),
+        strict=True,
+    )
+    for s, d, o, c in pairs:
         succ[(s, o)] = (d, int(c))
         enabled[s].append(o)
     conflict = tool_conflicts(spec)
@@ -445,6 +415,7 @@ def concurrent_model(
         workers=tuple(workers),
         scale=scale,
         choices=choices,
+        steps=steps,
         succ=succ,
         enabled=[tuple(e) for e in enabled],
         conflict=conflict,
@@ -1243,9 +1214,7 @@ def assembly_makespan(
     ``cuts``, ``solves``, ``replay`` and ``found_by``.
     """
     sched = assembly_schedule(spec, graph)
-    model = ReplayModel(
-        spec, spec_workers(spec), GraphSteps(graph), tool_conflicts(spec), PlacementCuts(graph)
-    )
+    model = replay_model(spec, graph)
 
     def replay(rows):
         found = schedule_violation(model, rows)

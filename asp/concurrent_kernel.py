@@ -3,11 +3,14 @@
 The same rules as :mod:`asp.concurrent` (one game, two builders: this one for speed, the
 Python one for states that do not fit the packed key), written over arrays:
 
-- ``nxt[s, o]``: the state after operation ``o`` in state ``s`` (-1: not a transition of the
-  co-reachable state graph); ``chg[s, o]`` its tool-change time;
+- ``indptr``/``dst``/``op``/``change``: the live transitions in CSR form
+  (:class:`asp.together.LiveSteps`): the enabled operations of state ``s`` are
+  ``op[indptr[s]:indptr[s + 1]]`` in the state graph's order, each with its target state and
+  tool-change time;
 - ``dur[w, o, :ndur[w, o]]``: the durations worker ``w`` may take for ``o`` (none: not allowed);
-- ``conflict[a, b]``: a tool conflict; ``en_ptr``/``en_ops``: the enabled operations per
-  state, in the state graph's order; ``complete[s]``; ``side[w]`` (0 robot, 1 human).
+- ``conflict[a, b]``: a tool conflict; ``complete[s]``; ``side[w]`` (0 robot, 1 human).
+
+Which operations may run together is :func:`asp.together.together` (memoised here).
 
 A node is an int32 row ``[kind, state, budget, op[0..W), rem[0..W), instr[0..W)]``
 (``kind`` 0 robot, 1 human, 2 end; ``op`` -1 for a free worker; ``instr`` -2 where there is
@@ -22,6 +25,8 @@ import numba
 import numpy as np
 from numba import types
 from numba.typed import Dict
+
+from asp.together import OK, edge, together
 
 WAIT = -1
 NONE = -2
@@ -58,33 +63,15 @@ def _key(row, nw):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _compatible(s, ops, m, nxt, conflict, memo):  # pragma: no cover - compiled
-    """``ops[:m]`` (sorted) may run together from state ``s`` (asp.concurrent's rule)."""
+def _compatible(s, ops, m, indptr, dst, op, conflict, memo):  # pragma: no cover - compiled
+    """``ops[:m]`` (sorted) may run together from state ``s`` (:func:`asp.together.together`)."""
     packed = 0
     for i in range(m):
         packed = packed * 256 + ops[i] + 1
     key = (s, packed)
     if key in memo:
         return memo[key]
-    ok = True
-    for i in range(m):
-        for j in range(i + 1, m):
-            if ops[i] == ops[j] or conflict[ops[i], ops[j]]:
-                ok = False
-    if ok:
-        reached = np.empty(1 << m, np.int64)
-        reached[0] = s
-        for mask in range(1 << m):
-            cur = reached[mask]
-            for i in range(m):
-                if not (mask >> i) & 1:
-                    t = nxt[cur, ops[i]]
-                    if t < 0:
-                        ok = False
-                        break
-                    reached[mask | (1 << i)] = t
-            if not ok:
-                break
+    ok = together(s, ops, m, indptr, dst, op, conflict)[0] == OK
     memo[key] = ok
     return ok
 
@@ -106,11 +93,11 @@ def _with(busy, nb, extra, ne, out):  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def _has_candidate(  # pragma: no cover - compiled
-    s, w, final, m, en_ptr, en_ops, ndur, nxt, conflict, memo, buf
+    s, w, final, m, indptr, dst, op, ndur, conflict, memo, buf
 ):
     """Worker ``w`` has an operation it may start next to ``final[:m]``."""
-    for k in range(en_ptr[s], en_ptr[s + 1]):
-        o = en_ops[k]
+    for k in range(indptr[s], indptr[s + 1]):
+        o = op[k]
         if ndur[w, o] == 0:
             continue
         taken = False
@@ -123,14 +110,14 @@ def _has_candidate(  # pragma: no cover - compiled
             buf[i] = final[i]
         buf[m] = o
         buf[: m + 1].sort()
-        if _compatible(s, buf, m + 1, nxt, conflict, memo):
+        if _compatible(s, buf, m + 1, indptr, dst, op, conflict, memo):
             return True
     return False
 
 
 @numba.njit(cache=True)
 def build_kernel(
-    nxt, chg, dur, ndur, conflict, en_ptr, en_ops, complete, side, budgets, max_nodes
+    indptr, dst, op, change, dur, ndur, conflict, complete, side, budgets, max_nodes
 ):  # pragma: no cover - compiled
     nw = side.shape[0]
     width = 3 + 3 * nw
@@ -141,13 +128,16 @@ def build_kernel(
     n = 0
     stack = np.empty(cap, np.int64)
     top = 0
-    e_src = np.empty(cap, np.int32)
-    e_dst = np.empty(cap, np.int32)
-    e_cost = np.empty(cap, np.int32)
-    e_side = np.empty(cap, np.int8)
-    e_ops = np.empty((cap, nw), np.int16)
-    e_dur = np.empty((cap, nw), np.int32)
-    e_dev = np.empty(cap, np.int8)
+    # Edges: source, target, cost, side, deviations, operation and duration per worker.
+    edges = (
+        np.empty(cap, np.int32),
+        np.empty(cap, np.int32),
+        np.empty(cap, np.int32),
+        np.empty(cap, np.int8),
+        np.empty(cap, np.int8),
+        np.empty((cap, nw), np.int16),
+        np.empty((cap, nw), np.int32),
+    )
     m_edges = 0
     row = np.empty(width, np.int64)
     # The end node first (index 0), then one start per budget.
@@ -183,7 +173,7 @@ def build_kernel(
     buf = np.empty(nw + 2, np.int64)
     deciders = np.empty(nw, np.int64)
     n_opts = np.empty(nw, np.int64)
-    opts = np.empty((nw, en_ops.shape[0] + 1 if en_ops.shape[0] > 0 else 1), np.int64)
+    opts = np.empty((nw, op.shape[0] + 1 if op.shape[0] > 0 else 1), np.int64)
     digit = np.empty(nw, np.int64)
     chosen = np.empty(nw, np.int64)
     new = np.empty(width, np.int64)
@@ -220,8 +210,8 @@ def build_kernel(
             w = deciders[d]
             opts[d, 0] = WAIT
             c = 1
-            for k in range(en_ptr[s], en_ptr[s + 1]):
-                o = en_ops[k]
+            for k in range(indptr[s], indptr[s + 1]):
+                o = op[k]
                 if ndur[w, o] == 0:
                     continue
                 taken = False
@@ -244,7 +234,7 @@ def build_kernel(
                     if chosen[a] >= 0 and chosen[a] == chosen[b2]:
                         distinct = False
             m = _with(busy, nb, chosen, nd, final) if distinct else 0
-            ok = distinct and _compatible(s, final, m, nxt, conflict, memo)
+            ok = distinct and _compatible(s, final, m, indptr, dst, op, conflict, memo)
             if ok and kind == 0:
                 something = nb > 0
                 for d in range(nd):
@@ -258,7 +248,7 @@ def build_kernel(
                             side[w] == 1
                             and cur[3 + w] == WAIT
                             and _has_candidate(
-                                s, w, final, m, en_ptr, en_ops, ndur, nxt, conflict, memo, buf
+                                s, w, final, m, indptr, dst, op, ndur, conflict, memo, buf
                             )
                         ):
                             something = True
@@ -271,7 +261,7 @@ def build_kernel(
                             if chosen[d] >= 0:
                                 o = chosen[d]
                                 new[3 + w] = o
-                                new[3 + nw + w] = dur[w, o, 0] + chg[s, o]
+                                new[3 + nw + w] = dur[w, o, 0] + change[edge(s, o, indptr, op)]
                         else:
                             new[3 + 2 * nw + w] = chosen[d]
                     new[0] = 1
@@ -279,25 +269,7 @@ def build_kernel(
                     if t < 0:
                         overflow = True
                         break
-                    if m_edges >= e_src.shape[0]:
-                        size = 2 * e_src.shape[0]
-                        e_src = _grow1(e_src, size)
-                        e_dst = _grow1(e_dst, size)
-                        e_cost = _grow1(e_cost, size)
-                        e_side = _grow1(e_side, size)
-                        e_dev = _grow1(e_dev, size)
-                        e_ops = _grow2(e_ops, size)
-                        e_dur = _grow2(e_dur, size)
-                    e_src[m_edges] = v
-                    e_dst[m_edges] = t
-                    e_cost[m_edges] = 0
-                    e_side[m_edges] = 0
-                    e_dev[m_edges] = 0
-                    for w in range(nw):
-                        e_ops[m_edges, w] = NONE
-                        e_dur[m_edges, w] = NONE
-                    for d in range(nd):
-                        e_ops[m_edges, deciders[d]] = chosen[d]
+                    edges = _append_edge(edges, m_edges, v, t, 0, 0, 0, deciders, chosen, nd)
                     m_edges += 1
             elif ok and kind == 1 and m > 0:
                 dev = 0
@@ -312,7 +284,7 @@ def build_kernel(
                         if chosen[d] == WAIT:
                             following = instruct and cur[3 + 2 * nw + w] == WAIT
                             if not following and _has_candidate(
-                                s, w, final, m, en_ptr, en_ops, ndur, nxt, conflict, memo, buf
+                                s, w, final, m, indptr, dst, op, ndur, conflict, memo, buf
                             ):
                                 valid = False
                                 break
@@ -336,7 +308,7 @@ def build_kernel(
                             w = deciders[d]
                             o = chosen[d]
                             new[3 + w] = o
-                            new[3 + nw + w] = dur[w, o, sd[j]] + chg[s, o]
+                            new[3 + nw + w] = dur[w, o, sd[j]] + change[edge(s, o, indptr, op)]
                         delta = -1
                         for w in range(nw):
                             if new[3 + w] >= 0 and (delta < 0 or new[3 + nw + w] < delta):
@@ -348,7 +320,7 @@ def build_kernel(
                                     buf[0] = new[3 + w]
                                     new[3 + w] = WAIT
                                     new[3 + nw + w] = 0
-                                    s2 = nxt[s2, buf[0]]
+                                    s2 = dst[edge(s2, buf[0], indptr, op)]
                                 else:
                                     new[3 + nw + w] -= delta
                         running = False
@@ -377,30 +349,15 @@ def build_kernel(
                             seen_c[n_seen] = delta
                             n_seen += 1
                         if not dup:
-                            if m_edges >= e_src.shape[0]:
-                                size = 2 * e_src.shape[0]
-                                e_src = _grow1(e_src, size)
-                                e_dst = _grow1(e_dst, size)
-                                e_cost = _grow1(e_cost, size)
-                                e_side = _grow1(e_side, size)
-                                e_dev = _grow1(e_dev, size)
-                                e_ops = _grow2(e_ops, size)
-                                e_dur = _grow2(e_dur, size)
-                            e_src[m_edges] = v
-                            e_dst[m_edges] = t
-                            e_cost[m_edges] = delta
-                            e_side[m_edges] = 1
-                            e_dev[m_edges] = dev
-                            for w in range(nw):
-                                e_ops[m_edges, w] = NONE
-                                e_dur[m_edges, w] = NONE
-                            for d in range(nd):
-                                e_ops[m_edges, deciders[d]] = chosen[d]
+                            edges = _append_edge(
+                                edges, m_edges, v, t, delta, 1, dev, deciders, chosen, nd
+                            )
+                            e_dur = edges[6]
                             for j in range(ns):
                                 d = started[j]
                                 w = deciders[d]
                                 e_dur[m_edges, w] = dur[w, chosen[d], sd[j]]
-                                e_dur[m_edges, w] += chg[s, chosen[d]]
+                                e_dur[m_edges, w] += change[edge(s, chosen[d], indptr, op)]
                             m_edges += 1
                         # Next durations.
                         j = ns - 1
@@ -428,6 +385,7 @@ def build_kernel(
                 break
         if overflow:
             break
+    e_src, e_dst, e_cost, e_side, e_dev, e_ops, e_dur = edges
     return (
         overflow,
         rows[:n].copy(),
@@ -440,6 +398,33 @@ def build_kernel(
         e_dur[:m_edges].copy(),
         e_dev[:m_edges].copy(),
     )
+
+
+@numba.njit(cache=True)
+def _append_edge(edges, m, v, t, cost, side, dev, deciders, chosen, nd):  # pragma: no cover
+    """Write edge ``m`` (``v -> t``, its cost, side and deviations; the deciders' choices as
+    its operations, every other worker and every duration NONE) into ``edges``, grown first
+    when full. Returns the edge arrays (new ones when grown)."""
+    e_src, e_dst, e_cost, e_side, e_dev, e_ops, e_dur = edges
+    if m >= e_src.shape[0]:
+        size = 2 * e_src.shape[0]
+        e_src = _grow1(e_src, size)
+        e_dst = _grow1(e_dst, size)
+        e_cost = _grow1(e_cost, size)
+        e_side = _grow1(e_side, size)
+        e_dev = _grow1(e_dev, size)
+        e_ops = _grow2(e_ops, size)
+        e_dur = _grow2(e_dur, size)
+    e_src[m] = v
+    e_dst[m] = t
+    e_cost[m] = cost
+    e_side[m] = side
+    e_dev[m] = dev
+    e_ops[m, :] = NONE
+    e_dur[m, :] = NONE
+    for d in range(nd):
+        e_ops[m, deciders[d]] = chosen[d]
+    return (e_src, e_dst, e_cost, e_side, e_dev, e_ops, e_dur)
 
 
 @numba.njit(cache=True)

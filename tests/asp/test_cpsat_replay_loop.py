@@ -14,14 +14,11 @@ from hypothesis import strategies as st
 
 from asp.baseline import assembly_schedule, list_schedule, min_makespan, schedule_violation
 from asp.concurrent import (
-    GraphSteps,
     PlacementCuts,
-    ReplayModel,
     assembly_makespan,
     build_game,
     concurrent_model,
-    spec_workers,
-    tool_conflicts,
+    replay_model,
     value,
 )
 from asp.solve import solve
@@ -68,11 +65,6 @@ def graph_of(spec, rel):
     except ValueError:  # no complete sequence (blocked every way)
         assume(False)
     return graph
-
-
-def replay_model(spec, graph, cuts: bool = True):
-    short = PlacementCuts(graph) if cuts else None
-    return ReplayModel(spec, spec_workers(spec), GraphSteps(graph), tool_conflicts(spec), short)
 
 
 def w0(spec, graph) -> float:
@@ -198,7 +190,7 @@ def test_short_cuts_hold_for_every_feasible_schedule(data):
             continue
         done = {i for i in range(n) if graph.key(s) >> i & 1}
         for b in range(n):
-            if b in done or model.succ.get((s, b)) is not None:
+            if b in done or model.steps.get((s, b)) is not None:
                 continue
             cut = model.cuts.cut(done, b)
             if cut is None:

@@ -1,0 +1,122 @@
+"""Which operations may run at the same time: one rule, written once.
+
+``../shared/DESIGN.md`` ("The concurrent game"): two operations may run at the same time
+only if each is feasible whichever finishes first (both orders are edges of the state
+graph) and neither changes a tool the other needs. For a set ``A`` running on top of state
+``s``: every ``s + T`` (``T`` a subset of ``A``) is a co-reachable state from which every
+other operation of ``A`` is a transition into a co-reachable state, and no two operations of
+``A`` conflict on a tool. :func:`together` is that rule; the concurrent game's Python
+builder (:meth:`asp.concurrent.ConcurrentModel.compatible`), its compiled builder
+(:mod:`asp.concurrent_kernel`) and the CP-SAT schedule replay
+(:func:`asp.baseline.schedule_violation`, and the list schedule built on it) all call it.
+
+The transitions are :class:`LiveSteps`: the state graph's transitions between co-reachable
+states in CSR form (per state, its out-transitions in the state graph's order), with the
+tool-change time each adds.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+OK = 0
+""":func:`together`: the operations may run together."""
+TOOL = 1
+""":func:`together`: ``ops[x]`` and ``ops[y]`` conflict on a tool."""
+ORDER = 2
+""":func:`together`: after the subset ``x`` (a bit mask over ``ops``), ``ops[y]`` is no
+transition."""
+
+
+class LiveSteps:
+    """The state graph's transitions between co-reachable states, in CSR form.
+
+    Attributes
+    ----------
+    indptr : (N + 1,) int64
+        Out-transitions of state ``s``: ``indptr[s]:indptr[s + 1]`` (the state graph's order).
+    dst, op : (E,) int
+        Target state and operation of each transition.
+    change : (E,) int64
+        Tool-change time each transition adds (zeros unless given).
+    """
+
+    def __init__(self, graph, change=None):
+        """``change(src, op)``: the tool-change time of the live transitions with those
+        sources and operations (optional; default 0)."""
+        alive = graph.coreachable()
+        keep = alive[graph.src] & alive[graph.dst]
+        src = graph.src[keep]
+        self.dst = graph.dst[keep]
+        self.op = graph.op[keep]
+        self.change = np.zeros(self.dst.size, dtype=np.int64)
+        if change is not None and src.size:
+            self.change = np.asarray(change(src, self.op), dtype=np.int64)
+        counts = np.bincount(src, minlength=graph.n_states)
+        self.indptr = np.zeros(graph.n_states + 1, dtype=np.int64)
+        np.cumsum(counts, out=self.indptr[1:])
+
+    @property
+    def n_states(self) -> int:
+        return int(self.indptr.size - 1)
+
+    @property
+    def src(self) -> np.ndarray:
+        """(E,) int64: the source state of each transition."""
+        return np.repeat(np.arange(self.n_states, dtype=np.int64), np.diff(self.indptr))
+
+    def get(self, key):
+        """``(next state, change)`` of operation ``o`` in state ``s`` (``key = (s, o)``), or
+        None when it is no live transition (a dict's ``get``)."""
+        s, o = key
+        e = edge(int(s), int(o), self.indptr, self.op)
+        return None if e < 0 else (int(self.dst[e]), int(self.change[e]))
+
+    def arrays(self) -> tuple:
+        """``(indptr, dst, op)``, as :func:`together` takes them."""
+        return self.indptr, self.dst, self.op
+
+
+@numba.njit(cache=True)
+def edge(s, o, indptr, op):  # pragma: no cover - compiled
+    """The transition of operation ``o`` out of state ``s``, or -1."""
+    for e in range(indptr[s], indptr[s + 1]):
+        if op[e] == o:
+            return e
+    return -1
+
+
+@numba.njit(cache=True)
+def together(s, ops, m, indptr, dst, op, conflict):  # pragma: no cover - compiled
+    """Whether ``ops[:m]`` may run together on top of state ``s`` (module docstring).
+
+    Returns
+    -------
+    (code, x, y)
+        ``(OK, 0, 0)``; ``(TOOL, x, y)``: ``ops[x]`` and ``ops[y]`` conflict on a tool (or are
+        the same operation); ``(ORDER, mask, y)``: ``ops[y]`` is no transition after the
+        operations of bit mask ``mask`` are done on top of ``s``. Subsets are visited in
+        increasing mask order, so ``mask`` is the first failing one.
+    """
+    for i in range(m):
+        for j in range(i + 1, m):
+            if ops[i] == ops[j] or conflict[ops[i], ops[j]]:
+                return TOOL, i, j
+    reached = np.empty(1 << m, np.int64)
+    reached[0] = s
+    for mask in range(1 << m):  # every subset after its smaller subsets
+        cur = reached[mask]
+        for i in range(m):
+            if not (mask >> i) & 1:
+                e = edge(cur, ops[i], indptr, op)
+                if e < 0:
+                    return ORDER, mask, i
+                reached[mask | (1 << i)] = dst[e]
+    return OK, 0, 0
+
+
+def first_failure(steps: LiveSteps, conflict: np.ndarray, state: int, ops) -> tuple[int, int, int]:
+    """:func:`together` on a sequence of operation indices (Python callers)."""
+    arr = np.asarray(ops, dtype=np.int64)
+    return together(int(state), arr, arr.size, *steps.arrays(), conflict)
