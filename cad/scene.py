@@ -35,6 +35,9 @@ DECLARED_METRES = (".glb", ".gltf", ".step", ".stp")
 MAX_INCH_ASSEMBLY_M = 3.0
 """A STEP declaring inches whose parts span more than this (metres, 118 in) has millimetre
 numbers under an inch label (Pro/E exports of metric models do this); it is read in mm."""
+MAX_GLTF_ASSEMBLY_M = 20.0
+"""A glTF (metres by its specification) whose parts span more than this has millimetre
+numbers (converters that keep a CAD model's numbers, e.g. COLLADA2GLTF); read in mm."""
 MAX_ID_LENGTH = 32
 _EXTENSIONS = r"\.(stp|step|sldprt|sldasm|ipt|iam|prt|asm|stl|obj|glb|gltf|3mf)$"
 
@@ -267,12 +270,12 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
     # the node holding every part (the product itself) is not a group
     group_nodes = [(g, b) for g, b in group_nodes if len(b) < len(part_nodes)]
 
-    inch_as_mm = _millimetres_labelled_inches(file, scene)
+    rescale = _millimetre_numbers(file, scene)
     names, meshes, bases = [], [], []
     for node, anc in part_nodes:
         transform, geom_name = graph[node]
         mesh = scene.geometry[geom_name].copy().apply_transform(transform)
-        meshes.append(mesh.apply_scale(1.0 / 25.4) if inch_as_mm else mesh)
+        meshes.append(mesh.apply_scale(rescale) if rescale != 1.0 else mesh)
         own = original(node)
         raw = best_raw_name([own, str(geom_name), *[original(a) for a in anc]])
         bases.append("part" if raw is None else clean_name(raw))
@@ -325,22 +328,35 @@ def step_length_unit(path: Path) -> str | None:
     return None
 
 
-def _millimetres_labelled_inches(path: Path, scene: trimesh.Scene) -> bool:
-    """True (and a warning) for a STEP declaring inches whose parts, read so, would span
-    more than :data:`MAX_INCH_ASSEMBLY_M`: its numbers are millimetres."""
-    if step_length_unit(path) != "in" or scene.bounds is None:
-        return False
-    size = float(np.linalg.norm(np.ptp(scene.bounds, axis=0)))  # metres (cascadio)
-    if size <= MAX_INCH_ASSEMBLY_M:
-        return False
+def _millimetre_numbers(path: Path, scene: trimesh.Scene) -> float:
+    """The factor that reads a file's millimetre numbers under a wrong unit label as mm
+    (1.0 when the label is plausible), with a warning.
+
+    A STEP declaring inches whose parts, read so, span more than
+    :data:`MAX_INCH_ASSEMBLY_M`: 1 / 25.4; a glTF/GLB (metres) spanning more than
+    :data:`MAX_GLTF_ASSEMBLY_M`: 1 / 1000.
+    """
+    suffix = path.suffix.lower()
+    if scene.bounds is None or suffix not in (".step", ".stp", ".glb", ".gltf"):
+        return 1.0
+    size = float(np.linalg.norm(np.ptp(scene.bounds, axis=0)))  # metres (cascadio, glTF)
+    if suffix in (".glb", ".gltf"):
+        label, limit, factor = "metres (glTF)", MAX_GLTF_ASSEMBLY_M, 1e-3
+    elif step_length_unit(path) == "in":
+        label, limit, factor = "inches", MAX_INCH_ASSEMBLY_M, 1.0 / 25.4
+    else:
+        return 1.0
+    if size <= limit:
+        return 1.0
     import warnings
 
     warnings.warn(
-        f"{path.name} declares inches, but read so it is {size:.3g} m across: its numbers "
-        f"are taken as millimetres ({size / 25.4 * 1000:.0f} mm across; rule in cad/scene.py)",
+        f"{path.name} declares {label}, but read so it is {size:.3g} m across: its numbers "
+        f"are taken as millimetres ({size * factor * 1000:.0f} mm across; rule in "
+        "cad/scene.py)",
         stacklevel=2,
     )
-    return True
+    return factor
 
 
 def _3dxml_groups(file: Path, nodes: list[str]) -> list[tuple[str, list[str]]]:

@@ -250,3 +250,16 @@ def test_millimetre_numbers_under_an_inch_label_are_read_as_millimetres(tmp_path
     # a true inch file stays in inches (4 in = 101.6 mm)
     assert step_length_unit(DATA / "table_frame_in.step") == "in"
     assert step_length_unit(DATA / "two_boxes.step") == "mm"
+
+
+def test_a_gltf_with_millimetre_numbers_is_read_in_millimetres(tmp_path):
+    """glTF is metres; a converter that keeps a CAD model's millimetre numbers writes an
+    engine hundreds of metres across (Khronos' 2CylinderEngine: 743 m)."""
+    scene = trimesh.Scene()
+    scene.add_geometry(shapes.box_between((0, 0, 0), (400, 300, 20)), node_name="Block")
+    scene.add_geometry(shapes.box_between((0, 0, 20), (40, 40, 60)), node_name="Cap")
+    path = tmp_path / "engine.glb"
+    scene.export(path)
+    with pytest.warns(UserWarning, match=r"declares metres \(glTF\), but read so it is 504 m across"):
+        assembly = load_assembly(path)
+    assert np.allclose(assembly.parts[0].mesh.extents, [400, 300, 20], atol=1e-3)
