@@ -260,6 +260,7 @@ def test_a_gltf_with_millimetre_numbers_is_read_in_millimetres(tmp_path):
     scene.add_geometry(shapes.box_between((0, 0, 20), (40, 40, 60)), node_name="Cap")
     path = tmp_path / "engine.glb"
     scene.export(path)
-    with pytest.warns(UserWarning, match=r"declares metres \(glTF\), but read so it is 504 m across"):
+    expected = r"declares metres \(glTF\), but read so it is 504 m across"
+    with pytest.warns(UserWarning, match=expected):
         assembly = load_assembly(path)
     assert np.allclose(assembly.parts[0].mesh.extents, [400, 300, 20], atol=1e-3)
