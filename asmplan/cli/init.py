@@ -28,6 +28,7 @@ def init_command(
     from asp.atomic import write_text
     from asp.generate import spec_text
     from asp.spec import spec_from_dict
+    from asp.units import cad_units
     from cad.yamlfile import DecimalsAsText
 
     if not source.exists():
@@ -41,6 +42,7 @@ def init_command(
         contact_tol=contact_tol,
         penetration_tol=penetration_tol,
         on_note=lambda line: typer.echo(line, err=True),
+        decide_units=cad_units,
     )
     # the text must read back as a valid spec before it is written
     spec = spec_from_dict(yaml.load(text, Loader=DecimalsAsText), source=str(output))  # noqa: S506
