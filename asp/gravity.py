@@ -21,7 +21,7 @@ along ``g``, :func:`base_index`):
   not a proof, that the full planner fails.
 
 The format's own down ``D`` (``-y`` for glTF/GLB, else ``-z``) is kept unless the best
-direction ``b`` (proven feasible first, then fewest large parts held, then fewest held,
+direction ``b`` (fewest large parts held first, then proven feasible, then fewest held,
 ``D`` first, then ``-z, -y, -x, +z, +y, +x``) is strictly better and needs no more hands:
 ``held[b] <= held[D]``, and ``b`` is proven feasible where ``D`` is proven infeasible, or
 ``b`` holds fewer large parts. Parts in holes favour a sideways gravity (the hole walls
@@ -135,7 +135,7 @@ def choose_gravity(relations, bounds: np.ndarray, default: str = "-z") -> Gravit
         feasible[g] = one_sequence(relations, g, base, loose)
     order = [default, *(d for d in PREFERENCE if d != default)]
     best = min(
-        order, key=lambda d: (feasible[d] is not True, held_large[d], held[d], order.index(d))
+        order, key=lambda d: (held_large[d], feasible[d] is not True, held[d], order.index(d))
     )
     better = (feasible[best] is True and feasible[default] is False) or (
         held_large[best] < held_large[default]
