@@ -43,7 +43,8 @@ _EXTENSIONS = r"\.(stp|step|sldprt|sldasm|ipt|iam|prt|asm|stl|obj|glb|gltf|3mf)$
 
 _GENERIC = re.compile(
     r"^((nauo|solid|body|mesh|shape|geometry|node|object|component|compound|part|g)_?\d*|"
-    r"(p_)?\d+(_\d+)*|unnamed\w*|noname\w*|default\w*|world|root|scene|open_cascade_step_translator\w*)$"
+    r"\d+(_\d+)*|unnamed\w*|noname\w*|default\w*|world|root|scene|open_cascade_step_translator\w*|"
+    r"p(_\d+)+)$"  # an instance path or label (cascadio's ``=>[0:1:1:7]``) cleaned
 )
 
 _REFERENCE_LABEL = re.compile(r"=>\[[\d:]*\]")
@@ -83,12 +84,12 @@ def is_generic(name: str) -> bool:
 
 def best_name(candidates: list[str], fallback: str = "part") -> str:
     """The first meaningful cleaned name among ``candidates`` (raw names), else ``fallback``."""
-    raw = best_raw_name(candidates)
+    raw = best_raw(candidates)
     return fallback if raw is None else clean_name(raw)
 
 
-def best_raw_name(candidates: list[str]) -> str | None:
-    """The first of ``candidates`` (raw names) whose cleaned name is meaningful, else None."""
+def best_raw(candidates: list[str]) -> str | None:
+    """The first of ``candidates`` (raw names) whose cleaned name is meaningful, or None."""
     return next((raw for raw in candidates if not is_generic(clean_name(raw))), None)
 
 
@@ -164,8 +165,10 @@ def load_scene_file(path: Path) -> trimesh.Scene:
             ) from None
     if path.stat().st_size == 0:
         raise GeometryError(f"empty mesh file {path}")
+    # an OBJ's objects (``o name``) are its parts: one file may hold a whole assembly
+    split = {"split_objects": True} if path.suffix.lower() == ".obj" else {}
     try:
-        scene = trimesh.load(str(path), force="scene")
+        scene = trimesh.load(str(path), force="scene", **split)
     except Exception as exc:  # trimesh raises many types for bad files
         if external_references(path):
             raise empty_scene_error(path) from None
@@ -271,15 +274,17 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
     group_nodes = [(g, b) for g, b in group_nodes if len(b) < len(part_nodes)]
 
     rescale = _millimetre_numbers(file, scene)
-    names, meshes, bases = [], [], []
+    names, meshes = [], []
     for node, anc in part_nodes:
         transform, geom_name = graph[node]
         mesh = scene.geometry[geom_name].copy().apply_transform(transform)
         meshes.append(mesh.apply_scale(rescale) if rescale != 1.0 else mesh)
-        own = original(node)
-        raw = best_raw_name([own, str(geom_name), *[original(a) for a in anc]])
-        bases.append("part" if raw is None else clean_name(raw))
-        names.append(display_name(own if _REFERENCE_LABEL.search(own) is None else raw or own))
+        raw = best_raw([original(node), str(geom_name), *[original(a) for a in anc]])
+        names.append(display_name(original(node) if raw is None else raw))
+    bases = [
+        best_name([original(node), str(graph[node][1]), *[original(a) for a in anc]])
+        for node, anc in part_nodes
+    ]
     ids = unique_ids(bases)
     id_of = {node: pid for (node, _), pid in zip(part_nodes, ids, strict=True)}
     group_ids = unique_ids(
