@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 import typer
 
 from asmplan.cli.app import OutputFormat, app
-from asmplan.cli.options import GAMES_MAX, SEED_MAX, check_output
+from asmplan.cli.options import GAMES_MAX, check_output, seed_option
 
 if TYPE_CHECKING:  # pragma: no cover - types only
     from asp.dag import GameDAG
@@ -79,9 +79,7 @@ def train_command(
     graph: Path = typer.Argument(..., help=SOURCE_HELP),
     turn_model: TurnModel | None = typer.Option(None, "--turn-model", help=TURN_MODEL_HELP),
     config: str = typer.Option("paper", "--config", help="Training configuration: paper|fast."),
-    seed: int = typer.Option(
-        0, "--seed", min=0, max=SEED_MAX, help="Seed of models, environments and torch."
-    ),
+    seed: int = seed_option("Seed of models, environments and torch."),
     output: Path = typer.Option(..., "--output", "-o", help="Run folder (models, log, plots)."),
     resume: bool = typer.Option(False, "--resume", help="Continue the run saved in --output."),
     max_cycles: int | None = typer.Option(
@@ -117,7 +115,7 @@ def evaluate_command(
     games: int = typer.Option(
         1000, "--games", min=1, max=GAMES_MAX, help="Simulated random-human games."
     ),
-    seed: int = typer.Option(0, "--seed", min=0, max=SEED_MAX, help="Seed of the simulation."),
+    seed: int = seed_option("Seed of the simulation."),
 ) -> None:
     """Score a trained robot policy exactly: WCPL, certified WCPL, random-human metrics, RR."""
     from arl.trainer import evaluate
