@@ -146,6 +146,9 @@ class AssemblyPlan:
     concurrent : asp.concurrent_plan.ConcurrentPlan or None
         With the turn model ``concurrent``: the curve ``W*(k)``, the CP-SAT schedule's
         certified worst case, the timelines.
+    units : list of dict
+        Every unit used and every sub-assembly of the CAD file, used or why not
+        (:func:`asp.units.units_report`; ``plan.json``'s ``units``).
     """
 
     assembly: Assembly
@@ -157,6 +160,7 @@ class AssemblyPlan:
     relations_summary: list[dict]
     schedule: Schedule
     concurrent: ConcurrentPlan | None = None
+    units: list[dict] = field(default_factory=list)
 
     @property
     def dag(self) -> GameDAG:
@@ -177,6 +181,7 @@ class AssemblyPlan:
             "transitions": self.graph.n_transitions,
             "sequences": self.sequences,
             "schedule": self.schedule.to_dict(),
+            "units": self.units,
         }
         if self.concurrent is None:
             return plan_document(
@@ -389,9 +394,11 @@ def state_graph(
 ) -> StateGraph:
     """The assembly state graph: every feasible partial assembly and operation.
 
-    Interchangeable parts are placed in a fixed order (:mod:`asp.symmetry`: same TCT and W*,
-    far fewer states) and, when a part can never be inserted alone, subassemblies are added
-    automatically (:func:`asp.units.build_with_units`); the graph's ``spec`` holds both.
+    A spec generated from a CAD file builds the file's sub-assemblies that can be built
+    and inserted as units (:func:`asp.units.cad_units`); interchangeable parts are placed
+    in a fixed order (:mod:`asp.symmetry`: same TCT and W*, far fewer states) and, when a
+    part can never be inserted alone, subassemblies are added automatically
+    (:func:`asp.units.build_with_units`); the graph's ``spec`` holds all of it.
 
     Parameters
     ----------
@@ -410,9 +417,15 @@ def state_graph(
     from asp.symmetry import reduce_interchangeable
     from asp.units import build_with_units
 
-    spec = reduce_interchangeable(assembly.spec, assembly.relations)
+    rel = assembly.relations
     return build_with_units(
-        spec, assembly.relations, on_unit=on_step, progress=progress, max_states=max_states
+        assembly.spec,
+        rel,
+        hierarchy=assembly.spec.generated,
+        prepare=lambda spec: reduce_interchangeable(spec, rel),
+        on_unit=on_step,
+        progress=progress,
+        max_states=max_states,
     )
 
 
@@ -590,6 +603,9 @@ def plan(
     summary = relations_summary(assembly.relations) if assembly.relations is not None else []
     say("[2/5] building the assembly state graph ...")
     graph = state_graph(assembly, max_states=max_states, on_step=on_step)
+    from asp.units import units_report
+
+    units = units_report(assembly.spec, assembly.relations, graph.spec.subassemblies)
     if graph.spec is not assembly.spec:  # subassemblies found: their insertions are operations
         assembly = Assembly(graph.spec, assembly.relations)
     sequences = graph.count_sequences()
@@ -621,7 +637,7 @@ def plan(
             schedule=(sched.result, sched.lower_bound),
         )
     return AssemblyPlan(
-        assembly, graph, sequences, the_game, solution, steps, summary, sched, concurrent
+        assembly, graph, sequences, the_game, solution, steps, summary, sched, concurrent, units
     )
 
 

@@ -23,7 +23,12 @@ rule, fixed so that a generated spec plans the same as the file it writes:
   ``SP_g`` is empty, e.g. a dowel in a through hole or a shaft in a bore with clearance):
   an agent holds it until a later operation fixes it. It needs the part relations, so
   :func:`hold_unsupported` applies it once they are computed (``asmplan.pipeline.load``),
-  and :func:`spec_text` computes them to write it.
+  and :func:`spec_text` computes them to write it;
+- subassemblies: the file's sub-assemblies that can be built on their own and inserted
+  as one unit (:func:`asp.units.cad_units`: not holding the base part, buildable in their
+  own workspace, free from the base part along some direction) are units; the others are
+  written commented with the reason. The state graph of a generated spec gives up a unit
+  that leaves no complete sequence (:func:`asp.units.build_with_units`).
 """
 
 from __future__ import annotations
@@ -31,6 +36,7 @@ from __future__ import annotations
 import math
 import os
 from collections import Counter
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -104,8 +110,6 @@ def hold_unsupported(spec: AssemblySpec, relations) -> tuple[AssemblySpec, tuple
     user's spec is returned unchanged. Returns the spec and the parts now held (in the
     order of the operations).
     """
-    from dataclasses import replace
-
     if not spec.generated or not spec.constraints.stability or relations is None:
         return spec, ()
     loose = set(unsupported_parts(relations, spec.gravity, spec.base_part))
@@ -267,8 +271,6 @@ def generated_spec(path: str | Path) -> AssemblySpec:
     Its ``source`` is the spec file it stands for (``assembly.yaml`` beside the CAD file,
     which need not exist), so that part files resolve as in the written spec.
     """
-    from dataclasses import replace
-
     path = Path(path)
     data, _ = spec_data(path)
     folder = path if path.is_dir() else path.parent
@@ -282,12 +284,16 @@ def spec_text(
     *,
     contact_tol: float | None = None,
     penetration_tol: float | None = None,
+    decide_units=None,
 ) -> str:
     """The generated spec of a CAD file or folder as a commented ``assembly.yaml``.
 
     Part files are relative to ``spec_folder``, where the file will be written. Tolerances
     given (mm) are written as the spec's ``contact_tol`` / ``penetration_tol`` and used for
-    the ``held`` marks; else both keys are written commented out.
+    the ``held`` marks; else both keys are written commented out. ``decide_units(spec,
+    relations)`` (:func:`asp.units.cad_units`, given by the caller: it sits above this
+    module) decides which of the file's sub-assemblies are written as ``subassemblies:``;
+    without it they are all written commented.
     """
     import cad
 
@@ -321,14 +327,8 @@ def spec_text(
         lines.append(
             "# identical parts: " + ", ".join(f"{n} x {s}" for s, n in sorted(counts.items()))
         )
-    if assembly.groups:
-        lines += [
-            "# The file's sub-assemblies: uncomment to build them on their own and insert each",
-            "# as one unit (asp/units.py; a part belongs to one unit: keep one level).",
-            "# subassemblies:",
-        ]
-        for gid, members in assembly.groups:
-            lines.append(f"#   {gid}: [{', '.join(members)}]")
+    folder = spec_folder or (path if path.is_dir() else path.parent)
+    lines += _hierarchy_lines(data, assembly, rel, folder, decide_units)
     lines += [
         "",
         "agents:   # name -> side (human, robot); add R2, H2, ... as the cell has them",
@@ -356,6 +356,40 @@ def spec_text(
             f"agents: {{{agents}}}, part: {op['part']}" + (", held: true}" if hold else "}")
         )
     return "\n".join(lines) + "\n"
+
+
+def _hierarchy_lines(data: dict, assembly, relations, spec_folder, decide) -> list[str]:
+    """The ``subassemblies:`` of a written spec: the file's sub-assemblies that ``decide``
+    accepts, and the others commented with the reason."""
+    if not assembly.groups:
+        return []
+    if decide is None:
+        lines = [
+            "# The file's sub-assemblies: uncomment to build each on its own",
+            "# subassemblies:",
+        ]
+        return lines + [f"#   {gid}: [{', '.join(ms)}]" for gid, ms in assembly.groups]
+    folder = os.path.abspath(spec_folder)  # it may not exist yet: join the paths as text
+    parts = []
+    for record in data["parts"]:
+        file, hash_, node = record["file"].partition("#")
+        parts.append(
+            {**record, "file": os.path.normpath(os.path.join(folder, file)) + hash_ + node}
+        )
+    spec = spec_from_dict({**data, "parts": parts}, source=os.path.join(folder, SPEC_FILE))
+    spec, _ = hold_unsupported(replace(spec, generated=True), relations)
+    choices = decide(spec, relations)
+    used = [u for u in choices if u.used]
+    lines = [
+        "# The file's sub-assemblies (asp/units.py): each one listed is built on its own and",
+        "# inserted as one unit; delete a line to place its parts one by one. Commented: the",
+        "# ones that cannot be units, and why.",
+        "subassemblies:" if used else "# subassemblies:",
+    ]
+    for u in choices:
+        entry = f"{u.id}: [{', '.join(u.members)}]"
+        lines.append(f"  {entry}" if u.used else f"#   {entry}   # not used: {u.reason}")
+    return lines
 
 
 def _tolerance_line(key: str, value: float | None, meaning: str) -> str:

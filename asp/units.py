@@ -26,7 +26,8 @@ sound plans.
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -72,53 +73,111 @@ def host_groups(oracle, p: int, base: int) -> list[set[int]]:
     return sorted(out, key=len)
 
 
-def build_with_units(spec: AssemblySpec, relations=None, *, on_unit=None, **kwargs):
-    """Build the state graph, adding a subassembly for each part that can never go in alone.
+def build_with_units(
+    spec: AssemblySpec,
+    relations=None,
+    *,
+    hierarchy: bool = False,
+    prepare: Callable[[AssemblySpec], AssemblySpec] | None = None,
+    on_unit: Callable[[str], None] | None = None,
+    **kwargs,
+):
+    """Build the state graph with the CAD file's sub-assemblies and, when a part can never
+    go in alone, automatic subassemblies.
 
-    When the assembly has no complete sequence, each root-cause part (an operation never
-    done although ready somewhere) is grouped with the parts that hold it
-    (:func:`host_groups`: the smallest group, preferring one that shares parts with a unit
-    already found, so that the parts held by one host enter with it), overlapping groups
-    merge (with the units of earlier rounds too), and the graph is built again with those
-    units (at most :data:`MAX_ROUNDS` rounds). The original error is raised if that does
-    not help. Every unit is checked by the state graph itself: its members must go into
-    its own workspace one by one and the finished unit into the assembly as one rigid body,
-    so a unit that cannot be built or inserted gives no plan. Keyword arguments go to
-    :func:`asp.state_graph.build_state_graph`; ``on_unit`` is called with a line for each
-    round that adds units.
+    With ``hierarchy`` (a spec generated from a CAD file), the file's sub-assemblies that
+    pass :func:`cad_units` become units first. When the assembly has no complete sequence,
+    a sub-assembly of the file whose insertion (or a member's placement in its workspace)
+    is among the stuck operations (:func:`stuck_operations`) is given up (its own
+    sub-assemblies may then become units) and the graph built again; when none is, each
+    stuck part is grouped with the parts that hold it (:func:`host_groups`: the smallest
+    group, preferring one that shares parts with a unit already found, so that the parts
+    held by one host enter with it), overlapping groups merge (with the units of earlier
+    rounds too), and the graph is built again (at most :data:`MAX_ROUNDS` rounds); if no
+    new unit can be found, the file's remaining sub-assemblies are given up before the
+    first error is raised. Every unit is checked by the state graph itself: its members
+    must go into its own workspace one by one and the finished unit into the assembly as
+    one rigid body, so units only ever give sound plans.
+
+    Parameters
+    ----------
+    spec : AssemblySpec
+    relations : cad Relations, optional
+    hierarchy : bool
+        Use the CAD file's sub-assemblies (:func:`with_cad_units`).
+    prepare : callable, optional
+        Applied to the spec with the file's units before building (e.g. the reduction of
+        interchangeable parts, :func:`asp.symmetry.reduce_interchangeable`).
+    on_unit : callable, optional
+        Called with a line for each unit decision (a person reads it on stderr).
+    **kwargs
+        For :func:`asp.state_graph.build_state_graph`.
 
     Returns
     -------
     StateGraph
-        Its ``spec`` holds the units found (``spec.subassemblies``).
+        Its ``spec`` holds the units used (``spec.subassemblies``).
     """
     from asp.state_graph import build_state_graph
 
+    say = on_unit or (lambda _line: None)
     first_error = None
-    found: list[tuple[str, ...]] = []
-    current = spec
-    for _ in range(MAX_ROUNDS + 1):
-        try:
-            return build_state_graph(current, relations, **kwargs)
-        except ValueError as exc:
-            if relations is None or "infeasible assembly" not in str(exc):
-                raise
-            first_error = first_error or exc
-            graph = build_state_graph(current, relations, **{**kwargs, "check": False})
-            groups = _new_units(graph, stuck_operations(graph), spec, found)
-            if groups is None:
-                raise first_error from None
+    given_up: set[str] = set()
+    while True:
+        base, choices = with_cad_units(spec, relations, given_up) if hierarchy else (spec, ())
+        optional = {u.id: set(u.members) for u in choices if u.used}
+        for u in choices:
+            say(hierarchy_line(u))
+        if prepare is not None:
+            base = prepare(base)
+        found: list[tuple[str, ...]] = []
+        current = base
+        for _ in range(MAX_ROUNDS + 1):
             try:
-                current = with_subassemblies(spec, _named(spec, groups))
+                return build_state_graph(current, relations, **kwargs)
+            except ValueError as exc:
+                if relations is None or "infeasible assembly" not in str(exc):
+                    raise
+                first_error = first_error or exc
+            graph = build_state_graph(current, relations, **{**kwargs, "check": False})
+            stuck = stuck_operations(graph)
+            drop = _stuck_units(graph.spec, stuck, optional)
+            if drop:
+                break
+            groups = _new_units(graph, stuck, base, found)
+            if groups is None:
+                drop = set(optional)
+                break
+            try:
+                current = with_subassemblies(base, _named(base, groups))
             except ValueError:
-                raise first_error from None
+                drop = set(optional)
+                break
             found = groups
-            if on_unit is not None:
-                on_unit(
-                    "no complete sequence with single parts: trying subassemblies "
-                    + "; ".join(f"[{', '.join(g)}]" for g in groups)
-                )
-    raise first_error
+            say(
+                "no complete sequence with single parts: trying subassemblies "
+                + "; ".join(f"[{', '.join(g)}]" for g in groups)
+            )
+        else:
+            drop = set(optional)
+        if not drop:
+            raise first_error from None
+        given_up |= drop
+        say(
+            f"the file's sub-assembl{'y' if len(drop) == 1 else 'ies'} {', '.join(sorted(drop))}"
+            f": {GIVEN_UP}; planned without it"
+        )
+
+
+def _stuck_units(spec: AssemblySpec, stuck: list[int], optional: dict[str, set[str]]) -> set[str]:
+    """The optional units whose insertion or members' placement is among ``stuck``."""
+    out = set()
+    for i in stuck:
+        op = spec.operations[i]
+        for uid, members in optional.items():
+            if op.unit == uid or set(op.parts) & members:
+                out.add(uid)
+    return out
 
 
 def stuck_operations(graph) -> list[int]:
@@ -190,6 +249,221 @@ def _named(spec: AssemblySpec, groups: list[tuple[str, ...]]) -> list[tuple[str,
     return out
 
 
+GIVEN_UP = "no complete sequence with it as one unit"
+"""Why a sub-assembly of the file that passed :func:`cad_units` is not used."""
+BUILD_SEARCH_LIMIT = 20_000
+"""Partial workspaces tried when checking that a sub-assembly can be built on its own;
+beyond it the check is left to the state graph."""
+
+
+@dataclass(frozen=True)
+class HierarchyUnit:
+    """One sub-assembly of the CAD file and whether it is planned as a unit.
+
+    Attributes
+    ----------
+    id : str
+        The unit id (the group's cleaned name).
+    members : tuple of str
+        Its parts (the spec's ids).
+    used : bool
+        Planned as a unit (built in its own workspace, inserted as one body).
+    reason : str
+        Why it is not used (empty when it is).
+    """
+
+    id: str
+    members: tuple[str, ...]
+    used: bool
+    reason: str = ""
+
+
+def hierarchy_line(unit: HierarchyUnit) -> str:
+    """One line for a person: the file's sub-assembly, used or why not."""
+    head = f"the file's sub-assembly {unit.id} [{', '.join(unit.members)}]"
+    return head + (
+        ": built on its own, inserted as one unit" if unit.used else f": not used ({unit.reason})"
+    )
+
+
+def cad_units(
+    spec: AssemblySpec, relations, exclude: Iterable[str] = ()
+) -> tuple[HierarchyUnit, ...]:
+    """Decide which of the CAD file's sub-assemblies become units.
+
+    The file's groups (:func:`asp.generate.spec_hierarchy`), outermost first; a part
+    belongs to one unit, so a group inside a used one is not used. A group is used when
+
+    - it does not hold the base part (that stands first in the main assembly);
+    - each of its parts is placed by an operation of its own, placing no other part;
+    - it can be built on its own: its parts go into its workspace one by one, each free
+      along a direction the gripper approaches from, touching and supported (unless held)
+      by the parts already there (a search over the orders, at most
+      :data:`BUILD_SEARCH_LIMIT` partial workspaces; undecided counts as buildable);
+    - it can be inserted as one rigid body: free from the base part along such a
+      direction, touching a part outside it and, with the stability constraint,
+      resting on one.
+
+    The state graph decides the rest (:func:`build_with_units` gives up a unit that
+    leaves no complete sequence). ``exclude``: groups given up already (their own groups
+    are then candidates).
+    """
+    from asp.feasibility import insertion_oracle
+    from asp.generate import spec_hierarchy
+
+    if relations is None:
+        return ()
+    groups = spec_hierarchy(spec)
+    if not groups:
+        return ()
+    exclude = set(exclude)
+    oracle = insertion_oracle(spec, relations)
+    index = {p: k for k, p in enumerate(oracle.parts)}
+    op_of = {p: op for op in spec.operations for p in op.parts}
+    taken_ids = set(spec.op_ids) | set(spec.part_ids) | {u for u, _ in spec.subassemblies}
+    in_unit: dict[str, str] = {m: u for u, ms in spec.subassemblies for m in ms}
+    out = []
+    for gid, members in groups:
+        uid = gid if gid not in taken_ids else f"{gid}_unit"
+        reason = _unit_problem(spec, oracle, index, op_of, in_unit, members)
+        if uid in exclude and not reason:
+            reason = GIVEN_UP
+        out.append(HierarchyUnit(uid, members, not reason, reason))
+        if not reason:
+            in_unit.update(dict.fromkeys(members, uid))
+            taken_ids.add(uid)
+    return tuple(out)
+
+
+def _unit_problem(spec, oracle, index, op_of, in_unit, members) -> str:
+    """Why a group cannot be a unit ("" when it can)."""
+    inside = {in_unit[m] for m in members if m in in_unit}
+    if inside:
+        return f"its parts are in the unit {sorted(inside)[0]} (one level of units)"
+    if spec.base_part in members:
+        return f"it holds the base part {spec.base_part}, placed first in the main assembly"
+    for m in members:
+        op = op_of.get(m)
+        if op is None:
+            return f"no operation places {m}"
+        if not set(op.parts) <= set(members):
+            return f"operation {op.id} places parts inside and outside it"
+    idx = [index[m] for m in members]
+    held = {index[m]: op_of[m].held for m in members}
+    why = _build_problem(oracle, idx, held)
+    if why:
+        return f"it cannot be built on its own: {why}"
+    return _insert_problem(spec, oracle, idx)
+
+
+def _build_problem(oracle, members: list[int], held: dict[int, bool]) -> str:
+    """Why no order builds ``members`` in a workspace of their own ("" if one does)."""
+    dead: set[int] = set()
+    best = [0]
+    tried = [0]
+
+    def grow(s: int, left: frozenset) -> bool:
+        if not left:
+            return True
+        if s in dead:
+            return False
+        tried[0] += 1
+        if tried[0] > BUILD_SEARCH_LIMIT:
+            raise _Undecided
+        if s.bit_count() > best[0].bit_count():
+            best[0] = s
+        for p in sorted(left):
+            fits = s == 0 or oracle.feasible(p, [s], held=held[p], workspace=True)[0]
+            if fits and grow(s | 1 << p, left - {p}):
+                return True
+        dead.add(s)
+        return False
+
+    try:
+        if grow(0, frozenset(members)):
+            return ""
+    except _Undecided:
+        return ""
+    s = best[0]
+    placed = [oracle.parts[j] for j in members if s >> j & 1]
+    p = next(j for j in members if not s >> j & 1)
+    reasons = oracle.reasons(p, s, held=held[p], workspace=True)
+    return f"with {', '.join(placed)} placed, {oracle.parts[p]} cannot go in ({'; '.join(reasons)})"
+
+
+class _Undecided(Exception):
+    """The build search reached its limit."""
+
+
+def _insert_problem(spec, oracle, members: list[int]) -> str:
+    """Why the finished group cannot go into any assembly as one body ("" if it may)."""
+    from asp.feasibility import unpack_words
+
+    unit = sum(1 << j for j in members)
+    outside = ((1 << len(oracle.parts)) - 1) & ~unit
+    contact = support = 0
+    blocked = [0] * 6
+    for j in members:
+        contact |= unpack_words(oracle.contact[j])
+        support |= unpack_words(oracle.support[j])
+        for d in range(6):
+            blocked[d] |= unpack_words(oracle.blocked[j, d])
+    if not contact & outside:
+        return "it touches no part outside it"
+    if oracle.stability and not support & outside:
+        return "nothing outside it can keep it from falling"
+    if oracle.base >= 0:
+        ways = [d for d in range(6) if oracle.directions[d] and not blocked[d] >> oracle.base & 1]
+        if not ways:
+            return f"the base part {oracle.parts[oracle.base]} blocks it along every direction"
+    return ""
+
+
+def units_report(
+    spec: AssemblySpec, relations, used: Iterable[tuple[str, Iterable[str]]]
+) -> list[dict]:
+    """Every unit and sub-assembly of the file, for ``plan.json``'s ``units``.
+
+    ``spec`` is the assembly's spec before planning and ``used`` the units the state graph
+    used (``graph.spec.subassemblies``). Each entry: ``id``, ``parts``, ``source`` (``spec``,
+    ``cad`` or ``automatic``), ``used`` and ``reason`` (why a sub-assembly of the file is
+    not used; empty when it is).
+    """
+    used = {u: tuple(ms) for u, ms in used}
+    own = {u for u, _ in spec.subassemblies}
+    choices: tuple[HierarchyUnit, ...] = ()
+    if spec.generated:
+        exclude: set[str] = set()
+        while True:  # the decisions build_with_units reached: the given-up ones excluded
+            choices = cad_units(spec, relations, exclude)
+            lost = {u.id for u in choices if u.used and u.id not in used}
+            if not lost:
+                break
+            exclude |= lost
+    cad = {u.id for u in choices}
+    out = [
+        {"id": u.id, "parts": list(u.members), "source": "cad", "used": u.used, "reason": u.reason}
+        for u in choices
+    ]
+    for uid, members in used.items():
+        if uid not in cad:
+            source = "spec" if uid in own else "automatic"
+            out.append(
+                {"id": uid, "parts": list(members), "source": source, "used": True, "reason": ""}
+            )
+    return out
+
+
+def with_cad_units(
+    spec: AssemblySpec, relations, exclude: Iterable[str] = ()
+) -> tuple[AssemblySpec, tuple[HierarchyUnit, ...]]:
+    """``spec`` with the CAD file's sub-assemblies that :func:`cad_units` accepts as units,
+    and every decision (used or why not)."""
+    choices = cad_units(spec, relations, exclude)
+    used = [(u.id, u.members) for u in choices if u.used]
+    return (with_subassemblies(spec, used) if used else spec), choices
+
+
 def unit_parts_of_line(spec: AssemblySpec, operations: Iterable[str]) -> list[list[str]]:
     """For each operation of a line, the parts it places (a unit's insertion: its members)."""
     members = unit_members(spec)
@@ -198,10 +472,15 @@ def unit_parts_of_line(spec: AssemblySpec, operations: Iterable[str]) -> list[li
 
 
 __all__ = [
+    "HierarchyUnit",
     "build_with_units",
+    "cad_units",
+    "hierarchy_line",
     "host_groups",
     "unit_members",
     "unit_parts_of_line",
+    "units_report",
+    "with_cad_units",
     "with_subassemblies",
     "workspace_of",
 ]

@@ -28,6 +28,7 @@ def init_command(
     from asp.atomic import write_text
     from asp.generate import spec_text
     from asp.spec import spec_from_dict
+    from asp.units import cad_units
     from cad.yamlfile import DecimalsAsText
 
     if not source.exists():
@@ -40,6 +41,7 @@ def init_command(
         spec_folder=output.parent,
         contact_tol=contact_tol,
         penetration_tol=penetration_tol,
+        decide_units=cad_units,
     )
     # the text must read back as a valid spec before it is written
     spec = spec_from_dict(yaml.load(text, Loader=DecimalsAsText), source=str(output))  # noqa: S506

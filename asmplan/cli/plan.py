@@ -41,6 +41,7 @@ def plan_summary(result) -> list[str]:
     if result.relations_summary:
         lines.append("part relations (contacts with directions; free directions in the assembly):")
         lines.append(relations_summary_text(result.relations_summary))
+    lines += units_text(result.units)
     lines.append(
         f"state graph: {graph.n_states:,} states, {graph.n_transitions:,} transitions, "
         f"{result.sequences:,} feasible sequences"
@@ -81,6 +82,19 @@ def plan_summary(result) -> list[str]:
         f"CP-SAT makespan (agents in parallel): {found}; "
         f"state-graph lower bound {sched.lower_bound:g} s"
     )
+    return lines
+
+
+def units_text(units: list[dict]) -> list[str]:
+    """The subassemblies of a plan (``plan.json``'s ``units``): used ones with their parts
+    and where they come from, the CAD file's unused ones with the reason."""
+    if not units:
+        return []
+    source = {"spec": "the spec", "cad": "the CAD file", "automatic": "found automatically"}
+    lines = ["subassemblies (each built on its own, then inserted as one unit):"]
+    for u in units:
+        head = f"  {u['id']} [{', '.join(u['parts'])}] from {source[u['source']]}"
+        lines.append(head + ("" if u["used"] else f": not used, {u['reason']}"))
     return lines
 
 

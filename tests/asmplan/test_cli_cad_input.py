@@ -53,7 +53,8 @@ def test_plan_a_cad_file_with_no_spec(tmp_path, kind):
     doc, err = plan(source, tmp_path / "out")
     assert "no assembly.yaml: generated a spec" in err
     ops = [s["operation"] for s in doc["robust_plan"] if s["operation"]]
-    assert len(ops) == len(doc["relations"])  # one placement per part
+    units = [u for u in doc["units"] if u["used"]]
+    assert len(ops) == len(doc["relations"]) + len(units)  # a placement per part and unit
     assert doc["tct"] > 0 and doc["minimax"] >= doc["tct"]
 
 
@@ -70,7 +71,7 @@ def test_init_writes_a_spec_that_plans_the_same(tmp_path):
         'table_frame_in.step#cap_1", shape: cap}' in text
         and "# identical parts: 2 x cap, 2 x pillar" in text
     )
-    assert "# subassemblies:\n#   pillar_unit_1: [cap_1, pillar_1]\n" in text
+    assert "\nsubassemblies:\n  pillar_unit_1: [cap_1, pillar_1]\n" in text  # used
     from_file, _ = plan(STEP, tmp_path / "a")
     from_spec, err = plan(spec, tmp_path / "b")
     assert "generated" not in err

@@ -214,3 +214,102 @@ def test_gusseted_box_plans_with_defaults(gusset_box):
     doc = result.to_dict()
     assert len(doc["subassemblies"]) == 2
     check_line(result.assembly.spec, gusset_box, plan_operations(doc))
+
+
+# ------------------------------------------------------------------ the CAD file's hierarchy
+
+
+def write_glb(path, parts: dict, tree: dict) -> None:
+    """A glTF in metres of ``parts`` (mm) under the product node ``Product``; ``tree`` maps
+    a group node to its children (parts or groups), nested as a CAD product tree."""
+    import trimesh
+
+    scene = trimesh.Scene()
+    scene.graph.update(frame_from="world", frame_to="Product")
+
+    def add(name, parent):
+        if name in tree:
+            scene.graph.update(frame_from=parent, frame_to=name)
+            for child in tree[name]:
+                add(child, name)
+        else:
+            scene.add_geometry(
+                parts[name].copy().apply_scale(0.001),
+                node_name=name,
+                geom_name=f"mesh_{name}",
+                parent_node_name=parent,
+            )
+
+    for name in tree["Product"]:
+        add(name, "Product")
+    scene.export(str(path))
+
+
+TOWER_TREE = {
+    "Product": ["Frame", "Level 1", "Level 2"],
+    "Frame": ["base", "Rods"],
+    "Rods": ["rod_1", "rod_2"],
+    "Level 1": ["holder_1", "bearing_1a", "bearing_1b"],
+    "Level 2": ["holder_2", "bearing_2a", "bearing_2b"],
+}
+
+
+def test_the_files_sub_assemblies_become_units(tmp_path):
+    from asmplan import pipeline
+    from asp.checker import plan_operations
+
+    write_glb(tmp_path / "tower.glb", rod_tower(), TOWER_TREE)
+    lines = []
+    result = pipeline.plan(tmp_path / "tower.glb", time_limit=5, on_step=lines.append)
+    doc = result.to_dict()
+    units = {u["id"]: u for u in doc["units"]}
+    assert {u: units[u]["used"] for u in units} == {
+        "frame": False,
+        "rods": False,
+        "level_1": True,
+        "level_2": True,
+    }
+    assert (
+        units["frame"]["reason"] == "it holds the base part base, placed first in the main assembly"
+    )
+    assert units["rods"]["reason"].startswith("it cannot be built on its own: with rod_1 placed")
+    assert all(u["source"] == "cad" for u in units.values())
+    assert sorted(doc["subassemblies"]) == ["level_1", "level_2"]
+    assert any("sub-assembly level_1 [bearing_1a, bearing_1b, holder_1]: built" in x for x in lines)
+    check_line(result.assembly.spec, result.assembly.relations, plan_operations(doc))
+
+
+def test_init_writes_the_units_it_uses(tmp_path):
+    from typer.testing import CliRunner
+
+    from asmplan.cli import app
+
+    write_glb(tmp_path / "tower.glb", rod_tower(), TOWER_TREE)
+    out = tmp_path / "work" / "assembly.yaml"
+    result = CliRunner().invoke(app, ["init", str(tmp_path / "tower.glb"), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    text = out.read_text()
+    assert "\nsubassemblies:\n" in text
+    assert "\n  level_1: [bearing_1a, bearing_1b, holder_1]\n" in text
+    assert "\n#   frame: [base, rod_1, rod_2]   # not used: it holds the base part" in text
+
+
+def test_a_sub_assembly_that_leaves_no_sequence_is_given_up(tmp_path):
+    """A corner of the gusseted box (two walls) can be built and goes in from above, but
+    then the corner's gusset can go in with neither wall: the plan gives the corner up and
+    finds the walls with their gussets instead."""
+    from asmplan import pipeline
+    from asp.checker import plan_operations
+    from asp.units import GIVEN_UP
+
+    parts = gusseted_box()
+    others = [p for p in parts if p not in ("front", "left")]
+    write_glb(
+        tmp_path / "box.glb", parts, {"Product": ["Corner", *others], "Corner": ["front", "left"]}
+    )
+    result = pipeline.plan(tmp_path / "box.glb", time_limit=5)
+    doc = result.to_dict()
+    units = {u["id"]: u for u in doc["units"]}
+    assert units["corner"]["used"] is False and units["corner"]["reason"] == GIVEN_UP
+    assert [u["source"] for u in units.values() if u["used"]] == ["automatic", "automatic"]
+    check_line(result.assembly.spec, result.assembly.relations, plan_operations(doc))
