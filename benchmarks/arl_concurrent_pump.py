@@ -10,6 +10,7 @@ Usage::
 
     .venv/bin/python benchmarks/arl_concurrent_pump.py --seeds 10
     .venv/bin/python benchmarks/arl_concurrent_pump.py --seeds 5 --unscaled
+    .venv/bin/python benchmarks/arl_concurrent_pump.py --seeds 10 --n-steps 32
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=10, help="training seeds 0..N-1")
     parser.add_argument("--unscaled", action="store_true", help="reward_scale none")
+    parser.add_argument("--n-steps", type=int, default=None, help="PPO n_steps (default: fast's)")
     args = parser.parse_args()
     torch.set_num_threads(1)
     assembly = pipeline.load(REPO / "examples" / "vacuum_pump")
@@ -46,6 +48,8 @@ def main() -> None:
     cfg = get_config("fast")
     if args.unscaled:
         cfg = cfg.replace(name="fast-unscaled", reward_scale="none")
+    if args.n_steps is not None:
+        cfg = cfg.replace(name=f"{cfg.name}-n_steps={args.n_steps}", n_steps=args.n_steps)
     hits = 0
     for seed in range(args.seeds):
         t0 = time.perf_counter()
