@@ -108,7 +108,8 @@ class Advice:
     options : list of dict
         At the person's turn, every operation the person may start with the worst case it
         leads to (``{"operation", "agent", "description", "cost", "worst"}``, ``worst``
-        the guaranteed total cost after it).
+        the guaranteed total cost after it). Concurrent: also ``durations`` (those the plan
+        knows; ``cost`` the longest) and ``deviation`` (not the instruction).
     elapsed : float
         Cost so far.
     bound : float
@@ -515,12 +516,17 @@ class ConcurrentAdvisor(Advisor):
                 for o, a, d in moves["starts"][m]:
                     if (o, a) in pending or a in busy:
                         continue
-                    w, dur = worst.get((o, a), (-math.inf, 0))
-                    worst[(o, a)] = (max(w, after), max(dur, d))
+                    w, durations = worst.get((o, a), (-math.inf, set()))
+                    worst[(o, a)] = (max(w, after), durations | {d})
         out = []
-        for (o, a), (w, dur) in sorted(worst.items()):
+        for (o, a), (w, durations) in sorted(worst.items()):
             item = self._op_dict(o, a)
-            item.update(cost=dur, worst=w, deviation=a in told and told[a] != o)
+            item.update(
+                cost=max(durations),
+                durations=sorted(durations),
+                worst=w,
+                deviation=a in told and told[a] != o,
+            )
             out.append(item)
         return out
 

@@ -637,15 +637,21 @@ def timed_write(path: str | os.PathLike[str], doc: dict) -> tuple[Path, float, i
     return out, time.perf_counter() - t0, out.stat().st_size
 
 
-def build_plan(assembly: str | os.PathLike[str], *, cost: str | None = None) -> dict:
-    """Plan an assembly (folder, ``assembly.yaml`` or ``.IN2``) without the CP-SAT schedule.
+def build_plan(
+    assembly: str | os.PathLike[str], *, cost: str | None = None, turn_model: str | None = None
+) -> dict:
+    """Plan an assembly (folder, ``assembly.yaml`` or ``.IN2``).
 
-    The relations, state graph, game and exact solution (:mod:`asmplan.pipeline`), then
-    :func:`plan_document`.
+    Turn model ``alternate``: the relations, state graph, game and exact solution
+    (:mod:`asmplan.pipeline`), then :func:`plan_document`, without the CP-SAT schedule.
+    ``concurrent`` (``turn_model``, default the spec's): :func:`asmplan.pipeline.plan`, the
+    curve ``W*(k)`` and the CP-SAT comparison included.
     """
     from asmplan import pipeline
 
     loaded = pipeline.load(assembly)
+    if (turn_model or loaded.spec.turn_model) == "concurrent":
+        return pipeline.plan(loaded, cost=cost, turn_model="concurrent").to_dict()
     graph = pipeline.state_graph(loaded)
     dag = pipeline.game(graph, cost=cost)
     solution = pipeline.solve_game(dag)

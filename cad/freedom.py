@@ -242,25 +242,47 @@ def check_interpenetration(
         of this pair Y mm)``.
     """
     tols = resolve_tolerances(assembly, None, penetration_tol)
+    for a, b in overlapping_pairs(assembly, tols, eroded, first=True):
+        raise interpenetration_error(assembly, tols, a, b)
+
+
+def overlapping_pairs(
+    assembly: Assembly, tols, eroded: list[trimesh.Trimesh] | None = None, *, first: bool = False
+) -> list[tuple[int, int]]:
+    """Pairs ``(a, b)``, ``a < b``, whose parts eroded by their shrinks still share volume
+    (overlap deeper than the pair's tolerance); only the first one if ``first``."""
     if eroded is None:
         eroded = eroded_meshes(assembly, tols.shrink)
     objects = [_collision_object(m) for m in eroded]
     bounds = [np.asarray(m.bounds) for m in eroded]
     n = len(assembly)
+    found = []
     for a in range(n):
         for b in range(a + 1, n):
             if not bounds_overlap(bounds[a], bounds[b]):
                 continue
             if _intersect(eroded[a], eroded[b], objects[a], objects[b]):
-                pa, pb = assembly.parts[a], assembly.parts[b]
-                ptol = tols.pair(a, b)
-                depth = _depth_estimate(pa.mesh, pb.mesh, ptol)
-                hint = unit_hint(assembly, a, b)
-                raise GeometryError(
-                    f"parts {pa.id!r} and {pb.id!r} interpenetrate by {depth} "
-                    f"(penetration tolerance of this pair {ptol:.3g} mm)"
-                    + (f"; {hint}" if hint else "")
-                )
+                found.append((a, b))
+                if first:
+                    return found
+    return found
+
+
+def interpenetration_error(assembly: Assembly, tols, a: int, b: int) -> GeometryError:
+    """The one-line error for parts ``a`` and ``b`` overlapping deeper than their tolerance."""
+    pa, pb = assembly.parts[a], assembly.parts[b]
+    ptol = tols.pair(a, b)
+    depth = _depth_estimate(pa.mesh, pb.mesh, ptol)
+    hint = unit_hint(assembly, a, b)
+    return GeometryError(
+        f"parts {pa.id!r} and {pb.id!r} interpenetrate by {depth} "
+        f"(penetration tolerance of this pair {ptol:.3g} mm)" + (f"; {hint}" if hint else "")
+    )
+
+
+def intersects(a: trimesh.Trimesh, b: trimesh.Trimesh) -> bool:
+    """Whether closed meshes ``a`` and ``b`` share volume (crossing surfaces or nesting)."""
+    return _intersect(a, b)
 
 
 def _depth_estimate(a: trimesh.Trimesh, b: trimesh.Trimesh, ptol: float) -> str:

@@ -11,7 +11,8 @@ from cad.assembly import Assembly
 from cad.contact import contact_relation
 from cad.directions import DIRECTIONS
 from cad.errors import GeometryError
-from cad.freedom import check_interpenetration, eroded_meshes
+from cad.fits import find_fits
+from cad.freedom import eroded_meshes
 from cad.freedom import translational_freedom as _freedom
 from cad.support import support_relation
 from cad.tolerances import resolve_tolerances
@@ -43,6 +44,9 @@ class Relations:
     sp : np.ndarray or None
         Bool, shape ``(n, n, 6)``: ``sp[i, j, d]`` = part i falling along ``d`` is stopped
         by part j (:mod:`cad.support`); None when not computed (tables built by hand).
+    fits : tuple of (str, str, float)
+        Screws, studs and pins drawn into a hole deeper than the pair's tolerance
+        (:mod:`cad.fits`): (inner part, part with the hole, extra tolerance in mm).
     """
 
     parts: tuple[str, ...]
@@ -54,6 +58,7 @@ class Relations:
     part_shrink: tuple[float, ...] = ()
     directions: tuple[str, ...] = DIRECTIONS
     sp: np.ndarray | None = None
+    fits: tuple[tuple[str, str, float], ...] = ()
 
     def __post_init__(self) -> None:
         n = len(self.parts)
@@ -91,6 +96,7 @@ class Relations:
             "tc": self.tc.tolist(),
             "tt": self.tt.tolist(),
             **({} if self.sp is None else {"sp": self.sp.tolist()}),
+            **({} if not self.fits else {"fits": [list(f) for f in self.fits]}),
         }
 
 
@@ -124,14 +130,18 @@ def compute_relations(
     Raises
     ------
     ValueError
-        Two parts interpenetrate deeper than the penetration tolerance.
+        Two parts interpenetrate deeper than the penetration tolerance and are not a fit
+        (a screw or pin in a hole, :mod:`cad.fits`).
     """
     tols = resolve_tolerances(assembly, contact_tol, penetration_tol)
     eroded = eroded_meshes(assembly, tols.shrink)
-    check_interpenetration(assembly, penetration_tol=tols, eroded=eroded)
+    fits = find_fits(assembly, tols, eroded)
     tc = contact_relation(assembly, penetration_tol=tols, progress=progress)
     tt = _freedom(assembly, penetration_tol=tols, progress=progress, check=False, eroded=eroded)
     sp = support_relation(assembly, tols, eroded, tc, tt, progress=progress)
+    for fit in fits:
+        fit.write_into(tc, tt, sp)
+    ids = assembly.ids
     return Relations(
         parts=assembly.ids,
         tc=tc,
@@ -141,6 +151,7 @@ def compute_relations(
         units=assembly.units,
         part_shrink=tuple(float(x) for x in tols.shrink),
         sp=sp,
+        fits=tuple((ids[f.inner], ids[f.outer], round(float(f.extra), 4)) for f in fits),
     )
 
 

@@ -58,7 +58,9 @@ so tessellation overlaps (hundredths), zero-clearance pins drawn at the hole dia
 with another polygon, finger joints cut with kerf compensation and press fits interfering
 by two to four tenths pass as they come. An overlap no deeper than the pair's tolerance
 counts as touching; a deeper one in the assembled pose is a ValueError naming the pair and
-the depth. Features shallower than the tolerance do not block a slide either (a 0.2 mm
+the depth, unless it is a *fit* (:mod:`cad.fits`): a screw, stud or pin in a hole drawn
+at the tap-drill diameter or pressed in, overlapping the wall all round by up to a fifth of
+its thickness. Features shallower than the tolerance do not block a slide either (a 0.2 mm
 ridge between two 100 mm parts is ignored), which is the price of accepting real exports.
 
 An explicit ``penetration_tol`` (``--penetration-tol``) replaces the rule: every part then

@@ -13,12 +13,14 @@ import typer
 
 from asmplan.cli.app import app
 from asmplan.cli.graph import say
+from asmplan.cli.plan import TurnModel
 
 LOCAL_HOSTS = ("127.0.0.1", "localhost", "::1")
 
 
-def load_source(source: Path) -> dict:
-    """The plan document of a plan folder, a ``plan.json`` or an assembly."""
+def load_source(source: Path, turn_model: str | None = None) -> dict:
+    """The plan document of a plan folder, a ``plan.json`` or an assembly (planned in
+    ``turn_model``, default the spec's)."""
     from asmplan.planfile import build_plan, read_plan
 
     if not source.exists():
@@ -26,7 +28,7 @@ def load_source(source: Path) -> dict:
     if (source.is_dir() and (source / "plan.json").is_file()) or source.suffix == ".json":
         return read_plan(source)
     say(f"planning {source} ...")
-    return build_plan(source)
+    return build_plan(source, turn_model=turn_model)
 
 
 def read_questionnaire(path: Path | None) -> list[dict] | None:
@@ -58,13 +60,17 @@ def serve_command(
     questionnaire: Path | None = typer.Option(
         None, "--questionnaire", help="JSON list of questionnaire items (default: built in)."
     ),
+    turn_model: TurnModel | None = typer.Option(
+        None, "--turn-model", help="An assembly's turn model when planned here (default: spec's)."
+    ),
 ) -> None:
     """Serve the advisor's JSON API and the page to play the plan (FastAPI + uvicorn)."""
     import uvicorn
 
     from asmplan.serve import create_app
 
-    plans = [load_source(s) for s in sources]
+    turn = None if turn_model is None else turn_model.value
+    plans = [load_source(s, turn) for s in sources]
     items = read_questionnaire(questionnaire)
     application = create_app(plans, sessions, questionnaire=items)
     if host not in LOCAL_HOSTS:

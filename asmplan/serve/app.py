@@ -78,8 +78,10 @@ class AnswersIn(BaseModel):
 
 
 def plan_id(plan: dict) -> str:
-    """A URL-safe id from the assembly's name (``vacuum pump`` -> ``vacuum-pump``)."""
-    return re.sub(r"[^a-z0-9]+", "-", str(plan.get("assembly", "plan")).lower()).strip("-")
+    """A URL-safe id from the assembly's name (``vacuum pump`` -> ``vacuum-pump``; a plan of
+    the concurrent game: ``vacuum-pump-concurrent``)."""
+    name = re.sub(r"[^a-z0-9]+", "-", str(plan.get("assembly", "plan")).lower()).strip("-")
+    return f"{name}-concurrent" if plan.get("turn_model") == "concurrent" else name
 
 
 def _plotly_js() -> Path:

@@ -218,7 +218,7 @@ class SessionStore:
                     _iso(s.created),
                     _iso(s.finished_at) if s.finished_at else "",
                     len(s.events),
-                    sum(1 for e in s.events if e["by"] == "human" and e["kind"] == "finished"),
+                    _choices(s.events),
                     s.deviations,
                     outcome.get("cost", ""),
                     plan["metrics"]["w0"],
@@ -237,6 +237,20 @@ def _event(record: dict) -> Event:
         record.get("time"),
         record.get("duration"),
     )
+
+
+def _choices(events: list) -> int:
+    """The person's choices: her starts, and her completions not seen to start (the
+    alternating game's sensor may see completions only)."""
+    seen, n = set(), 0
+    for e in events:
+        if e["by"] != "human":
+            continue
+        key = (e["operation"], e["agent"])
+        if e["kind"] == "started" or key not in seen:
+            n += 1
+        seen.add(key)
+    return n
 
 
 def _side(plan: dict, agent: str) -> str:

@@ -35,3 +35,16 @@ def test_questionnaire_file(tmp_path):
 def test_binds_local_by_default():
     host = inspect.signature(serve_command).parameters["host"].default
     assert host.default == "127.0.0.1"
+
+
+def test_load_source_plans_an_assembly_in_its_turn_model(tmp_path):
+    """An assembly given to ``serve`` is planned in the spec's turn model or ``--turn-model``."""
+    import yaml
+
+    from tests.asmplan.plans import CHOICES
+
+    (tmp_path / "assembly.yaml").write_text(yaml.safe_dump({**CHOICES, "turn_model": "concurrent"}))
+    doc = load_source(tmp_path)
+    assert doc["turn_model"] == doc["policy"]["turn_model"] == "concurrent"
+    assert [r["bound"] for r in doc["robustness"]] == [12, 14, 15, 15]
+    assert load_source(tmp_path, "alternate")["turn_model"] == "alternate"

@@ -11,6 +11,7 @@ from __future__ import annotations
 import shutil
 from pathlib import Path
 
+import httpx
 import pytest
 
 from asmplan.advisor import Advisor
@@ -82,7 +83,11 @@ def test_play_the_pump_to_the_end(browser, tmp_path):
             for li in page.locator("#robot-log li").all()
         ]
         final = float(page.locator("#final-cost").inner_text())
+        answers = _answer_the_questionnaire(page)
+        sid = page.evaluate("() => document.body.dataset.session")
+        stored = httpx.get(f"{url}/api/sessions/{sid}").json()
         assert errors == []
+    assert stored["answers"] == answers and stored["outcome"]["cost"] == final
     # The same choices through the advisor: the same robots' replies, the same cost.
     advisor = Advisor(plan)
     want_robots, choices = [], list(clicked)
@@ -100,3 +105,90 @@ def test_play_the_pump_to_the_end(browser, tmp_path):
     assert final == advice.elapsed
     assert (tmp_path / "page-end.png").stat().st_size > 10_000
     assert plan["metrics"]["w0"] <= final <= plan["minimax"]
+
+
+def _answer_the_questionnaire(page) -> dict:
+    """Fill every item (a scale: its top value; a text: a sentence) and send the answers."""
+    page.wait_for_selector("#submit-answers", timeout=30_000)
+    answers = {}
+    for item in page.locator("#questionnaire input").all():
+        name = item.get_attribute("name")
+        if item.get_attribute("type") == "range":
+            top = item.get_attribute("max")
+            item.evaluate("(e, v) => { e.value = v; }", top)
+            answers[name] = int(top)
+        else:
+            item.fill("the robots waited for me")
+            answers[name] = "the robots waited for me"
+    page.click("#submit-answers")
+    page.wait_for_selector("#thanks:not([hidden])", timeout=30_000)
+    return answers
+
+
+@pytest.mark.slow
+def test_play_the_concurrent_pump_to_the_end(browser, tmp_path):
+    """The pump in the concurrent game: start operations and let the cell run to each next
+    completion by clicking; the robots' replies, the clock and the final numbers are the
+    policy's (replayed through the advisor), W*(0) = 215 s."""
+    from asmplan import pipeline
+
+    plan = pipeline.plan(PUMP, turn_model="concurrent", time_limit=20).to_dict()
+    w0 = plan["robustness"][0]["bound"]
+    with running([plan], tmp_path / "state") as url:
+        page = browser.new_page(viewport={"width": 1280, "height": 1000})
+        errors: list[str] = []
+        page.on("pageerror", lambda exc: errors.append(str(exc)))
+        page.goto(url + "/")
+        ready = "() => ['1', 'done'].includes(document.body.dataset.ready)"
+        page.wait_for_function(ready, timeout=30_000)
+        assert page.locator("#w0").inner_text() == f"{w0:g} s"
+        assert page.locator("#concurrent-panel").is_visible()
+        events = []
+        for k in range(400):
+            if page.locator("#final").is_visible():
+                break
+            starts = page.locator('#options button[data-kind="start"]')
+            finishes = page.locator("#finishes button")
+            if starts.count():
+                pick = starts.nth(k % starts.count())
+                event = {"kind": "started", "duration": float(pick.get_attribute("data-duration"))}
+            else:
+                pick = finishes.nth(k % finishes.count())
+                event = {"kind": "finished", "time": float(pick.get_attribute("data-time"))}
+            event.update(
+                operation=pick.get_attribute("data-op"), agent=pick.get_attribute("data-agent")
+            )
+            events.append(event)
+            if k == 12:
+                page.screenshot(path=str(tmp_path / "concurrent-mid-game.png"))
+            pick.click()
+            page.wait_for_function(ready, timeout=30_000)
+        page.wait_for_selector("#final:not([hidden])", timeout=30_000)
+        page.screenshot(path=str(tmp_path / "concurrent-end.png"), full_page=True)
+        robots = [
+            (
+                li.get_attribute("data-op"),
+                li.get_attribute("data-agent"),
+                li.get_attribute("data-time"),
+            )
+            for li in page.locator("#robot-log li").all()
+        ]
+        final = float(page.locator("#final-cost").inner_text())
+        shown_w0 = float(page.locator("#final-w0").inner_text())
+        assert errors == []
+    # The same events through the advisor: the same robots' replies at the same times.
+    advisor = Advisor(plan)
+    advice = advisor.advice()
+    want = [(None, None, "0")] if not advice.robots else []
+    want += [(r["operation"], r["agent"], "0") for r in advice.robots]
+    for event in events:
+        before = advice
+        advice = advisor.observe(event)
+        fresh = (advice.state, advice.elapsed) != (before.state, before.elapsed)
+        if fresh and not advice.finished:
+            t = f"{advice.elapsed:g}"
+            want += [(r["operation"], r["agent"], t) for r in advice.robots] or [(None, None, t)]
+    assert advice.finished and robots == want
+    assert final == advice.elapsed == w0 == shown_w0  # the pump: no choice costs anything
+    assert plan["minimax"] == w0
+    assert (tmp_path / "concurrent-end.png").stat().st_size > 10_000

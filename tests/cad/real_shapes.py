@@ -212,13 +212,15 @@ def _inv(angle):
     return np.tan(angle) - angle
 
 
-def gear_outline(teeth: int, flank_points: int, phase: float = 0.0) -> np.ndarray:
+def gear_outline(
+    teeth: int, flank_points: int, phase: float = 0.0, interference: float = GEAR_INTERFERENCE
+) -> np.ndarray:
     """CCW outline of an involute spur gear (module :data:`MODULE`, 20 degrees, root
-    clearance 0.25 m) with tooth thickness ``pi m / 2 + GEAR_INTERFERENCE`` at the pitch
-    circle; a tooth is centred at angle ``phase``."""
+    clearance 0.25 m) with tooth thickness ``pi m / 2 + interference`` at the pitch
+    circle (negative: backlash); a tooth is centred at angle ``phase``."""
     r = MODULE * teeth / 2
     rb, ra, rf = r * np.cos(PRESSURE), r + MODULE, r - 1.25 * MODULE
-    half_pitch = (np.pi * MODULE / 2 + GEAR_INTERFERENCE) / (2 * r)  # half tooth angle at r
+    half_pitch = (np.pi * MODULE / 2 + interference) / (2 * r)  # half tooth angle at r
     radii = np.linspace(max(rb, rf), ra, flank_points)
     half = half_pitch + _inv(PRESSURE) - _inv(np.arccos(np.clip(rb / radii, -1, 1)))
     if rf < rb:  # radial flank below the base circle

@@ -139,6 +139,44 @@ def test_dowel_beside_a_hole_is_not_captured():
     assert not rel.sp[rel.index("dowel"), rel.index("plate"), DOWN]
 
 
-def test_press_fit_deeper_than_the_tolerance_is_an_error():
-    with pytest.raises(ValueError, match="'plate' and 'dowel' interpenetrate"):
-        compute_relations(Assembly.from_meshes(dowel_assembly(0.6, 0.0, False)))
+def tapped_block(d: float, drill: float, width: float) -> dict:
+    """A screw of diameter ``d`` in a blind hole drawn at the tap-drill diameter ``drill``
+    (the thread is not drawn: the screw overlaps the wall all round), head on the top."""
+    depth = 3 * d
+    hole = revolve([(0, -depth - 0.6 * drill), (drill / 2, -depth), (drill / 2, 1), (0, 1)], 64)
+    block = difference(
+        box((-width / 2, -width / 2, -depth - 2 * d), (width / 2, width / 2, 0)), hole
+    )
+    return {"block": block, "screw": socket_screw(d, 2.5 * d, 48, 0.0)}
+
+
+@pytest.mark.parametrize(
+    ("d", "drill", "width"),
+    [(2.0, 1.6, 20), (3.0, 2.5, 30), (3.0, 2.5, 12), (8.0, 6.8, 100), (12.0, 10.2, 120),
+     (6.35, 5.1, 60)],  # M2, M3, M8, M12 and UNC 1/4-20 at their tap drills
+)  # fmt: skip
+def test_screw_in_a_tapped_hole_drawn_at_the_tap_drill_is_a_fit(d, drill, width):
+    rel = compute_relations(Assembly.from_meshes(tapped_block(d, drill, width)))
+    s, b = rel.index("screw"), rel.index("block")
+    assert dirs(rel.tc[s, b]) == SIDE | {"-z"}
+    assert dirs(rel.tt[s, b]) == {"+z"}
+    assert dirs(rel.tt[b, s]) == {"-z"}
+    assert rel.sp[s, b, DOWN]
+    ((inner, outer, extra),) = rel.fits
+    assert (inner, outer) == ("screw", "block") and 0 < extra < 0.1 * d
+    planned(rel, "block")
+
+
+@pytest.mark.parametrize(
+    ("parts", "pair"),
+    [
+        (lambda: tapped_block(3.0, 2.0, 30), "'block' and 'screw'"),  # 0.5 mm: not a thread
+        (lambda: dowel_assembly(1.2, 0.0, False), "'plate' and 'dowel'"),
+        # a plate sunk 0.8 mm into another: deep, and no hole around it
+        (lambda: {"a": box((0, 0, 0), (40, 40, 10)), "b": box((5, 5, 9.2), (35, 35, 14))},
+         "'a' and 'b'"),
+    ],
+)  # fmt: skip
+def test_overlap_that_is_not_a_fit_is_an_error(parts, pair):
+    with pytest.raises(ValueError, match=f"{pair} interpenetrate by about"):
+        compute_relations(Assembly.from_meshes(parts()))

@@ -3,7 +3,7 @@
 "use strict";
 
 const state = { plan: null, planInfo: null, meshes: {}, session: null, advice: null,
-                bars: [], lastParts: [], busy: false };
+                bars: [], lastParts: [], busy: false, open: {}, deviated: new Set() };
 
 function fmt(x) {
   return Number.isInteger(x) ? String(x) : Number(x).toFixed(2).replace(/\.?0+$/, "");
@@ -41,8 +41,12 @@ async function start() {
   document.getElementById("title").textContent =
     `${state.planInfo.assembly}: you are the person, the robots follow the robust plan`;
   const unit = state.planInfo.cost === "steps" ? "" : " s";
-  document.getElementById("w0").textContent = fmt(state.planInfo.metrics.w0) + unit;
+  const rows = state.planInfo.robustness || [];
+  const w0 = isConcurrent() && rows.length ? rows[0].bound : state.planInfo.metrics.w0;
+  document.getElementById("w0").textContent = fmt(w0) + unit;
   document.getElementById("wstar").textContent = fmt(state.planInfo.minimax) + unit;
+  document.getElementById("concurrent-panel").hidden = !isConcurrent();
+  document.getElementById("finishes-panel").hidden = !isConcurrent();
   state.meshes = await api("GET", `/api/plans/${encodeURIComponent(state.plan)}/meshes`);
   const session = await api("POST", "/api/sessions", { plan: state.plan });
   state.session = session.id;
@@ -50,8 +54,13 @@ async function start() {
   await show(session.advice);
 }
 
+function isConcurrent() {
+  return state.planInfo && state.planInfo.turn_model === "concurrent";
+}
+
 // One step of the game: show the advice; on the robots' turn, play their reply.
 async function show(advice) {
+  if (isConcurrent()) return showConcurrent(advice);
   state.advice = advice;
   document.getElementById("elapsed").textContent = fmt(advice.elapsed);
   document.getElementById("guarantee").textContent = fmt(advice.total_bound);
@@ -84,15 +93,129 @@ async function show(advice) {
 }
 
 async function record(move, who) {
+  const before = state.advice;
+  await post({ kind: "finished", operation: move.operation, agent: move.agent }, (advice) =>
+    state.bars.push({ agent: move.agent, operation: move.operation, who,
+                      start: before.elapsed, end: advice.elapsed }));
+}
+
+// ---------------------------------------------------------------- the concurrent game
+// At each event the robots commit first (their reply is logged), then the person starts
+// operations; a completion ("next completion" buttons) advances the clock.
+
+function sideOf(agent) {
+  if (agent.includes(":")) return agent.split(":").pop();
+  return (state.planInfo.agents || {})[agent] || "human";
+}
+
+function trackBars(advice) {
+  state.open = state.open || {};
+  const running = new Set(advice.running.map((r) => r.operation));
+  for (const r of advice.running) {
+    if (!state.open[r.operation]) {
+      state.open[r.operation] = { agent: r.agent, operation: r.operation, start: advice.elapsed,
+                                  who: sideOf(r.agent), deviation: state.deviated.has(r.operation) };
+    }
+  }
+  for (const [op, bar] of Object.entries(state.open)) {
+    if (!running.has(op) && advice.done.includes(op)) {
+      state.bars.push({ ...bar, end: advice.elapsed });
+      delete state.open[op];
+    }
+  }
+}
+
+async function showConcurrent(advice) {
+  state.deviated = state.deviated || new Set();
+  const fresh = state.advice === null || state.advice.state !== advice.state ||
+    state.advice.elapsed !== advice.elapsed;
+  state.advice = advice;
+  trackBars(advice);
+  document.getElementById("elapsed").textContent = fmt(advice.elapsed);
+  document.getElementById("clock").textContent = fmt(advice.elapsed);
+  document.getElementById("guarantee").textContent = fmt(advice.total_bound);
+  drawView(advice);
+  drawGantt();
+  if (fresh && !advice.finished) {  // a new event: the robots' commitment
+    const log = document.getElementById("robot-log");
+    if (!advice.robots.length) {
+      log.append(el("li", { "data-time": advice.elapsed, class: "wait" },
+        `t = ${fmt(advice.elapsed)}: the robots wait`));
+    }
+    for (const r of advice.robots) {
+      log.append(el("li", { "data-op": r.operation, "data-agent": r.agent, "data-time": advice.elapsed },
+        `t = ${fmt(advice.elapsed)}: ${r.agent} starts ${r.operation} (${r.description})`));
+    }
+  }
+  const running = document.getElementById("running");
+  running.replaceChildren(...advice.running.map((r) =>
+    el("li", { "data-op": r.operation, "data-agent": r.agent },
+      `${r.agent}: ${r.operation} ${describe(r.operation)} (${fmt(r.remaining)} left)`)));
+  const told = advice.instructions.map((i) => i.operation === null
+    ? `${i.agent}: wait` : `${i.agent}: ${i.operation} ${i.description}`);
+  document.getElementById("instruction").textContent = told.length
+    ? `· the plan asks ${told.join("; ")}` : "";
+  const options = document.getElementById("options");
+  const finishes = document.getElementById("finishes");
+  options.replaceChildren();
+  finishes.replaceChildren();
+  if (advice.finished) return finish(advice);
+  for (const opt of advice.options) {
+    const asked = advice.instructions.some((i) => i.operation === opt.operation &&
+      i.agent === opt.agent);
+    const button = el("button", { "data-kind": "start", "data-op": opt.operation,
+                                  "data-agent": opt.agent, "data-worst": opt.worst,
+                                  "data-deviation": opt.deviation ? "1" : "0",
+                                  "data-duration": opt.cost,
+                                  class: asked ? "asked" : opt.deviation ? "deviation" : "" });
+    button.append(el("span", {}, `${opt.agent} starts ${opt.operation} ${opt.description}`));
+    let pick = null;
+    if (opt.durations.length > 1) {
+      pick = el("select", { "data-op": opt.operation, title: "how long you will take" });
+      for (const d of opt.durations) pick.append(el("option", { value: d }, `${fmt(d)} s`));
+      pick.value = String(opt.cost);
+      pick.addEventListener("click", (ev) => ev.stopPropagation());
+    } else {
+      button.append(el("span", {}, ` (${fmt(opt.cost)} s)`));
+    }
+    button.append(el("span", { class: "worst" }, `worst case ${fmt(opt.worst)}`));
+    button.addEventListener("click", () => {
+      if (opt.deviation) state.deviated.add(opt.operation);
+      post({ kind: "started", operation: opt.operation, agent: opt.agent,
+             duration: pick ? Number(pick.value) : opt.cost });
+    });
+    options.append(button);
+    if (pick) options.append(pick);
+  }
+  for (const f of advice.finishes) {
+    const button = el("button", { "data-kind": "finish", "data-op": f.operation,
+                                  "data-agent": f.agent, "data-time": f.time,
+                                  "data-worst": f.worst });
+    button.append(el("span", {}, `${f.agent} finishes ${f.operation} at t = ${fmt(f.time)}`));
+    button.append(el("span", { class: "worst" }, `worst case ${fmt(f.worst)}`));
+    button.addEventListener("click", () =>
+      post({ kind: "finished", operation: f.operation, agent: f.agent, time: f.time }));
+    finishes.append(button);
+  }
+  setStatus(advice.finishes.length
+    ? "start an operation, or let the cell run to its next completion"
+    : "start an operation (you do not idle while you have something to do)");
+  document.body.dataset.ready = "1";
+}
+
+function describe(op) {
+  const info = (state.planInfo.operations || {})[op];
+  return info ? info.description : "";
+}
+
+// Post an event; on success call `then(advice)` (if given) and show the new advice.
+async function post(event, then) {
   if (state.busy) return;
   state.busy = true;
   document.body.dataset.ready = "0";
-  const before = state.advice;
   try {
-    const advice = await api("POST", `/api/sessions/${state.session}/events`,
-      { kind: "finished", operation: move.operation, agent: move.agent });
-    state.bars.push({ agent: move.agent, operation: move.operation, who,
-                      start: before.elapsed, end: advice.elapsed });
+    const advice = await api("POST", `/api/sessions/${state.session}/events`, event);
+    if (then) then(advice);
     document.getElementById("error").textContent = "";
     state.busy = false;
     await show(advice);
@@ -136,13 +259,20 @@ function drawView(advice) {
 }
 
 function drawGantt() {
-  const bars = state.bars.filter((b) => b.end > b.start);
+  // Running operations are drawn to their planned end, faded.
+  const left = Object.fromEntries((state.advice.running || []).map((r) => [r.operation, r.remaining]));
+  const open = Object.values(state.open || {}).map((b) =>
+    ({ ...b, end: state.advice.elapsed + (left[b.operation] || 0), running: true }));
+  const bars = [...state.bars, ...open].filter((b) => b.end > b.start);
   const colour = { robot: "#2e9d4a", human: "#9e9e9e" };
   const trace = {
     type: "bar", orientation: "h", y: bars.map((b) => b.agent),
     x: bars.map((b) => b.end - b.start), base: bars.map((b) => b.start),
     text: bars.map((b) => b.operation), textposition: "inside",
-    marker: { color: bars.map((b) => colour[b.who]) }, hoverinfo: "text+x",
+    marker: { color: bars.map((b) => colour[b.who]), opacity: bars.map((b) => b.running ? 0.45 : 1),
+              line: { color: bars.map((b) => b.deviation ? "#d62728" : "#ffffff"),
+                      width: bars.map((b) => b.deviation ? 3 : 0) } },
+    hoverinfo: "text+x",
   };
   const layout = { margin: { l: 50, r: 10, t: 30, b: 30 }, title: { text: "Gantt chart", font: { size: 13 } },
                    xaxis: { title: { text: "time" }, rangemode: "tozero" },
@@ -158,6 +288,13 @@ async function finish(advice) {
   document.getElementById("final-w0").textContent = fmt(out.w0);
   document.getElementById("final-wstar").textContent = fmt(out.minimax);
   document.getElementById("final-deviations").textContent = String(out.deviations);
+  if (out.robustness) {  // the concurrent game: W*(0) and W*(k) for the deviations made
+    const rows = out.robustness.filter((r) => r.k !== null);
+    const row = rows.find((r) => r.k === out.deviations) || rows[rows.length - 1];
+    document.getElementById("final-w0").textContent = fmt(rows[0].bound);
+    document.getElementById("final-wk").textContent = `${fmt(row.bound)} (k = ${row.k})`;
+    document.getElementById("final-wk-note").hidden = false;
+  }
   document.getElementById("final").hidden = false;
   document.body.dataset.ready = "done";
   const items = await api("GET", "/api/questionnaire");
