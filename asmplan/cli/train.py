@@ -86,17 +86,34 @@ def train_command(
         None, "--max-cycles", min=1, max=MAX_CYCLES, help="Stop after N cycles."
     ),
     progress: bool = typer.Option(True, "--progress/--no-progress", help="Show a progress bar."),
+    max_memory: float | None = typer.Option(
+        None,
+        "--max-memory",
+        min=0.001,
+        max=1e6,
+        help="Refuse a game whose training needs more GB than this, before any work "
+        "(default: 3/4 of this machine's memory; arl/memory.py).",
+    ),
 ) -> None:
     """Train a robust robot policy by alternating PPO against a learned adversarial human."""
     from arl.config import get_config
     from arl.trainer import train
 
     check_output(output, folder=True)
-    cfg = get_config(config)
+    get_config(config)  # a bad name fails before any work
     dag = load_training_game(graph, turn_model)
+    cfg = get_config(config, dag.metadata.get("turn_model"))
     if max_cycles is not None:
         cfg = cfg.replace(max_cycles=max_cycles)
-    result = train(dag, cfg, seed=seed, output=output, progress=progress, resume=resume)
+    result = train(
+        dag,
+        cfg,
+        seed=seed,
+        output=output,
+        progress=progress,
+        resume=resume,
+        max_memory_gb=max_memory,
+    )
     status = "converged" if result.converged else "stopped"
     typer.echo(
         f"{status} after {len(result.cycles)} cycles in {result.wall_s:.1f} s: "
