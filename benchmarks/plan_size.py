@@ -1,8 +1,8 @@
 """Plan file size and write/read times for the largest plans, both turn models.
 
-Usage: python benchmarks/plan_size.py [--concurrent] [NAME.IN2 | ASSEMBLY ...]
-(default: SAWYER30 and KILBRID; with ``--concurrent``: the pump with the person's ranges,
-MITCHELL and SAWYER30 in the concurrent game, budgets 0..2).
+Usage: python benchmarks/plan_size.py [--concurrent [--max-k K]] [NAME.IN2 | ASSEMBLY ...]
+(default: SAWYER30 and KILBRID; with ``--concurrent``: the pump with the person's ranges and
+MITCHELL in the concurrent game, budgets 0..K, K = 2 by default; SAWYER30 fits with K = 0).
 Prints, per plan: game nodes, policy states and moves, solve / plan / write / read seconds, MB.
 Data: Scholl (1993), read from ../shared/data/salbp (never copied into the repository).
 """
@@ -41,11 +41,11 @@ def _alternate(spec):
     )
 
 
-def _concurrent(spec):
+def _concurrent(spec, max_k: int = 2):
     from asp.concurrent import concurrent_model, robustness
 
     graph = build_state_graph(spec)
-    curve = robustness(concurrent_model(spec, graph), max_k=2)
+    curve = robustness(concurrent_model(spec, graph), max_k=max_k)
     game = curve.game
     return game.dag, lambda: plan_document(
         spec=spec, dag=game.dag, solution=curve.solution, game=game
@@ -54,17 +54,22 @@ def _concurrent(spec):
 
 def main(args: list[str]) -> None:
     concurrent = "--concurrent" in args
+    max_k = 2
+    if "--max-k" in args:
+        at = args.index("--max-k")
+        max_k = int(args[at + 1])
+        args = args[:at] + args[at + 2 :]
     names = [a for a in args if a != "--concurrent"]
     if not names:
         names = (
-            ["vacuum_pump_ranges", "MITCHELL.IN2", "SAWYER30.IN2"]
+            ["vacuum_pump_ranges", "MITCHELL.IN2"]
             if concurrent
             else ["SAWYER30.IN2", "KILBRID.IN2"]
         )
     for name in names:
         spec = _spec(name)
         t0 = time.perf_counter()
-        dag, document = (_concurrent if concurrent else _alternate)(spec)
+        dag, document = _concurrent(spec, max_k) if concurrent else _alternate(spec)
         t1 = time.perf_counter()
         doc = document()
         t2 = time.perf_counter()
