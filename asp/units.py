@@ -26,6 +26,7 @@ sound plans.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
@@ -35,6 +36,9 @@ from asp.spec import AssemblySpec, with_subassemblies
 
 MAX_ROUNDS = 8
 """Rounds of automatic detection (each adds the units of the root causes found)."""
+MAX_WORKSPACE_PRODUCT = 64
+"""Beyond this product of ``members + 1`` over the units, they are built one after another
+(:func:`built_in_turn`)."""
 
 
 def unit_members(spec: AssemblySpec) -> dict[str, tuple[str, ...]]:
@@ -133,6 +137,7 @@ def build_with_units(
         found: list[tuple[str, ...]] = []
         current = base
         for _ in range(MAX_ROUNDS + 1):
+            current = built_in_turn(hold_unsupported_units(current, relations))
             try:
                 return build_state_graph(current, relations, **kwargs)
             except ValueError as exc:
@@ -144,7 +149,10 @@ def build_with_units(
             drop = _stuck_units(graph.spec, stuck, optional)
             if drop:
                 break
-            groups = _new_units(graph, stuck, base, found)
+            drop = set()
+            groups = _new_units(graph, stuck, base, found, optional, drop)
+            if drop:
+                break
             if groups is None:
                 drop = set(optional)
                 break
@@ -167,6 +175,71 @@ def build_with_units(
             f"the file's sub-assembl{'y' if len(drop) == 1 else 'ies'} {', '.join(sorted(drop))}"
             f": {GIVEN_UP}; planned without it"
         )
+
+
+def hold_unsupported_units(spec: AssemblySpec, relations) -> AssemblySpec:
+    """A generated spec with ``held: true`` on the insertion of each unit that no part
+    outside it can keep from falling (an upper die set sliding down its guide pins), as
+    :func:`asp.generate.hold_unsupported` does for single parts; other specs unchanged."""
+    if not spec.generated or not spec.constraints.stability or relations is None:
+        return spec
+    sp = getattr(relations, "sp", None)
+    if sp is None:
+        return spec
+    from dataclasses import replace
+
+    from asp.spec import DIRECTIONS
+
+    index = {str(p): k for k, p in enumerate(relations.parts)}
+    rests = np.asarray(sp, dtype=bool)[:, :, DIRECTIONS.index(spec.gravity)]
+    loose = set()
+    for uid, members in spec.subassemblies:
+        rows = [index[m] for m in members if m in index]
+        outside = np.ones(len(index), dtype=bool)
+        outside[rows] = False
+        if rows and not rests[np.ix_(rows, np.flatnonzero(outside))].any():
+            loose.add(uid)
+    if not loose:
+        return spec
+    ops = [replace(op, held=True) if op.unit in loose else op for op in spec.operations]
+    return replace(spec, operations=tuple(ops))
+
+
+def built_in_turn(spec: AssemblySpec) -> AssemblySpec:
+    """``spec`` with its units built one after another when their workspaces would
+    multiply the states.
+
+    Each workspace under construction multiplies the states by the number of its partial
+    builds, so ``k`` units of two parts built in any interleaving give ``3**k`` times as
+    many. When the product of ``members + 1`` over the units exceeds
+    :data:`MAX_WORKSPACE_PRODUCT`, each unit's member operations wait for every member
+    operation of the unit before it (the units in the order of their first member
+    operation): one workspace is under construction at a time, which the states grow by
+    the sum instead of the product. Inserting the units stays free, so every plan is
+    still sound; a person still builds a unit while a robot works on the main body.
+    """
+    units = list(spec.subassemblies)
+    if math.prod(len(ms) + 1 for _, ms in units) <= MAX_WORKSPACE_PRODUCT:
+        return spec
+    from dataclasses import replace
+
+    position = {p: k for k, op in enumerate(spec.operations) for p in op.parts}
+    units.sort(key=lambda u: min(position[m] for m in u[1]))
+    ops_of = {
+        uid: [op.id for op in spec.operations if op.parts and set(op.parts) <= set(ms)]
+        for uid, ms in units
+    }
+    wait: dict[str, tuple[str, ...]] = {}
+    for (before, _), (uid, _) in zip(units, units[1:], strict=False):
+        for o in ops_of[uid]:
+            wait[o] = tuple(ops_of[before])
+    ops = [
+        replace(op, after=tuple(dict.fromkeys((*op.after, *wait[op.id]))))
+        if wait.get(op.id)
+        else op
+        for op in spec.operations
+    ]
+    return replace(spec, operations=tuple(ops))
 
 
 def _stuck_units(spec: AssemblySpec, stuck: list[int], optional: dict[str, set[str]]) -> set[str]:
@@ -196,12 +269,26 @@ def stuck_operations(graph) -> list[int]:
     return [i for i in range(model.n_ops) if model.part_lists[i] and model.ready(keys, i).any()]
 
 
-def _new_units(graph, ops: list[int], spec: AssemblySpec, found: list[tuple[str, ...]]):
-    """The automatic units after a round: ``found`` with the parts of the never-done
-    operations ``ops`` grouped with their hosts (None when nothing changes)."""
+def _new_units(
+    graph,
+    ops: list[int],
+    spec: AssemblySpec,
+    found: list[tuple[str, ...]],
+    optional: dict[str, set[str]] | None = None,
+    drop: set[str] | None = None,
+):
+    """The automatic units after a round: ``found`` with the parts of the stuck
+    operations ``ops`` grouped with their hosts (None when nothing changes).
+
+    A group may not take parts of the spec's units; when the only groups of a stuck part
+    take parts of ``optional`` units (the CAD file's), the units of its smallest group
+    are added to ``drop`` (to be given up) instead.
+    """
     model = graph.model
     oracle = model.oracle
-    fixed = {m for _, ms in spec.subassemblies for m in ms}  # the spec's own units stay
+    optional = optional or {}
+    owner = {m: u for u, ms in optional.items() for m in ms}
+    fixed = {m for _, ms in spec.subassemblies for m in ms} - set(owner)
     placed_by = {p for op in spec.operations for p in op.parts}
     groups = [set(g) for g in found]
     before = sorted(map(sorted, groups))
@@ -221,9 +308,12 @@ def _new_units(graph, ops: list[int], spec: AssemblySpec, found: list[tuple[str,
                     {oracle.parts[j] for j in g} for g in host_groups(oracle, p, oracle.base)
                 ]
             grouped = set().union(*groups) if groups else set()
-            candidates = [
-                c for c in candidates if not c & fixed and c <= placed_by and not c <= grouped
-            ]
+            candidates = [c for c in candidates if not c & fixed and c <= placed_by]
+            if candidates and all(c & set(owner) for c in candidates) and drop is not None:
+                smallest = min(candidates, key=len)
+                drop |= {owner[m] for m in smallest if m in owner}
+                continue
+            candidates = [c for c in candidates if not c & set(owner) and not c <= grouped]
             if not candidates:
                 continue
             group = min(candidates, key=lambda c: (len(c - grouped), len(c)))
@@ -301,8 +391,8 @@ def cad_units(
       by the parts already there (a search over the orders, at most
       :data:`BUILD_SEARCH_LIMIT` partial workspaces; undecided counts as buildable);
     - it can be inserted as one rigid body: free from the base part along such a
-      direction, touching a part outside it and, with the stability constraint,
-      resting on one.
+      direction and touching a part outside it (one that rests on nothing outside it is
+      held while it goes in, :func:`hold_unsupported_units`).
 
     The state graph decides the rest (:func:`build_with_units` gives up a unit that
     leaves no complete sequence). ``exclude``: groups given up already (their own groups
@@ -401,17 +491,14 @@ def _insert_problem(spec, oracle, members: list[int]) -> str:
 
     unit = sum(1 << j for j in members)
     outside = ((1 << len(oracle.parts)) - 1) & ~unit
-    contact = support = 0
+    contact = 0
     blocked = [0] * 6
     for j in members:
         contact |= unpack_words(oracle.contact[j])
-        support |= unpack_words(oracle.support[j])
         for d in range(6):
             blocked[d] |= unpack_words(oracle.blocked[j, d])
     if not contact & outside:
         return "it touches no part outside it"
-    if oracle.stability and not support & outside:
-        return "nothing outside it can keep it from falling"
     if oracle.base >= 0:
         ways = [d for d in range(6) if oracle.directions[d] and not blocked[d] >> oracle.base & 1]
         if not ways:

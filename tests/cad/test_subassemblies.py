@@ -313,3 +313,58 @@ def test_a_sub_assembly_that_leaves_no_sequence_is_given_up(tmp_path):
     assert units["corner"]["used"] is False and units["corner"]["reason"] == GIVEN_UP
     assert [u["source"] for u in units.values() if u["used"]] == ["automatic", "automatic"]
     check_line(result.assembly.spec, result.assembly.relations, plan_operations(doc))
+
+
+def pairs_spec(n_units: int, generated: bool = False):
+    """A base and ``n_units`` pairs of parts, each pair a unit (no geometry)."""
+    parts = ["base"] + [f"p{k}{s}" for k in range(n_units) for s in "ab"]
+    ops = [{"id": p, "agents": {"H": 1, "R": 1}, "part": p} for p in parts[1:]]
+    data = {
+        "parts": [{"id": p, "file": f"{p}.stl"} for p in parts],
+        "agents": {"H": {"side": "human"}, "R": {"side": "robot"}},
+        "base_part": "base",
+        "operations": ops,
+        "subassemblies": {f"u{k}": [f"p{k}a", f"p{k}b"] for k in range(n_units)},
+    }
+    spec = spec_from_dict(data, source="pairs.yaml")
+    if generated:
+        from dataclasses import replace
+
+        spec = replace(spec, generated=True)
+    return spec
+
+
+def test_many_units_are_built_one_after_another():
+    from asp.units import MAX_WORKSPACE_PRODUCT, built_in_turn
+
+    few = pairs_spec(2)
+    assert MAX_WORKSPACE_PRODUCT >= 3**2 and built_in_turn(few) is few
+    many = pairs_spec(5)  # 3**5 = 243 partial builds at once: too many
+    turned = built_in_turn(many)
+    assert turned.operation("p1a").after == ("p0a", "p0b")
+    assert turned.operation("p4b").after == ("p3a", "p3b")
+    assert turned.operation("p0a").after == ()
+    free, chained = build_state_graph(many), build_state_graph(turned)
+    assert chained.n_states < free.n_states
+    for seq in chained.sequences(limit=20):
+        check_line(turned, None, seq)
+
+
+def test_a_generated_spec_holds_a_unit_nothing_outside_holds_up():
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from asp.units import hold_unsupported_units
+
+    spec = pairs_spec(2, generated=True)
+    parts = list(spec.part_ids)
+    sp = np.zeros((5, 5, 6), dtype=bool)
+    k = {p: i for i, p in enumerate(parts)}
+    sp[k["p0a"], k["base"], 5] = True  # unit u0 rests on the base; u1 only on itself
+    sp[k["p1b"], k["p1a"], 5] = True
+    rel = SimpleNamespace(parts=parts, sp=sp)
+    held = hold_unsupported_units(spec, rel)
+    assert not held.operation("u0").held and held.operation("u1").held
+    user = pairs_spec(2)
+    assert hold_unsupported_units(user, rel) is user  # a user's spec is never changed

@@ -159,7 +159,10 @@ async function showConcurrent(advice) {
   const finishes = document.getElementById("finishes");
   options.replaceChildren();
   finishes.replaceChildren();
-  if (advice.finished) return finish(advice);
+  if (advice.finished) {
+    document.getElementById("finishes-panel").hidden = true;
+    return finish(advice);
+  }
   for (const opt of advice.options) {
     const asked = advice.instructions.some((i) => i.operation === opt.operation &&
       i.agent === opt.agent);
