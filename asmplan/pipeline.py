@@ -190,6 +190,7 @@ class AssemblyPlan:
                 solution=self.solution,
                 describe=alternate_states(self.graph, self.game.dag),
                 extra=extra,
+                relations=self.assembly.relations,
             )
         curve = self.concurrent.curve
         doc = plan_document(
@@ -198,6 +199,7 @@ class AssemblyPlan:
             solution=curve.solution,
             game=curve.game,
             extra=extra,
+            relations=self.assembly.relations,
         )
         from asp.concurrent_plan import plan_entries
 

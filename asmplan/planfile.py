@@ -44,6 +44,8 @@ from asp.rules import close_kernel
 from asp.solve import Solution, node_order
 
 FORMAT = "asmplan-plan/2"
+MAIN = "main"
+"""The workspace of the main assembly (a unit's workspace is named by the unit's id)."""
 SCHEMA_FILE = "plan-2.schema.json"
 TURN_NAMES = ("robot", "human")
 
@@ -462,6 +464,8 @@ def line_steps(policy: dict, follow: str, operations: dict[str, dict]) -> list[d
         total += cost
         infos = [operations.get(op, {}) for op, _, _ in started]
         idle = "pass" if "starts" not in moves else "wait"
+        spaces = list(dict.fromkeys(x.get("workspace", MAIN) for x in infos))
+        units = [x["unit"] for x in infos if x.get("unit")]
         steps.append(
             {
                 "step": len(steps) + 1,
@@ -470,7 +474,13 @@ def line_steps(policy: dict, follow: str, operations: dict[str, dict]) -> list[d
                 "agent": ",".join(a for _, a, _ in started),
                 "description": "; ".join(x.get("description", "") for x in infos) or idle,
                 "parts": [p for x in infos for p in x.get("parts", [])],
-                "starts": [{"operation": op, "agent": a, "duration": d} for op, a, d in started],
+                "starts": [
+                    {"operation": op, "agent": a, "duration": d, **_where(x)}
+                    for (op, a, d), x in zip(started, infos, strict=True)
+                ],
+                "workspace": spaces[0] if len(spaces) == 1 else None,
+                "unit": units[0] if len(units) == 1 else None,
+                "held": any(x.get("held", False) for x in infos),
                 "cost": cost,
                 "elapsed": total,
                 "bound": states["bound"][moves["next"][j]],
@@ -479,6 +489,16 @@ def line_steps(policy: dict, follow: str, operations: dict[str, dict]) -> list[d
             }
         )
         i = moves["next"][j]
+
+
+def _where(info: dict) -> dict:
+    """What a line step says of one operation it starts: parts, workspace, unit, held."""
+    return {
+        "parts": list(info.get("parts", [])),
+        "workspace": info.get("workspace", MAIN),
+        "unit": info.get("unit"),
+        "held": info.get("held", False),
+    }
 
 
 def _instruction_move(policy: dict, i: int) -> int:
@@ -504,26 +524,26 @@ def plan_document(
     describe: StateDescriber | None = None,
     extra: dict | None = None,
     game=None,
+    relations=None,
 ) -> dict:
     """The whole plan file: policy, lines, metrics, operations and parts, plus ``extra``.
 
     ``extra`` holds the keys computed elsewhere (relations, state graph sizes, ``schedule``);
     they are kept as given. ``game``: the :class:`asp.concurrent.ConcurrentGame` whose DAG
     ``dag`` is (turn model ``concurrent``; ``solution`` its exact solution, the policy that
-    of its start, the largest budget).
+    of its start, the largest budget). ``relations``: the part relations (``cad``
+    ``Relations``, None without geometry): each line step's ``insertions`` then name the
+    direction each body goes in along, and ``geometry`` the unit, scale and tolerances.
     """
     table = policy_table(dag, solution)
     policy = policy_document(dag, solution, describe, table, game=game)
-    operations = {
-        op.id: {
-            "description": op.description,
-            "agents": dict(op.durations),
-            "parts": [op.unit] if op.unit else list(op.parts),
-        }
-        for op in spec.operations
-    }
+    operations = operation_records(spec)
     principal = line_steps(policy, "plan", operations)
     worst = line_steps(policy, "worst", operations)
+    line_check = {
+        "robust_plan": add_insertions(principal, spec, relations, operations),
+        "worst_line": add_insertions(worst, spec, relations, operations),
+    }
     w0 = principal[-1]["elapsed"] if principal else 0.0
     doc = {
         "format": FORMAT,
@@ -546,11 +566,24 @@ def plan_document(
             "policy_moves": policy["n_moves"],
         },
         "agents": {a.name: a.side for a in spec.agents},
+        "gravity": spec.gravity,
+        "base_part": spec.base_part,
+        "geometry": geometry_record(spec, relations),
+        "sources": list(dict.fromkeys(_split_file(p.file)[0] for p in spec.parts if p.file)),
         "parts": [
-            {"id": p.id, "name": p.name, "file": p.file, "quantity": p.quantity} for p in spec.parts
+            {
+                "id": p.id,
+                "name": p.name,
+                "file": p.file,
+                "quantity": p.quantity,
+                "source": part_source(spec, p.file),
+            }
+            for p in spec.parts
         ],
         "operations": operations,
         "subassemblies": {u: list(ms) for u, ms in spec.subassemblies},
+        "workspaces": workspace_records(spec, operations, principal),
+        "line_check": line_check,
         "robust_plan": principal,
         "worst_line": worst,
         "policy": policy,
@@ -561,6 +594,179 @@ def plan_document(
     if spec.credit:
         doc["credit"] = spec.credit
     return doc
+
+
+# --------------------------------------------------------------------------- replay facts
+#
+# What a checker that replays a line from plan.json and the meshes alone needs: the
+# workspace of every operation, the real parts a unit's insertion places, held parts,
+# gravity, the length unit and frame, where each part's mesh is, and for each insertion
+# the direction it goes in along (README, "The plan file").
+
+
+def operation_records(spec) -> dict[str, dict]:
+    """Operation id -> ``description, agents, parts, workspace, unit, held``.
+
+    ``parts`` are real part ids: a unit's insertion lists the unit's members (``unit`` names
+    it). ``workspace`` is where the operation's parts go: ``MAIN``, or the id of the unit
+    whose member it places (a unit is built in its own workspace, then inserted into main).
+    """
+    members = dict(spec.subassemblies)
+    owner = {p: u for u, ms in members.items() for p in ms}
+    out = {}
+    for op in spec.operations:
+        parts = list(members.get(op.unit, op.parts)) if op.unit else list(op.parts)
+        space = MAIN if op.unit or not op.parts else owner.get(op.parts[0], MAIN)
+        out[op.id] = {
+            "description": op.description,
+            "agents": dict(op.durations),
+            "parts": parts,
+            "workspace": space,
+            "unit": op.unit or None,
+            "held": bool(op.held),
+        }
+    return out
+
+
+def add_insertions(steps: list[dict], spec, relations, operations: dict) -> str | None:
+    """Give each step ``insertions``: the bodies it puts in, in order, each with its way in.
+
+    An insertion is ``{operation, parts, workspace, unit, held, free_along, insert_along}``:
+    one per part an operation places in turn, one for a unit (all its members together).
+    ``free_along`` is a direction ``d`` with ``TT_d`` from everything already in the
+    workspace (the body can leave along ``d``), ``insert_along`` is ``-d``: the body moves
+    along it to go in. Both are null for the first body of a workspace and without
+    geometry. The line is replayed by :func:`asp.checker.check_line`; returns None when it
+    accepts the line, else its error (the insertions then carry no directions).
+    """
+    from asp.checker import check_line
+
+    ops = [s["operation"] for step in steps for s in step["starts"]]
+    error = None
+    checked: dict[str, list] = {}
+    try:
+        for c in check_line(spec, relations, ops):
+            checked.setdefault(c.operation, []).append((list(c.parts), c.direction or None))
+    except (ValueError, KeyError) as exc:
+        error, checked = str(exc).strip("'\""), {}
+    for step in steps:
+        step["insertions"] = []
+        for start in step["starts"]:
+            op = start["operation"]
+            info = operations.get(op, {})
+            parts = info.get("parts", [])
+            bodies = checked.get(op) or [
+                (body, None) for body in ([parts] if info.get("unit") else [[p] for p in parts])
+            ]
+            for body, free in bodies:
+                step["insertions"].append(
+                    {
+                        "operation": op,
+                        "parts": body,
+                        "workspace": info.get("workspace", MAIN),
+                        "unit": info.get("unit"),
+                        "held": info.get("held", False),
+                        "free_along": free,
+                        "insert_along": _opposite(free) if free else None,
+                    }
+                )
+    return error
+
+
+def _opposite(direction: str) -> str:
+    return ("-" if direction[0] == "+" else "+") + direction[1:]
+
+
+def geometry_record(spec, relations) -> dict | None:
+    """The length unit, scale, frame and tolerances of the geometry (None without it).
+
+    Coordinates are the source file's own frame (its node transforms applied, no axis
+    changed) times ``scale`` (millimetres per file unit; null when the files declare
+    different units); tolerances are in millimetres; a pair ``(i, j)`` tolerates an
+    overlap of ``part_shrink[i] + part_shrink[j]`` (:mod:`cad.tolerances`).
+    """
+    if relations is None:
+        return None
+    from cad.units import unit_scale
+
+    file_unit = str(getattr(relations, "units", "mm"))
+    shrink = tuple(getattr(relations, "part_shrink", ()))
+    if len(shrink) != len(relations.parts):
+        shrink = (float(relations.penetration_tol) / 2,) * len(relations.parts)
+    try:
+        scale = unit_scale(file_unit)
+    except ValueError:
+        scale = None  # "mixed": the files declare different units
+    return {
+        "unit": "mm",
+        "file_unit": file_unit,
+        "scale": scale,
+        "frame": "file",
+        "contact_tol": float(relations.contact_tol),
+        "penetration_tol": float(relations.penetration_tol),
+        "part_shrink": dict(zip(map(str, relations.parts), map(float, shrink), strict=True)),
+    }
+
+
+def _split_file(file: str) -> tuple[str, str | None]:
+    """``"model.step#nut_2"`` -> ``("model.step", "nut_2")``; a plain file has no node."""
+    name, sep, node = file.partition("#")
+    return name, (node if sep else None)
+
+
+def source_folder(source: str) -> Path:
+    """The folder part files are relative to: ``source`` itself when it is a folder of
+    meshes, else the folder holding it."""
+    path = Path(source) if source else Path()
+    return path if path.is_dir() else path.parent
+
+
+def part_source(spec, file: str | None) -> dict | None:
+    """Where a part's mesh is: ``file`` (relative to :func:`source_folder`),
+    ``node`` (the part inside a scene file, or null), ``path`` (absolute, when it exists)."""
+    if not file:
+        return None
+    name, node = _split_file(file)
+    folder = source_folder(spec.source)
+    path = (folder / name).resolve()
+    return {"file": name, "node": node, "path": str(path) if path.is_file() else None}
+
+
+def workspace_records(spec, operations: dict, principal: list[dict]) -> list[dict]:
+    """The main workspace, then each unit's in the order the principal line inserts them.
+
+    Each: ``id``, ``parts`` (its parts, in the order the principal line places them; main:
+    its ``initial`` parts first, then every part placed into it, a unit's members at its
+    insertion), ``operations`` (in principal-line order), ``inserted_by`` and ``into``
+    (a unit: the operation inserting it, into ``MAIN``; main: null).
+    """
+    placed = {p for info in operations.values() for p in info["parts"]}
+    initial = [p.id for p in spec.parts if p.id not in placed]
+    order = [s["operation"] for step in principal for s in step["starts"]]
+    order += [op for op in operations if op not in order]
+    spaces = {MAIN: {"id": MAIN, "initial": initial, "parts": list(initial), "operations": []}}
+    inserted_by = {info["unit"]: op for op, info in operations.items() if info["unit"]}
+    for op in order:
+        info = operations.get(op)
+        if info is None:
+            continue
+        space = info["workspace"]
+        if space not in spaces:
+            spaces[space] = {"id": space, "parts": [], "operations": []}
+        spaces[space]["operations"].append(op)
+        spaces[space]["parts"].extend(info["parts"])
+    out = []
+    for sid, rec in spaces.items():
+        unit = sid != MAIN
+        out.append(
+            {
+                **rec,
+                "initial": rec.get("initial", []),
+                "inserted_by": inserted_by.get(sid) if unit else None,
+                "into": MAIN if unit else None,
+            }
+        )
+    return out
 
 
 # --------------------------------------------------------------------------- read / write
@@ -656,5 +862,9 @@ def build_plan(
     dag = pipeline.game(graph, cost=cost)
     solution = pipeline.solve_game(dag)
     return plan_document(
-        spec=loaded.spec, dag=dag, solution=solution, describe=alternate_states(graph, dag)
+        spec=loaded.spec,
+        dag=dag,
+        solution=solution,
+        describe=alternate_states(graph, dag),
+        relations=loaded.relations,
     )

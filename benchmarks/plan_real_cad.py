@@ -8,9 +8,10 @@ against relations loaded afresh from the same file. Prints one row per assembly:
 W*, the CP-SAT status and the checker's verdict, or the error (the command's last stderr line).
 
 Assemblies, by default: the Fabrica assemblies in ``../shared/data/cad/fabrica/``, the built
-rod tower, bolted bracket and finger box (tests/cad), and every public CAD file found under
-the folders of ``$ASMPLAN_REAL_CAD`` (``:``-separated; default ``/tmp/realcad``), skipped when
-absent: STEP, 3DXML, GLB/glTF and 3MF files, and folders of part meshes (OBJ/STL/PLY).
+rod tower, bolted bracket, finger box, gear pair and bearing stack (tests/cad), and every
+public CAD file found under the folders of ``$ASMPLAN_REAL_CAD`` (``:``-separated; default
+``/tmp/realcad``), skipped when absent: STEP, 3DXML, GLB/glTF, 3MF and OBJ files, and
+folders of part meshes (OBJ/STL/PLY).
 Public files are never copied into the repository.
 
 Run: ``.venv/bin/python benchmarks/plan_real_cad.py [--timeout S] [--out DIR] [PATH ...]``
@@ -34,7 +35,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # run from a checkout
 
 FABRICA = ROOT.parent / "shared" / "data" / "cad" / "fabrica"
-BUILT = ("rod_tower", "bolted_bracket", "finger_box")
+BUILT = ("rod_tower", "bolted_bracket", "finger_box", "gear_pair", "bearing_stack")
 SCENES = {".step", ".stp", ".3dxml", ".glb", ".gltf", ".3mf"}
 MESHES = {".obj", ".stl", ".ply", ".off"}
 COLUMNS = (
@@ -66,8 +67,8 @@ def built(name: str, folder: Path) -> Path:
 
 
 def find_assemblies(folder: Path) -> list[Path]:
-    """Every CAD scene file under ``folder`` and every folder holding two or more part meshes
-    (or an ``assembly.yaml``), sorted."""
+    """Every CAD scene file under ``folder``, every folder holding two or more part meshes
+    (or an ``assembly.yaml``) and a folder's only OBJ, sorted."""
     found: list[Path] = []
     for here, dirs, files in os.walk(folder):
         dirs.sort()
@@ -76,8 +77,11 @@ def find_assemblies(folder: Path) -> list[Path]:
             found.append(here_path)
             dirs.clear()
             continue
-        if sum(Path(f).suffix.lower() in MESHES for f in files) >= 2:
+        meshes = [f for f in sorted(files) if Path(f).suffix.lower() in MESHES]
+        if len(meshes) >= 2:
             found.append(here_path)
+        elif meshes and meshes[0].lower().endswith(".obj"):  # one OBJ: its objects are parts
+            found.append(here_path / meshes[0])
         found.extend(here_path / f for f in sorted(files) if Path(f).suffix.lower() in SCENES)
     return found
 

@@ -34,7 +34,8 @@ _EXTENSIONS = r"\.(stp|step|sldprt|sldasm|ipt|iam|prt|asm|stl|obj|glb|gltf|3mf)$
 
 _GENERIC = re.compile(
     r"^((nauo|solid|body|mesh|shape|geometry|node|object|component|compound|part|g)_?\d*|"
-    r"\d+|unnamed\w*|noname\w*|default\w*|world|root|scene|open_cascade_step_translator\w*)$"
+    r"\d+|unnamed\w*|noname\w*|default\w*|world|root|scene|open_cascade_step_translator\w*|"
+    r"p(_\d+)+)$"  # an instance path or label (cascadio's ``=>[0:1:1:7]``) cleaned
 )
 
 
@@ -71,11 +72,13 @@ def is_generic(name: str) -> bool:
 
 def best_name(candidates: list[str], fallback: str = "part") -> str:
     """The first meaningful cleaned name among ``candidates`` (raw names), else ``fallback``."""
-    for raw in candidates:
-        name = clean_name(raw)
-        if not is_generic(name):
-            return name
-    return fallback
+    raw = best_raw(candidates)
+    return fallback if raw is None else clean_name(raw)
+
+
+def best_raw(candidates: list[str]) -> str | None:
+    """The first of ``candidates`` (raw names) whose cleaned name is meaningful, or None."""
+    return next((raw for raw in candidates if not is_generic(clean_name(raw))), None)
 
 
 def unique_ids(names: list[str], taken: set[str] | None = None) -> list[str]:
@@ -150,8 +153,10 @@ def load_scene_file(path: Path) -> trimesh.Scene:
             ) from None
     if path.stat().st_size == 0:
         raise GeometryError(f"empty mesh file {path}")
+    # an OBJ's objects (``o name``) are its parts: one file may hold a whole assembly
+    split = {"split_objects": True} if path.suffix.lower() == ".obj" else {}
     try:
-        scene = trimesh.load(str(path), force="scene")
+        scene = trimesh.load(str(path), force="scene", **split)
     except Exception as exc:  # trimesh raises many types for bad files
         raise GeometryError(f"unreadable mesh file {path}: {type(exc).__name__}: {exc}") from None
     if not isinstance(scene, trimesh.Scene):  # pragma: no cover - force="scene"
@@ -228,10 +233,11 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
     group_nodes = [(g, b) for g, b in group_nodes if len(b) < len(part_nodes)]
 
     names, meshes = [], []
-    for node, _ in part_nodes:
+    for node, anc in part_nodes:
         transform, geom_name = graph[node]
         meshes.append(scene.geometry[geom_name].copy().apply_transform(transform))
-        names.append(display_name(original(node)))
+        raw = best_raw([original(node), str(geom_name), *[original(a) for a in anc]])
+        names.append(display_name(original(node) if raw is None else raw))
     bases = [
         best_name([original(node), str(graph[node][1]), *[original(a) for a in anc]])
         for node, anc in part_nodes

@@ -41,7 +41,8 @@ def test_clean_name(raw, clean):
 @pytest.mark.parametrize(
     ("name", "generic"),
     [("nauo7", True), ("12", True), ("open_cascade_step_translator_7_8_1_1", True),
-     ("mesh_0", True), ("mesh0", True), ("g3", True), ("bolt", False), ("", True)],
+     ("mesh_0", True), ("mesh0", True), ("g3", True), ("bolt", False), ("", True),
+     ("p_0_1_1_7_1", True), ("p_608_2rs_bearing", False), ("p_91780a169", False)],
 )  # fmt: skip
 def test_generic_names(name, generic):
     assert is_generic(name) == generic
@@ -176,6 +177,55 @@ def test_3dxml_parts_and_names(tmp_path):
     corners = sorted(tuple(p.mesh.bounds[0].round(6)) for p in assembly.parts[1:])
     assert corners == [(5, 5, 5), (25, 25, 5)]
     assert shape_classes(assembly.parts)[1:] == ("washer", "washer")
+
+
+def test_occ_label_nodes_take_their_parents_names(tmp_path):
+    """A Pro/E STEP through cascadio: each solid is a node ``=>[0:1:1:7]`` (an OCC label)
+    under its product's instance node; ids and names come from the product, never the label
+    (trimesh's models/as1_pe_203.stp, the CAx-IF bolted brackets)."""
+    scene = trimesh.Scene()
+    scene.graph.update(frame_from="world", frame_to="AS1_PE_ASM")
+    for k, (product, label) in enumerate(
+        [
+            ("L-BRACKET_1", "=>[0:1:1:7]_1"),
+            ("BOLT_3", "=>[0:1:1:11]_3"),
+            ("BOLT_4", "=>[0:1:1:11]_4"),
+        ]
+    ):
+        scene.graph.update(frame_from="AS1_PE_ASM", frame_to=product)
+        mesh = shapes.box_between((10 * k, 0, 0), (10 * k + 5, 5, 5)).apply_scale(0.001)
+        scene.add_geometry(mesh, node_name=label, geom_name=f"SOLID_{k}", parent_node_name=product)
+    path = tmp_path / "as1_pe.glb"
+    scene.export(path)
+    parts = read_scene(path)
+    assert sorted(zip(parts.ids, parts.names, strict=True)) == [
+        ("bolt_3", "BOLT_3"), ("bolt_4", "BOLT_4"), ("l_bracket_1", "L-BRACKET_1"),
+    ]  # fmt: skip
+
+
+def test_one_obj_file_with_several_objects_is_an_assembly(tmp_path):
+    """An OBJ exported with one ``o`` object per part: each object is a part (it was read
+    as one merged part); a part file of a folder with several objects stays one part."""
+    scene = trimesh.Scene()
+    scene.add_geometry(
+        shapes.box_between((0, 0, 0), (40, 40, 5)), node_name="Base Plate", geom_name="Base Plate"
+    )
+    scene.add_geometry(
+        shapes.box_between((5, 5, 5), (15, 15, 15)), node_name="Block", geom_name="Block"
+    )
+    path = tmp_path / "pair.obj"
+    scene.export(path)
+    assembly = load_assembly(path)
+    assert sorted(assembly.ids) == ["base_plate", "block"]
+    assert all(p.mesh.is_watertight for p in assembly.parts)
+    folder = tmp_path / "parts"
+    folder.mkdir()
+    path.rename(folder / "pair.obj")
+    (folder / "other.stl").write_bytes(
+        shapes.box_between((0, 0, 5), (4, 4, 9)).export(file_type="stl")
+    )
+    parts = load_assembly(folder)
+    assert parts.ids == ("other", "pair") and len(parts.parts[1].mesh.faces) == 24
 
 
 def test_gltf_names_and_hierarchy(tmp_path):

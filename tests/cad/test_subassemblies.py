@@ -116,7 +116,13 @@ def test_plan_file_shows_the_hierarchy(tower):
         ["bearing_2a", "bearing_2b", "holder_2"],
     ]
     units = [s for s in doc["robust_plan"] if s["operation"] in doc["subassemblies"]]
-    assert [s["parts"] for s in units] == [[s["operation"]] for s in units] and len(units) == 2
+    # a unit's insertion names the unit and places its real member parts
+    assert [s["unit"] for s in units] == [s["operation"] for s in units] and len(units) == 2
+    assert [sorted(s["parts"]) for s in units] == [
+        sorted(doc["subassemblies"][s["unit"]]) for s in units
+    ]
+    members = [s for s in doc["robust_plan"] if s["workspace"] not in ("main", None)]
+    assert {s["workspace"] for s in members} == set(doc["subassemblies"]) and len(members) == 6
     check_line(result.assembly.spec, tower, plan_operations(doc))
 
 
