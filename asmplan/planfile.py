@@ -723,13 +723,28 @@ def source_folder(source: str) -> Path:
 
 def part_source(spec, file: str | None) -> dict | None:
     """Where a part's mesh is: ``file`` (relative to :func:`source_folder`),
-    ``node`` (the part inside a scene file, or null), ``path`` (absolute, when it exists)."""
+    ``node`` (the part's scene-graph node, as trimesh names it, in a scene file; else
+    null), ``path`` (absolute, when it exists)."""
     if not file:
         return None
     name, node = _split_file(file)
     folder = source_folder(spec.source)
     path = (folder / name).resolve()
+    if node is not None and path.is_file():
+        node = _scene_node(path, node)
     return {"file": name, "node": node, "path": str(path) if path.is_file() else None}
+
+
+def _scene_node(path: Path, part: str) -> str:
+    """The scene-graph node (as trimesh names it) of the part ``part`` of a scene file."""
+    from cad.scene import read_scene
+
+    try:
+        scene = read_scene(path)
+    except (OSError, ValueError):
+        return part
+    k = scene.find(part)
+    return scene.nodes[k] if k is not None and k < len(scene.nodes) else part
 
 
 def workspace_records(spec, operations: dict, principal: list[dict]) -> list[dict]:

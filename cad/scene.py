@@ -123,6 +123,10 @@ class SceneParts:
         or more, outermost first; the root is not a group).
     units : str or None
         The unit the file declares (short name), or None.
+    nodes : tuple of str
+        Each part's scene-graph node as trimesh names it (``trimesh.load(file,
+        force="scene").graph[node]`` gives its transform and geometry): what a reader of
+        ``plan.json`` looks a part up by.
     """
 
     ids: tuple[str, ...]
@@ -130,6 +134,7 @@ class SceneParts:
     meshes: tuple[trimesh.Trimesh, ...]
     groups: tuple[tuple[str, tuple[str, ...]], ...]
     units: str | None
+    nodes: tuple[str, ...] = ()
 
     def find(self, node: str) -> int | None:
         """Index of the part whose id or node name is ``node`` (None if there is none)."""
@@ -257,6 +262,7 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
         meshes=tuple(meshes),
         groups=groups,
         units=declared_units(file, scene),
+        nodes=tuple(str(node) for node, _ in part_nodes),
     )
 
 
