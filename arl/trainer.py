@@ -37,6 +37,7 @@ from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecEnvWrapper
 from arl.config import TrainConfig, get_config
 from arl.envs import GameVecEnv, Observer, TurnEnv
 from arl.game import AGENTS, NO_MOVE, GameTables
+from arl.memory import check_training_size
 from arl.runfolder import LOG_FORMAT, RunFolder
 from arl.tabulate import action_probabilities, tabulate
 from asp import rules
@@ -315,6 +316,7 @@ def train(
     progress: bool = False,
     resume: bool = False,
     callback: CycleCallback | None = None,
+    max_memory_gb: float | None = None,
 ) -> TrainResult:
     """Train a robust robot policy by alternating PPO against a learned adversarial human.
 
@@ -335,14 +337,18 @@ def train(
         ``max_cycles``) from its last committed cycle.
     callback : callable, optional
         ``callback(record) -> bool | None`` after each cycle; ``False`` stops training.
+    max_memory_gb : float, optional
+        Refuse (before anything heavy runs) a game whose estimated training memory is over
+        this (default: three quarters of this machine's memory; :mod:`arl.memory`).
 
     Returns
     -------
     TrainResult
     """
-    cfg = get_config(config)
+    cfg = get_config(config, dag.metadata.get("turn_model"))
     if resume and output is None:
         raise ValueError("resume: expected an output folder to resume from")
+    check_training_size(dag, cfg, max_memory_gb)
     folder = None if output is None else RunFolder(output)
     run = _start_run(dag, cfg, seed, folder, resume)
     try:

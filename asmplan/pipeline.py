@@ -269,12 +269,16 @@ def load(
     """:func:`load_assembly` and, when the spec has meshes, its :func:`relations`.
 
     A generated spec (no ``assembly.yaml``) is announced through ``on_step``, else as a
-    warning; its placements of parts nothing can keep from falling become ``held`` and, when
-    no complete sequence can start from its base part, another base is taken
-    (:func:`asp.generate.workable_base`), each named in a note. ``contact_tol`` and
+    warning; its gravity is chosen from the relations (:mod:`asp.gravity`: the format's
+    own down unless another direction is clearly better), said in a note; its placements
+    of parts nothing can keep from falling become ``held``
+    (:func:`asp.generate.hold_unsupported`) and, when no complete sequence can start
+    from its base part, another base is taken (:func:`asp.generate.workable_base`), each
+    named in a note. ``contact_tol`` and
     ``penetration_tol`` (mm) replace the spec's tolerances when given.
     """
-    from asp.generate import HELD_REASON, workable_base
+    from asp.feasibility import load_relations
+    from asp.generate import HELD_REASON, orient_generated, spec_geometry, workable_base
 
     spec = with_tolerances(load_assembly(source), contact_tol, penetration_tol)
 
@@ -296,7 +300,11 @@ def load(
     if spec.has_geometry:
         if on_step is not None:
             on_step(f"computing part relations of {len(spec.parts)} parts ...")
-        rel = relations(spec, progress=progress)
+        geometry = spec_geometry(spec)
+        rel = load_relations(spec, progress=progress, geometry=geometry)
+        spec, choice = orient_generated(spec, rel, geometry)
+        if choice is not None:
+            note(f"generated spec: gravity {choice.gravity}: {choice.reason}")
         spec, rebased = workable_base(spec, rel)
         if rebased:
             note(rebased)

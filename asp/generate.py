@@ -8,15 +8,19 @@ rule, fixed so that a generated spec plans the same as the file it writes:
 - parts: one per mesh node of the file (ids and names from the file, :mod:`cad.scene`),
   or per mesh file of the folder (a ``bom.csv``/``bom.yaml`` in the folder still names
   them); ``shape`` is the shape class (identical parts share it, :mod:`cad.identical`);
-- the base part, placed first: the lowest of the large parts (those whose footprint, the
-  bounding box's area across gravity ``-z``, is at least half the largest);
+- gravity: the format's own down (``-y`` for glTF/GLB, whose specification makes ``+y``
+  up; ``-z`` for the others) unless another axis direction is clearly better for the
+  parts' relations (:mod:`asp.gravity`: a Y-up STEP export gets ``-y``);
+  :func:`orient_generated` applies it once the relations are computed, and says why;
+- the base part, placed first: the lowest of the large parts along gravity (those whose
+  footprint, the bounding box's area across gravity, is at least half the largest);
 - agents: one human ``H`` and one robot ``R1``;
 - one placement operation per part, ids ``"1"``, ``"2"``, ... in the order base first,
   then the others from the lowest to the highest (against gravity), open to both agents;
 - durations (:func:`placement_durations`): the human takes 3 s plus 1 s per 25 mm of
   the part's bounding-box diagonal, at most 60 s, in whole seconds; the robot takes 1.5
   times as long (rounded to whole seconds); the cost model is ``time``;
-- gravity ``-z``, every gripper approach direction, every constraint on; the units are
+- every gripper approach direction, every constraint on; the units are
   those the files declare (STEP, glTF, 3MF), ``units: mm`` for the others;
 - ``held: true`` on the placement of every part (the base aside) that no other part can
   stop falling along gravity (:func:`unsupported_parts`: its row of the support relation
@@ -55,16 +59,6 @@ def placement_durations(diagonal_mm: float) -> tuple[float, float]:
     """``(human, robot)`` seconds to place a part of bounding-box diagonal ``diagonal_mm``."""
     human = min(MAX_DURATION_S, float(round(HUMAN_BASE_S + HUMAN_S_PER_MM * diagonal_mm)))
     return human, float(round(ROBOT_FACTOR * human))
-
-
-def base_index(bounds: np.ndarray) -> int:
-    """The lowest of the large parts: of the parts whose footprint (bounding-box area
-    across gravity) is at least half the largest, the one whose bottom is lowest (the
-    larger footprint on a tie); ``bounds`` shape (n, 2, 3)."""
-    footprint = np.prod(bounds[:, 1, :2] - bounds[:, 0, :2], axis=1)
-    large = np.flatnonzero(footprint >= 0.5 * footprint.max())
-    order = sorted(large, key=lambda k: (bounds[k, 0, 2], -footprint[k], k))
-    return int(order[0])
 
 
 HELD_REASON = "nothing below can stop it falling; an agent holds it until a later part fixes it"
@@ -223,20 +217,25 @@ def cad_assembly(path: str | Path):
     return assembly
 
 
-def spec_data(path: str | Path, spec_folder: str | Path | None = None) -> tuple[dict, object]:
+def spec_data(
+    path: str | Path, spec_folder: str | Path | None = None, gravity: str | None = None
+) -> tuple[dict, object]:
     """The generated spec of a CAD file or folder, as the YAML mapping, and its geometry.
 
     Part files are written relative to ``spec_folder`` (default: the CAD file's folder,
-    or the folder of meshes itself).
+    or the folder of meshes itself); ``gravity`` defaults to the format's own down
+    (:func:`asp.gravity.default_down`).
 
     Returns
     -------
     (dict, cad.Assembly)
         The mapping :func:`asp.spec.spec_from_dict` reads, and the parts it was made from.
     """
+    from asp.gravity import base_index, default_down
     from cad.identical import shape_classes
 
     path = Path(path)
+    gravity = gravity or default_down(path)
     assembly = cad_assembly(path)
     shapes = shape_classes(assembly.parts)
     counts = Counter(shapes)
@@ -257,10 +256,12 @@ def spec_data(path: str | Path, spec_folder: str | Path | None = None) -> tuple[
         parts.append(record)
     bounds = np.array([p.bounds for p in assembly.parts])  # (n, 2, 3) in mm
     extents = bounds[:, 1] - bounds[:, 0]
-    base = base_index(bounds)
+    base = base_index(bounds, gravity)
+    axis, sign = "xyz".index(gravity[1]), (1.0 if gravity[0] == "-" else -1.0)
+    low, high = (0, 1) if sign > 0 else (1, 0)  # the bottom and top faces along gravity
     order = [base] + sorted(
         (k for k in range(len(assembly.parts)) if k != base),
-        key=lambda k: (bounds[k, 0, 2], bounds[k, 1, 2], k),
+        key=lambda k: (sign * bounds[k, low, axis], sign * bounds[k, high, axis], k),
     )
     operations = []
     for number, k in enumerate(order, start=1):
@@ -284,7 +285,7 @@ def spec_data(path: str | Path, spec_folder: str | Path | None = None) -> tuple[
             "R1": {"side": "robot", "description": "robot arm with a gripper"},
         },
         "base_part": assembly.parts[base].id,
-        "gravity": "-z",
+        "gravity": gravity,
         "gripper_approach": ["+x", "-x", "+y", "-y", "+z", "-z"],
         "constraints": {"topological": True, "stability": True, "functional": True},
         "turn_model": "alternate",
@@ -312,17 +313,49 @@ def load_any(path: str | os.PathLike[str]) -> AssemblySpec:
     return generated_spec(path) if is_cad_input(path) else load_spec(path)
 
 
-def generated_spec(path: str | Path) -> AssemblySpec:
+def generated_spec(path: str | Path, gravity: str | None = None) -> AssemblySpec:
     """The spec generated from a CAD file or a folder of part meshes (``generated=True``).
 
     Its ``source`` is the spec file it stands for (``assembly.yaml`` beside the CAD file,
     which need not exist), so that part files resolve as in the written spec.
     """
     path = Path(path)
-    data, _ = spec_data(path)
+    data, _ = spec_data(path, gravity=gravity)
     folder = path if path.is_dir() else path.parent
     spec = spec_from_dict(data, source=str(folder / SPEC_FILE))
     return replace(spec, generated=True, source=str(path))
+
+
+def gravity_choice(relations, geometry, default: str):
+    """:func:`asp.gravity.choose_gravity` for parts ``geometry`` (a ``cad.Assembly``)."""
+    from asp.gravity import choose_gravity
+
+    box = {p.id: p.bounds for p in geometry.parts}
+    bounds = np.array([box[str(pid)] for pid in relations.parts], dtype=float)
+    return choose_gravity(relations, bounds, default)
+
+
+def orient_generated(spec: AssemblySpec, relations, geometry):
+    """A generated spec with the gravity :mod:`asp.gravity` chooses, and the choice.
+
+    When the choice differs from the spec's (the format's own down), the spec is
+    generated again along it (base part and operation order follow gravity). A user's
+    spec, or one without relations, is returned unchanged with None.
+    """
+    import warnings
+
+    if not spec.generated or relations is None or getattr(relations, "sp", None) is None:
+        return spec, None
+    choice = gravity_choice(relations, geometry, spec.gravity)
+    if choice.gravity == spec.gravity:
+        return spec, choice
+    from dataclasses import replace
+
+    with warnings.catch_warnings():  # the same files again: their warnings were given
+        warnings.simplefilter("ignore")
+        turned = generated_spec(spec.source, gravity=choice.gravity)
+    tolerances = {"contact_tol": spec.contact_tol, "penetration_tol": spec.penetration_tol}
+    return replace(turned, **tolerances), choice
 
 
 def spec_text(
@@ -331,17 +364,20 @@ def spec_text(
     *,
     contact_tol: float | None = None,
     penetration_tol: float | None = None,
+    on_note=None,
     decide_units=None,
 ) -> str:
     """The generated spec of a CAD file or folder as a commented ``assembly.yaml``.
 
     Part files are relative to ``spec_folder``, where the file will be written. Tolerances
     given (mm) are written as the spec's ``contact_tol`` / ``penetration_tol`` and used for
-    the ``held`` marks; else both keys are written commented out. ``decide_units(spec,
+    the ``held`` marks; else both keys are written commented out. ``on_note`` (optional) is
+    called with a line saying which gravity was chosen and why. ``decide_units(spec,
     relations)`` (:func:`asp.units.cad_units`, given by the caller: it sits above this
     module) decides which of the file's sub-assemblies are written as ``subassemblies:``;
     without it they are all written commented.
     """
+    import warnings
     from dataclasses import replace
 
     import cad
@@ -350,6 +386,13 @@ def spec_text(
     relations = cad.compute_relations(
         assembly, contact_tol=contact_tol, penetration_tol=penetration_tol
     )
+    choice = gravity_choice(relations, assembly, data["gravity"])
+    if choice.gravity != data["gravity"]:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            data, assembly = spec_data(path, spec_folder, gravity=choice.gravity)
+    if on_note is not None:
+        on_note(f"gravity {choice.gravity}: {choice.reason}")
     generated = replace(spec_from_dict(data, source=str(path)), generated=True)
     spec, rebased = workable_base(generated, relations)
     if rebased:
@@ -398,7 +441,8 @@ def spec_text(
             if rebased
             else "the lowest of the large parts"
         ),
-        "gravity: -z                # direction of gravity in the file's frame",
+        f"gravity: {data['gravity']}                # direction of gravity in the file's frame:",
+        f"#   {choice.reason} (asp/gravity.py)",
         "gripper_approach: [+x, -x, +y, -y, +z, -z]   # directions a part may be inserted from",
         "constraints: {topological: true, stability: true, functional: true}",
         "turn_model: alternate",

@@ -30,7 +30,7 @@ import trimesh
 from cad.assembly import Assembly, prepare_part
 from cad.bom import PartRecord, read_bom
 from cad.errors import GeometryError
-from cad.scene import SCENE_SUFFIXES, read_scene
+from cad.scene import SCENE_SUFFIXES, empty_scene_error, read_scene
 from cad.unit_hints import part_scale_hint
 from cad.units import unit_scale
 
@@ -168,7 +168,7 @@ def _record_mesh(row: PartRecord, base: Path, units: str | None):
             )
         return scene.meshes[k], unit, f"{file}#{scene.ids[k]}"
     if not scene.meshes:
-        raise GeometryError(f"unreadable mesh file {file}: no triangles could be read (empty mesh)")
+        raise empty_scene_error(file)
     meshes = scene.meshes
     mesh = meshes[0] if len(meshes) == 1 else trimesh.util.concatenate(list(meshes))
     return mesh, unit, str(file)
@@ -177,7 +177,7 @@ def _record_mesh(row: PartRecord, base: Path, units: str | None):
 def _scene_assembly(path: Path, units: str | None) -> Assembly:
     scene = read_scene(path)
     if not scene.meshes:
-        raise GeometryError(f"unreadable mesh file {path}: no triangles could be read (empty mesh)")
+        raise empty_scene_error(path)
     unit = scene.units or units or "mm"
     scale = unit_scale(unit)
     parts = tuple(

@@ -8,8 +8,10 @@ Part ids are the names the file gives, cleaned into short unique ids (:func:`cle
 :func:`unique_ids`): ``"Hex Nut M6<2>"`` -> ``hex_nut_m6``, numbered when a name repeats
 (``nut_1``, ``nut_2``), in the file's order. Instance paths and numbers
 (``bearing#1:23:2:16``, ``Bolt:1``, ``Part1<3>``) are cut off; names that say nothing
-(``NAUO7``, ``12``, ``Open CASCADE STEP translator 7.8 1.1``, ``mesh_0``) give way to the
-mesh's name or the nearest named parent, else ``part``.
+(``NAUO7``, ``12``, ``Open CASCADE STEP translator 7.8 1.1``, ``mesh_0``, and OCCT's
+reference labels ``=>[0:1:1:7]`` that cascadio gives the shape nodes of Pro/E and Creo
+exports) give way to the mesh's name or the nearest named parent (``L-BRACKET`` ->
+``l_bracket_1``), else ``part``. A part's display name comes from the same node.
 """
 
 from __future__ import annotations
@@ -20,6 +22,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 from pathlib import Path
 
+import numpy as np
 import trimesh
 
 from cad.errors import GeometryError
@@ -29,14 +32,23 @@ SCENE_SUFFIXES = (".glb", ".gltf", ".3mf", ".step", ".stp", ".3dxml")
 """Files that hold several parts (one per mesh node)."""
 DECLARED_METRES = (".glb", ".gltf", ".step", ".stp")
 """Formats whose unit is the metre (STEP through cascadio, glTF by definition)."""
+MAX_INCH_ASSEMBLY_M = 3.0
+"""A STEP declaring inches whose parts span more than this (metres, 118 in) has millimetre
+numbers under an inch label (Pro/E exports of metric models do this); it is read in mm."""
+MAX_GLTF_ASSEMBLY_M = 20.0
+"""A glTF (metres by its specification) whose parts span more than this has millimetre
+numbers (converters that keep a CAD model's numbers, e.g. COLLADA2GLTF); read in mm."""
 MAX_ID_LENGTH = 32
 _EXTENSIONS = r"\.(stp|step|sldprt|sldasm|ipt|iam|prt|asm|stl|obj|glb|gltf|3mf)$"
 
 _GENERIC = re.compile(
     r"^((nauo|solid|body|mesh|shape|geometry|node|object|component|compound|part|g)_?\d*|"
-    r"\d+|unnamed\w*|noname\w*|default\w*|world|root|scene|open_cascade_step_translator\w*|"
+    r"\d+(_\d+)*|unnamed\w*|noname\w*|default\w*|world|root|scene|open_cascade_step_translator\w*|"
     r"p(_\d+)+)$"  # an instance path or label (cascadio's ``=>[0:1:1:7]``) cleaned
 )
+
+_REFERENCE_LABEL = re.compile(r"=>\[[\d:]*\]")
+"""OCCT's label of a referred shape (``=>[0:1:1:7]``): an instance path, never a name."""
 
 
 def clean_name(raw: str) -> str:
@@ -45,7 +57,7 @@ def clean_name(raw: str) -> str:
     Instance suffixes (``#...``, ``:1``, ``<2>``, ``(3)``) and file extensions are cut off,
     everything but letters and digits becomes ``_``, at most :data:`MAX_ID_LENGTH` chars.
     """
-    name = str(raw).strip()
+    name = _REFERENCE_LABEL.sub("", str(raw)).strip()
     name = re.split(r"[#<]", name, maxsplit=1)[0]
     name = re.sub(r":\d+$", "", name)
     name = re.sub(r"\(\d+\)$", "", name)
@@ -163,10 +175,39 @@ def load_scene_file(path: Path) -> trimesh.Scene:
     try:
         scene = trimesh.load(str(path), force="scene", **split)
     except Exception as exc:  # trimesh raises many types for bad files
+        if external_references(path):
+            raise empty_scene_error(path) from None
         raise GeometryError(f"unreadable mesh file {path}: {type(exc).__name__}: {exc}") from None
     if not isinstance(scene, trimesh.Scene):  # pragma: no cover - force="scene"
         scene = trimesh.Scene(scene)
     return scene
+
+
+def empty_scene_error(path: Path) -> GeometryError:
+    """The one-line error for a file with no triangles; names the files a STEP refers to
+    (``DOCUMENT_FILE``: an assembly whose parts live in other files, which OCCT does not
+    follow)."""
+    referred = external_references(path)
+    if referred:
+        shown = ", ".join(referred[:6]) + (", ..." if len(referred) > 6 else "")
+        return GeometryError(
+            f"{path} holds no geometry of its own: it references external files ({shown}); "
+            "export the assembly as one STEP file with its parts embedded"
+        )
+    return GeometryError(f"unreadable mesh file {path}: no triangles could be read (empty mesh)")
+
+
+def external_references(path: Path) -> tuple[str, ...]:
+    """The files a STEP file's ``DOCUMENT_FILE`` entities name, in order, without repeats
+    (empty for other formats)."""
+    if path.suffix.lower() not in (".step", ".stp"):
+        return ()
+    try:
+        text = path.read_text(encoding="latin-1")
+    except OSError:
+        return ()
+    found = re.findall(r"DOCUMENT_FILE\s*\(\s*'([^']+)'", text, flags=re.IGNORECASE)
+    return tuple(dict.fromkeys(found))
 
 
 def declared_units(path: Path, scene: trimesh.Scene) -> str | None:
@@ -237,10 +278,12 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
     # the node holding every part (the product itself) is not a group
     group_nodes = [(g, b) for g, b in group_nodes if len(b) < len(part_nodes)]
 
+    rescale = _millimetre_numbers(file, scene)
     names, meshes = [], []
     for node, anc in part_nodes:
         transform, geom_name = graph[node]
-        meshes.append(scene.geometry[geom_name].copy().apply_transform(transform))
+        mesh = scene.geometry[geom_name].copy().apply_transform(transform)
+        meshes.append(mesh.apply_scale(rescale) if rescale != 1.0 else mesh)
         raw = best_raw([original(node), str(geom_name), *[original(a) for a in anc]])
         names.append(display_name(original(node) if raw is None else raw))
     bases = [
@@ -264,6 +307,67 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
         units=declared_units(file, scene),
         nodes=tuple(str(node) for node, _ in part_nodes),
     )
+
+
+def step_length_unit(path: Path) -> str | None:
+    """The length unit of a STEP file's first ``GLOBAL_UNIT_ASSIGNED_CONTEXT`` (``"in"``,
+    ``"mm"``, ``"m"``, ...), read from the text; None when there is none or it is unknown.
+
+    The unit is a ``CONVERSION_BASED_UNIT('INCH' | 'FOOT', ...)`` or an
+    ``SI_UNIT(prefix, .METRE.)``, among the context's units the one that is a
+    ``LENGTH_UNIT``.
+    """
+    if path.suffix.lower() not in (".step", ".stp"):
+        return None
+    try:
+        text = path.read_text(encoding="latin-1")
+    except OSError:
+        return None
+    context = re.search(r"GLOBAL_UNIT_ASSIGNED_CONTEXT\s*\(\s*\(([^)]*)\)", text)
+    for ref in re.findall(r"#\d+", context.group(1)) if context else []:
+        entity = re.search(rf"{ref}\s*=([^;]*);", text)
+        if entity is None or "LENGTH_UNIT" not in entity.group(1):
+            continue
+        body = entity.group(1)
+        named = re.search(r"CONVERSION_BASED_UNIT\s*\(\s*'([A-Za-z ]+)'", body)
+        if named:
+            return {"inch": "in", "foot": "ft"}.get(named.group(1).strip().lower())
+        si = re.search(r"SI_UNIT\s*\(\s*(\$|\.\w+\.)\s*,\s*\.METRE\.", body)
+        if si:
+            prefix = si.group(1).strip(".").upper()
+            return {"$": "m", "MILLI": "mm", "CENTI": "cm", "MICRO": "um"}.get(prefix)
+    return None
+
+
+def _millimetre_numbers(path: Path, scene: trimesh.Scene) -> float:
+    """The factor that reads a file's millimetre numbers under a wrong unit label as mm
+    (1.0 when the label is plausible), with a warning.
+
+    A STEP declaring inches whose parts, read so, span more than
+    :data:`MAX_INCH_ASSEMBLY_M`: 1 / 25.4; a glTF/GLB (metres) spanning more than
+    :data:`MAX_GLTF_ASSEMBLY_M`: 1 / 1000.
+    """
+    suffix = path.suffix.lower()
+    if scene.bounds is None or suffix not in (".step", ".stp", ".glb", ".gltf"):
+        return 1.0
+    size = float(np.linalg.norm(np.ptp(scene.bounds, axis=0)))  # metres (cascadio, glTF)
+    if suffix in (".glb", ".gltf"):
+        label, limit, factor = "metres (glTF)", MAX_GLTF_ASSEMBLY_M, 1e-3
+    elif step_length_unit(path) == "in":
+        label, limit, factor = "inches", MAX_INCH_ASSEMBLY_M, 1.0 / 25.4
+    else:
+        return 1.0
+    if size <= limit:
+        return 1.0
+    import warnings
+
+    warnings.warn(
+        f"{path.name} declares {label}, but read so it is {size:.3g} m across: its numbers "
+        f"are taken as millimetres ({size * factor * 1000:.0f} mm across; rule in "
+        "cad/scene.py)",
+        stacklevel=2,
+    )
+    return factor
 
 
 def _3dxml_groups(file: Path, nodes: list[str]) -> list[tuple[str, list[str]]]:

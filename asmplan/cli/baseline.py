@@ -8,7 +8,7 @@ from pathlib import Path
 import typer
 
 from asmplan.cli.app import OutputFormat, app
-from asmplan.cli.options import SEED_MAX, TIME_LIMIT_MAX, WORKERS_MAX
+from asmplan.cli.options import WORKERS_MAX, seed_option, time_limit_option
 
 
 def baseline_result(source: Path, *, time_limit: float, workers: int, seed: int):
@@ -41,17 +41,11 @@ def baseline_command(
         ..., help="PSPLIB .sm, game DAG (.json/.graphml), or assembly (folder, yaml, .IN2)."
     ),
     fmt: OutputFormat = typer.Option(OutputFormat.text, "--format", help="Output format."),
-    time_limit: float = typer.Option(
-        60.0,
-        "--time-limit",
-        min=0.001,
-        max=TIME_LIMIT_MAX,
-        help="CP-SAT time limit, seconds.",
-    ),
+    time_limit: float = time_limit_option(60.0),
     workers: int = typer.Option(
         1, "--workers", min=1, max=WORKERS_MAX, help="CP-SAT workers (1: repeatable)."
     ),
-    seed: int = typer.Option(0, "--seed", min=0, max=SEED_MAX, help="CP-SAT random seed."),
+    seed: int = seed_option("CP-SAT random seed."),
 ) -> None:
     """CP-SAT baseline: minimum makespan (.sm, assembly) or minimum-cost path (game DAG)."""
     if not source.exists():

@@ -11,7 +11,7 @@ from pathlib import Path
 import typer
 
 from asmplan.cli.app import app, choices, fail
-from asmplan.cli.options import GAMES_MAX, SEED_MAX, WORKERS_MAX
+from asmplan.cli.options import GAMES_MAX, WORKERS_MAX, seed_option
 from asmplan.experiments.backends import BACKENDS
 from asmplan.experiments.tasks import EXPERIMENT_KEYS, Solver
 
@@ -87,9 +87,7 @@ def experiment_command(
         "--solver",
         help="exact minimax, ARL, or both (ARL with exact beside it).",
     ),
-    seed: int = typer.Option(
-        0, "--seed", min=0, max=SEED_MAX, help="Base seed; each task derives its own from it."
-    ),
+    seed: int = seed_option("Base seed; each task derives its own from it."),
     config: ConfigChoice = typer.Option(ConfigChoice.paper, "--config", help="ARL configuration."),
     backend: BackendChoice = typer.Option(
         BackendChoice.local, "--backend", help="local process pool or Ray."

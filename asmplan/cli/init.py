@@ -41,6 +41,7 @@ def init_command(
         spec_folder=output.parent,
         contact_tol=contact_tol,
         penetration_tol=penetration_tol,
+        on_note=lambda line: typer.echo(line, err=True),
         decide_units=cad_units,
     )
     # the text must read back as a valid spec before it is written

@@ -25,6 +25,19 @@ WORKERS_MAX = 1_024
 CostModel = choices("CostModel", COST_MODELS, "Cost of a move.")
 
 
+def time_limit_option(default: float):
+    """``--time-limit``: one definition for every command that runs CP-SAT."""
+    return typer.Option(
+        default, "--time-limit", min=0.001, max=TIME_LIMIT_MAX, help="CP-SAT time limit, seconds."
+    )
+
+
+def seed_option(help: str, default: int | None = 0):
+    """``--seed``: one definition (a 32-bit seed, :data:`SEED_MAX`) for every command; ``help``
+    says what it seeds."""
+    return typer.Option(default, "--seed", min=0, max=SEED_MAX, help=help)
+
+
 def _tolerance(name: str):
     def check(value: float | None) -> float | None:
         from cad.tolerances import checked_tolerance

@@ -15,13 +15,13 @@ import typer
 from asmplan.cli.app import app, choices
 from asmplan.cli.graph import say
 from asmplan.cli.options import (
-    SEED_MAX,
-    TIME_LIMIT_MAX,
     CostModel,
     check_output,
     contact_tol_option,
     finite_or_none,
     penetration_tol_option,
+    seed_option,
+    time_limit_option,
 )
 from asp.spec import TURN_MODELS
 
@@ -109,10 +109,8 @@ def plan_command(
         None, "--output", "-o", help="Folder for plan.json, dag.png (and manifest.json)."
     ),
     cost: CostModel | None = typer.Option(None, "--cost", help="Cost model (default: spec's)."),
-    time_limit: float = typer.Option(
-        30.0, "--time-limit", min=0.001, max=TIME_LIMIT_MAX, help="CP-SAT time limit, seconds."
-    ),
-    seed: int = typer.Option(0, "--seed", min=0, max=SEED_MAX, help="CP-SAT random seed."),
+    time_limit: float = time_limit_option(30.0),
+    seed: int = seed_option("CP-SAT random seed."),
     turn_model: TurnModel | None = typer.Option(
         None, "--turn-model", help="alternate (the paper's turns) or concurrent (default: spec's)."
     ),

@@ -13,7 +13,7 @@ from pathlib import Path
 import typer
 
 from asmplan.cli.app import app, choices
-from asmplan.cli.options import SEED_MAX, CostModel
+from asmplan.cli.options import CostModel, seed_option
 from asp.numbers import cost_unit
 from asp.rules import SIDE_NAMES, cost_at_most, costs_close
 
@@ -135,12 +135,8 @@ def play_command(
     moves: str | None = typer.Option(
         None, "--moves", help="Scripted move numbers, e.g. 2,1,3 (then reads stdin)."
     ),
-    seed: int | None = typer.Option(
-        None,
-        "--seed",
-        min=0,
-        max=SEED_MAX,
-        help="Break the computer human's ties at random with this seed.",
+    seed: int | None = seed_option(
+        "Break the computer human's ties at random with this seed.", default=None
     ),
     cost: CostModel | None = typer.Option(
         None, "--cost", help="Cost model of an assembly (default: the spec's)."

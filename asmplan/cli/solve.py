@@ -8,7 +8,7 @@ from pathlib import Path
 import typer
 
 from asmplan.cli.app import OutputFormat, app
-from asmplan.cli.options import GAMES_MAX, SEED_MAX, finite_or_none
+from asmplan.cli.options import GAMES_MAX, finite_or_none, seed_option
 
 
 @app.command("solve")
@@ -18,7 +18,7 @@ def solve_command(
     games: int = typer.Option(
         1000, "--games", min=1, max=GAMES_MAX, help="Simulated random-human games."
     ),
-    seed: int = typer.Option(0, "--seed", min=0, max=SEED_MAX, help="Seed of the simulation."),
+    seed: int = seed_option("Seed of the simulation."),
     wcpl: float | None = typer.Option(
         None,
         "--wcpl",

@@ -7,7 +7,7 @@ from pathlib import Path
 import typer
 
 from asmplan.cli.app import app
-from asmplan.cli.options import SEED_MAX, check_output
+from asmplan.cli.options import check_output, seed_option
 
 MAX_LAYERS = 1_000
 MAX_NODES_PER_LAYER = 1_000
@@ -29,7 +29,7 @@ def synth_command(
     max_actions: int = typer.Option(
         4, "--max-actions", min=1, max=MAX_ACTIONS, help="Maximum actions per node A (1 to 100)."
     ),
-    seed: int = typer.Option(0, "--seed", min=0, max=SEED_MAX, help="Generator seed."),
+    seed: int = seed_option("Generator seed."),
     output: Path = typer.Option(..., "--output", "-o", help="Graph file (.json or .graphml)."),
 ) -> None:
     """Generate a synthetic assembly DAG (paper, section 3.2)."""

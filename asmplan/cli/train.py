@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING
 import typer
 
 from asmplan.cli.app import OutputFormat, app
-from asmplan.cli.options import GAMES_MAX, SEED_MAX, check_output
+from asmplan.cli.options import GAMES_MAX, check_output, seed_option
 
 if TYPE_CHECKING:  # pragma: no cover - types only
     from asp.dag import GameDAG
@@ -79,26 +79,41 @@ def train_command(
     graph: Path = typer.Argument(..., help=SOURCE_HELP),
     turn_model: TurnModel | None = typer.Option(None, "--turn-model", help=TURN_MODEL_HELP),
     config: str = typer.Option("paper", "--config", help="Training configuration: paper|fast."),
-    seed: int = typer.Option(
-        0, "--seed", min=0, max=SEED_MAX, help="Seed of models, environments and torch."
-    ),
+    seed: int = seed_option("Seed of models, environments and torch."),
     output: Path = typer.Option(..., "--output", "-o", help="Run folder (models, log, plots)."),
     resume: bool = typer.Option(False, "--resume", help="Continue the run saved in --output."),
     max_cycles: int | None = typer.Option(
         None, "--max-cycles", min=1, max=MAX_CYCLES, help="Stop after N cycles."
     ),
     progress: bool = typer.Option(True, "--progress/--no-progress", help="Show a progress bar."),
+    max_memory: float | None = typer.Option(
+        None,
+        "--max-memory",
+        min=0.001,
+        max=1e6,
+        help="Refuse a game whose training needs more GB than this, before any work "
+        "(default: 3/4 of this machine's memory; arl/memory.py).",
+    ),
 ) -> None:
     """Train a robust robot policy by alternating PPO against a learned adversarial human."""
     from arl.config import get_config
     from arl.trainer import train
 
     check_output(output, folder=True)
-    cfg = get_config(config)
+    get_config(config)  # a bad name fails before any work
     dag = load_training_game(graph, turn_model)
+    cfg = get_config(config, dag.metadata.get("turn_model"))
     if max_cycles is not None:
         cfg = cfg.replace(max_cycles=max_cycles)
-    result = train(dag, cfg, seed=seed, output=output, progress=progress, resume=resume)
+    result = train(
+        dag,
+        cfg,
+        seed=seed,
+        output=output,
+        progress=progress,
+        resume=resume,
+        max_memory_gb=max_memory,
+    )
     status = "converged" if result.converged else "stopped"
     typer.echo(
         f"{status} after {len(result.cycles)} cycles in {result.wall_s:.1f} s: "
@@ -117,7 +132,7 @@ def evaluate_command(
     games: int = typer.Option(
         1000, "--games", min=1, max=GAMES_MAX, help="Simulated random-human games."
     ),
-    seed: int = typer.Option(0, "--seed", min=0, max=SEED_MAX, help="Seed of the simulation."),
+    seed: int = seed_option("Seed of the simulation."),
 ) -> None:
     """Score a trained robot policy exactly: WCPL, certified WCPL, random-human metrics, RR."""
     from arl.trainer import evaluate

@@ -144,22 +144,11 @@ def write_figures(plan: ConcurrentPlan, folder: str | os.PathLike[str] | Callabl
             title=f"{name}\nguaranteed makespan against a person who may deviate k times",
         )
     ]
-    bars, makespan = plan.cooperative
-    written.append(
-        plot_gantt(
-            bars,
-            path_of("gantt_cooperative.png"),
-            makespan=makespan,
-            title=f"{name}: robust plan (k = {k}), the person follows it: {makespan:g}",
-        )
+    lines = (
+        ("gantt_cooperative.png", plan.cooperative, "the person follows it"),
+        ("gantt_worst.png", plan.worst, "against the worst person"),
     )
-    bars, makespan = plan.worst
-    written.append(
-        plot_gantt(
-            bars,
-            path_of("gantt_worst.png"),
-            makespan=makespan,
-            title=f"{name}: robust plan (k = {k}) against the worst person: {makespan:g}",
-        )
-    )
+    for file, (bars, makespan), who in lines:
+        title = f"{name}: robust plan (k = {k}), {who}: {makespan:g}"
+        written.append(plot_gantt(bars, path_of(file), makespan=makespan, title=title))
     return written

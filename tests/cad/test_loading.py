@@ -222,3 +222,25 @@ def test_step_scene_loads_in_millimetres_with_the_stacked_relations():
     # DIRECTIONS = +x -x +y -y +z -z: the high cube lies on the +z side of the low one
     assert rel.tc[i, j].tolist() == [False, False, False, False, True, False]
     assert rel.tt[j, i].tolist() == [True, True, True, True, True, False]
+
+
+def test_a_step_that_only_references_other_files_says_so(tmp_path):
+    pytest.importorskip("cascadio")
+    path = tmp_path / "foot.stp"
+    path.write_text(
+        "ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION((''),'2;1');\n"
+        "FILE_NAME('foot.stp','2026-01-01T00:00:00',(''),(''),'','','');\n"
+        "FILE_SCHEMA(('AUTOMOTIVE_DESIGN { 1 0 10303 214 1 1 1 1 }'));\nENDSEC;\nDATA;\n"
+        "#1=APPLICATION_CONTEXT('automotive design');\n"
+        "#2=PRODUCT_CONTEXT('',#1,'mechanical');\n"
+        "#3=PRODUCT('FOOT','FOOT','',(#2));\n"
+        "#4=PRODUCT_DEFINITION_FORMATION('','',#3);\n"
+        "#5=PRODUCT_DEFINITION_CONTEXT('part definition',#1,'design');\n"
+        "#6=PRODUCT_DEFINITION('design','',#4,#5);\n"
+        "#7=DOCUMENT_TYPE('');\n"
+        "#8=DOCUMENT_FILE('FOOT_FRONT.stp','','',#7,'',$);\n"
+        "#9=DOCUMENT_FILE('FOOT_BACK.stp','','',#7,'',$);\n"
+        "ENDSEC;\nEND-ISO-10303-21;\n"
+    )
+    with pytest.raises(ValueError, match=r"references external files \(FOOT_FRONT.stp, FOOT_BACK"):
+        load_assembly(path)

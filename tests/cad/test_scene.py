@@ -28,6 +28,7 @@ DATA = Path(__file__).parent / "data"
         ("Side Panel.SLDPRT", "side_panel"),
         ("608-2RS bearing", "p_608_2rs_bearing"),
         ("NAUO7", "nauo7"),
+        ("=>[0:1:1:7]_1", "1"),
         (
             "a-very-long-name-of-a-part-that-goes-on-and-on-forever",
             "a_very_long_name_of_a_part_that",
@@ -42,7 +43,8 @@ def test_clean_name(raw, clean):
     ("name", "generic"),
     [("nauo7", True), ("12", True), ("open_cascade_step_translator_7_8_1_1", True),
      ("mesh_0", True), ("mesh0", True), ("g3", True), ("bolt", False), ("", True),
-     ("p_0_1_1_7_1", True), ("p_608_2rs_bearing", False), ("p_91780a169", False)],
+     ("p_0_1_1_7_1", True), ("0_1_1_7", True), ("p_608_2rs_bearing", False),
+     ("p_91780a169", False)],
 )  # fmt: skip
 def test_generic_names(name, generic):
     assert is_generic(name) == generic
@@ -238,3 +240,77 @@ def test_gltf_names_and_hierarchy(tmp_path):
     assert np.allclose(assembly.parts[2].mesh.extents, [40, 40, 5], atol=1e-4)
     classes = shape_classes(assembly.parts)
     assert classes[0] == classes[1] == "bearing" and classes[2] == "bottom_plate"
+
+
+def test_occt_reference_labels_give_way_to_the_product_name(tmp_path):
+    """Pro/E STEP through cascadio: shape nodes ``=>[0:1:1:7]`` under ``L-BRACKET``."""
+    scene = trimesh.Scene()
+    scene.graph.update(frame_from="world", frame_to="AS1_PE_ASM")
+    nodes = {
+        "L-BRACKET": ("=>[0:1:1:7]", shapes.box_between((0, 0, 0), (40, 40, 5))),
+        "L-BRACKET_1": ("=>[0:1:1:7]_1", shapes.box_between((0, 0, 5), (40, 40, 10))),
+        "PLATE": ("=>[0:1:1:3]", shapes.box_between((0, 0, 10), (40, 40, 15))),
+    }
+    for k, (parent, (node, mesh)) in enumerate(nodes.items()):
+        scene.graph.update(frame_from="AS1_PE_ASM", frame_to=parent)
+        scene.add_geometry(
+            mesh.copy().apply_scale(0.001),
+            node_name=node,
+            geom_name=f"SOLID_{k}",
+            parent_node_name=parent,
+        )
+    path = tmp_path / "brackets.glb"
+    scene.export(path)
+    parts = read_scene(path)
+    assert parts.ids == ("l_bracket_1", "l_bracket_2", "plate")
+    assert parts.names == ("L-BRACKET", "L-BRACKET", "PLATE")
+
+
+def _scaled_step(source: Path, target: Path, factor: float) -> Path:
+    """``source`` with every coordinate and length (points, vector magnitudes) times
+    ``factor``, its units unchanged."""
+    import re
+
+    def points(match: re.Match) -> str:
+        values = ",".join(f"{float(v) * factor:.9g}" for v in match.group(2).split(","))
+        return f"{match.group(1)}({values})"
+
+    text = source.read_text()
+    text = re.sub(r"(CARTESIAN_POINT\('[^']*',)\(([^)]*)\)", points, text)
+    text = re.sub(
+        r"(VECTOR\('[^']*',#\d+,)([-\d.Ee+]+)\)",
+        lambda m: f"{m.group(1)}{float(m.group(2)) * factor:.9g})",
+        text,
+    )
+    target.write_text(text)
+    return target
+
+
+def test_millimetre_numbers_under_an_inch_label_are_read_as_millimetres(tmp_path):
+    """A Pro/E-style STEP: the unit says INCH, the numbers are millimetres (a 400 x 400 mm
+    plate that, read in inches, would be 10 m wide)."""
+    pytest.importorskip("cascadio")
+    from cad.scene import step_length_unit
+
+    path = _scaled_step(DATA / "table_frame_in.step", tmp_path / "frame_mm_as_in.step", 100.0)
+    assert step_length_unit(path) == "in"
+    with pytest.warns(UserWarning, match=r"declares inches, but read so it is .* m across"):
+        assembly = load_assembly(path)
+    assert np.allclose(assembly.parts[0].mesh.extents, [400, 400, 50], atol=1e-2)
+    # a true inch file stays in inches (4 in = 101.6 mm)
+    assert step_length_unit(DATA / "table_frame_in.step") == "in"
+    assert step_length_unit(DATA / "two_boxes.step") == "mm"
+
+
+def test_a_gltf_with_millimetre_numbers_is_read_in_millimetres(tmp_path):
+    """glTF is metres; a converter that keeps a CAD model's millimetre numbers writes an
+    engine hundreds of metres across (Khronos' 2CylinderEngine: 743 m)."""
+    scene = trimesh.Scene()
+    scene.add_geometry(shapes.box_between((0, 0, 0), (400, 300, 20)), node_name="Block")
+    scene.add_geometry(shapes.box_between((0, 0, 20), (40, 40, 60)), node_name="Cap")
+    path = tmp_path / "engine.glb"
+    scene.export(path)
+    expected = r"declares metres \(glTF\), but read so it is 504 m across"
+    with pytest.warns(UserWarning, match=expected):
+        assembly = load_assembly(path)
+    assert np.allclose(assembly.parts[0].mesh.extents, [400, 300, 20], atol=1e-3)

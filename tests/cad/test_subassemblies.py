@@ -227,8 +227,12 @@ def test_gusseted_box_plans_with_defaults(gusset_box):
 
 def write_glb(path, parts: dict, tree: dict) -> None:
     """A glTF in metres of ``parts`` (mm) under the product node ``Product``; ``tree`` maps
-    a group node to its children (parts or groups), nested as a CAD product tree."""
+    a group node to its children (parts or groups), nested as a CAD product tree. Y-up,
+    as glTF's specification has it (+z of the parts becomes +y)."""
+    import numpy as np
     import trimesh
+
+    y_up = trimesh.transformations.rotation_matrix(-np.pi / 2, (1, 0, 0))
 
     scene = trimesh.Scene()
     scene.graph.update(frame_from="world", frame_to="Product")
@@ -240,7 +244,7 @@ def write_glb(path, parts: dict, tree: dict) -> None:
                 add(child, name)
         else:
             scene.add_geometry(
-                parts[name].copy().apply_scale(0.001),
+                parts[name].copy().apply_transform(y_up).apply_scale(0.001),
                 node_name=name,
                 geom_name=f"mesh_{name}",
                 parent_node_name=parent,

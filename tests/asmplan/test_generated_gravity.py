@@ -1,0 +1,146 @@
+"""A generated spec's gravity: the file's own down unless another is clearly better.
+
+A Pro/E (Creo) or SolidWorks STEP export is often Y-up: with gravity ``-z`` the bracket of
+a bolted joint needs a bolt beside it to "rest" on and the bolts need the bracket, so no
+order exists. The generated spec chooses ``-y`` there (:mod:`asp.gravity`), says so on
+stderr and in ``asmplan init``'s comment, and plans; Z-up files keep ``-z``, glTF keeps
+its ``-y`` unless its content is Z-up; a user's spec is never changed. Geometry built here.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import trimesh
+import yaml
+from typer.testing import CliRunner
+
+import cad
+from asmplan import pipeline
+from asmplan.cli import app
+from asp.checker import check_line, plan_operations
+from asp.generate import gravity_choice
+from asp.gravity import base_index, one_sequence
+from cad.assembly import prepare_part
+from tests.cad.real_shapes import bolted_bracket, box
+
+Y_UP = trimesh.transformations.rotation_matrix(-np.pi / 2, (1, 0, 0))
+"""Turns a Z-up model Y-up (+z -> +y), as a Y-up exporter writes it."""
+
+
+def bracket(turn: np.ndarray) -> cad.Assembly:
+    parts = tuple(
+        prepare_part(k, m.copy().apply_transform(turn), scale=1.0, source=k)
+        for k, m in bolted_bracket(0.5).items()
+    )
+    return cad.Assembly(parts=parts, units="mm", source="built")
+
+
+@pytest.fixture(scope="module")
+def brackets():
+    out = {}
+    for name, turn in (("z-up", np.eye(4)), ("y-up", Y_UP)):
+        assembly = bracket(turn)
+        out[name] = (assembly, cad.compute_relations(assembly))
+    return out
+
+
+@pytest.mark.parametrize(
+    ("model", "default", "chosen"),
+    [("z-up", "-z", "-z"), ("y-up", "-z", "-y"), ("y-up", "-y", "-y"), ("z-up", "-y", "-z")],
+)
+def test_the_bolted_bracket_gets_its_true_gravity(brackets, model, default, chosen):
+    assembly, relations = brackets[model]
+    choice = gravity_choice(relations, assembly, default)
+    assert choice.gravity == chosen
+    assert choice.feasible[chosen] is True
+    wrong = "-z" if chosen == "-y" else "-y"
+    assert choice.feasible[wrong] is False  # sideways gravity: the bracket needs a bolt
+    assert ("not the default" in choice.reason) == (chosen != default)
+
+
+def test_fewer_held_parts_alone_never_turn_gravity_sideways():
+    """Pins in through holes are "supported" by the hole walls under a sideways gravity;
+    a Z-up plate with loose pins keeps -z (the pins held), though +-x holds none."""
+    from tests.cad.real_shapes import cylinder, difference
+
+    xs = (-20.0, 0.0, 20.0)
+    plate = difference(
+        box((-30, -10, 0), (30, 10, 5)), *(cylinder(3.1, -1, 6, 32, (x, 0)) for x in xs)
+    )
+    parts = [prepare_part("plate", plate, scale=1.0, source="plate")]
+    parts += [
+        prepare_part(f"pin_{k}", cylinder(3.0, -5, 15, 24, (x, 0)), scale=1.0, source="pin")
+        for k, x in enumerate(xs)
+    ]
+    assembly = cad.Assembly(parts=tuple(parts), units="mm", source="built")
+    choice = gravity_choice(cad.compute_relations(assembly), assembly, "-z")
+    assert choice.held["-z"] == 3 and choice.held["+x"] == 0
+    assert choice.gravity == "-z"
+
+
+def test_large_parts_held_along_the_default_turn_a_gltf_z_up():
+    """Three stacked plates: along a glTF's -y every plate would need holding."""
+    plates = [box((0, 0, 10 * k), (60, 40, 10 * k + 10)) for k in range(3)]
+    assembly = cad.Assembly(
+        parts=tuple(prepare_part(f"p{k}", m, scale=1.0, source="b") for k, m in enumerate(plates)),
+        units="mm",
+        source="built",
+    )
+    choice = gravity_choice(cad.compute_relations(assembly), assembly, "-y")
+    assert choice.held_large["-y"] == 2 and choice.gravity == "-z"
+
+
+def test_base_part_and_search_follow_gravity(brackets):
+    assembly, relations = brackets["y-up"]
+    bounds = np.array([p.bounds for p in assembly.parts])
+    base = base_index(bounds, "-y")
+    assert assembly.parts[base].id == "base"
+    assert one_sequence(relations, "-y", base, set()) is True
+    assert one_sequence(relations, "-z", base_index(bounds, "-z"), set()) is False
+
+
+def write_folder(folder: Path, turn: np.ndarray) -> Path:
+    folder.mkdir()
+    for name, mesh in bolted_bracket(0.5).items():
+        mesh.copy().apply_transform(turn).export(folder / f"{name}.stl")
+    return folder
+
+
+def test_a_y_up_export_plans_with_gravity_minus_y(tmp_path):
+    source = write_folder(tmp_path / "yup", Y_UP)
+    notes: list[str] = []
+    assembly = pipeline.load(source, on_step=notes.append)
+    spec = assembly.spec
+    assert spec.gravity == "-y" and spec.base_part == "base"
+    assert any(n.startswith("generated spec: gravity -y: not the default -z") for n in notes)
+    assert spec.operations[0].parts == ("base",)
+
+    result = CliRunner().invoke(app, ["plan", str(source), "-o", str(tmp_path / "out")])
+    assert result.exit_code == 0, result.output
+    assert "gravity -y" in result.stderr
+    doc = json.loads((tmp_path / "out" / "plan.json").read_text())
+    check_line(spec, assembly.relations, plan_operations(doc), units=doc["subassemblies"])
+
+    out = tmp_path / "spec" / "assembly.yaml"
+    result = CliRunner().invoke(app, ["init", str(source), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    assert "gravity -y: not the default -z" in result.stderr
+    text = out.read_text()
+    assert "gravity: -y" in text and "likely Y up (asp/gravity.py)" in text
+    assert yaml.safe_load(text)["gravity"] == "-y"
+
+
+def test_a_users_gravity_is_never_changed(tmp_path):
+    source = write_folder(tmp_path / "yup", Y_UP)
+    out = source / "assembly.yaml"
+    result = CliRunner().invoke(app, ["init", str(source), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    out.write_text(out.read_text().replace("gravity: -y", "gravity: -z", 1))
+    notes: list[str] = []
+    spec = pipeline.load(source, on_step=notes.append).spec
+    assert not spec.generated and spec.gravity == "-z"
+    assert not any("gravity" in n for n in notes)
