@@ -158,7 +158,9 @@ def one_sequence(relations, gravity: str, base: int, held: set[int]) -> bool | N
     sp = np.asarray(relations.sp if relations.sp is not None else relations.tc, dtype=bool)
 
     def masks(table: np.ndarray) -> list[int]:
-        return [sum(1 << j for j in np.flatnonzero(row) if j != i) for i, row in enumerate(table)]
+        # Python ints (not numpy's int64): the masks of 64 parts and more must not overflow.
+        rows = [np.flatnonzero(row).tolist() for row in table]
+        return [sum(1 << j for j in js if j != i) for i, js in enumerate(rows)]
 
     support = masks(sp[:, :, g])
     contact = [c | s for c, s in zip(masks(tc.any(axis=2)), support, strict=True)]
@@ -177,7 +179,7 @@ def one_sequence(relations, gravity: str, base: int, held: set[int]) -> bool | N
         """Some part left out is blocked along every direction: blocking only grows."""
         return any(not s >> p & 1 and all(s & blocked[d][p] for d in range(6)) for p in range(n))
 
-    stack = [1 << base]
+    stack = [1 << int(base)]
     while stack:
         s = stack.pop()
         if s == full:

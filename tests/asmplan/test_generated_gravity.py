@@ -144,3 +144,21 @@ def test_a_users_gravity_is_never_changed(tmp_path):
     spec = pipeline.load(source, on_step=notes.append).spec
     assert not spec.generated and spec.gravity == "-z"
     assert not any("gravity" in n for n in notes)
+
+
+def test_one_sequence_past_64_parts():
+    """Bit masks of 70 parts (the cycloidal drive has 72): no int64 overflow."""
+    from types import SimpleNamespace
+
+    from cad.directions import DIRECTIONS
+
+    n = 70
+    down, up = DIRECTIONS.index("-z"), DIRECTIONS.index("+z")
+    tc = np.zeros((n, n, 6), dtype=bool)
+    tt = np.ones((n, n, 6), dtype=bool)
+    for i in range(1, n):  # part i stands on part i - 1
+        tc[i, i - 1, down] = tc[i - 1, i, up] = True
+        tt[i, i - 1, down] = tt[i - 1, i, up] = False
+    relations = SimpleNamespace(parts=[f"p{i}" for i in range(n)], tc=tc, tt=tt, sp=tc)
+    assert one_sequence(relations, "-z", np.int64(0), set()) is True
+    assert one_sequence(relations, "-z", np.int64(n - 1), set()) is False
