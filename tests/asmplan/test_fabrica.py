@@ -7,14 +7,9 @@ cooperative line against the relations the plan was made from.
 
 from __future__ import annotations
 
-import json
-
 import pytest
-from typer.testing import CliRunner
 
-from asmplan import pipeline
-from asmplan.cli import app
-from asp.checker import check_line, plan_operations
+from tests.asmplan.checked import plan_and_check
 
 DUCT_REASON = (
     "the duct's six pins lie 30 degrees off the z axis (axis (0.5, 0, 0.866)): no axis "
@@ -36,10 +31,4 @@ def test_fabrica_assembly_plans_and_the_checker_accepts(tmp_path, shared_data, n
     source = shared_data / "cad" / "fabrica" / name
     if not source.is_dir():
         pytest.skip(f"{source} not found")
-    result = CliRunner().invoke(app, ["plan", str(source), "-o", str(tmp_path)])
-    assert result.exit_code == 0, result.output
-    doc = json.loads((tmp_path / "plan.json").read_text())
-    ops = plan_operations(doc)
-    assembly = pipeline.load(source, on_step=lambda _: None)
-    assert sorted(ops) == sorted(assembly.spec.op_ids)
-    check_line(assembly.spec, assembly.relations, ops, units=doc["subassemblies"])
+    plan_and_check(source, tmp_path)

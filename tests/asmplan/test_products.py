@@ -6,16 +6,12 @@ into a plan the independent checker accepts."""
 from __future__ import annotations
 
 import functools
-import json
 
 import numpy as np
 import pytest
-from typer.testing import CliRunner
 
-from asmplan import pipeline
-from asmplan.cli import app
-from asp.checker import check_line, plan_operations
 from cad import DIRECTIONS, Assembly, compute_relations
+from tests.asmplan.checked import plan_and_check
 from tests.cad import products
 from tests.cad.test_loading import write_folder, write_scene
 
@@ -111,11 +107,4 @@ def test_product_plans_with_defaults_and_the_checker_accepts(tmp_path, name, kin
         source = write_folder(tmp_path / name, assembly)
     else:
         source = write_scene(tmp_path / f"{name}.glb", assembly, scale=0.001)
-    out = tmp_path / "out"
-    result = CliRunner().invoke(app, ["plan", str(source), "-o", str(out), "--time-limit", "5"])
-    assert result.exit_code == 0, result.output
-    doc = json.loads((out / "plan.json").read_text())
-    ops = plan_operations(doc)
-    loaded = pipeline.load(source, on_step=lambda _: None)
-    assert sorted(ops) == sorted(loaded.spec.op_ids)
-    check_line(loaded.spec, loaded.relations, ops, units=doc["subassemblies"])
+    plan_and_check(source, tmp_path / "out", "--time-limit", "5")
