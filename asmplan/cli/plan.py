@@ -12,20 +12,18 @@ from pathlib import Path
 
 import typer
 
-from asmplan.cli.app import app, choices
+from asmplan.cli.app import app
 from asmplan.cli.graph import say
 from asmplan.cli.options import (
     CostModel,
+    TurnModel,
     check_output,
-    contact_tol_option,
     finite_or_none,
-    penetration_tol_option,
     seed_option,
     time_limit_option,
+    tolerance_option,
+    turn_model_option,
 )
-from asp.spec import TURN_MODELS
-
-TurnModel = choices("TurnModel", TURN_MODELS, "Turn model of the game.")
 
 
 def plan_summary(result) -> list[str]:
@@ -111,8 +109,8 @@ def plan_command(
     cost: CostModel | None = typer.Option(None, "--cost", help="Cost model (default: spec's)."),
     time_limit: float = time_limit_option(30.0),
     seed: int = seed_option("CP-SAT random seed."),
-    turn_model: TurnModel | None = typer.Option(
-        None, "--turn-model", help="alternate (the paper's turns) or concurrent (default: spec's)."
+    turn_model: TurnModel | None = turn_model_option(
+        "alternate (the paper's turns) or concurrent (default: spec's)."
     ),
     max_k: int | None = typer.Option(
         None,
@@ -132,8 +130,8 @@ def plan_command(
     max_states: int | None = typer.Option(
         None, "--max-states", min=1, help="State graph limit (default: spec's, else 20,000,000)."
     ),
-    contact_tol: float | None = contact_tol_option(),
-    penetration_tol: float | None = penetration_tol_option(),
+    contact_tol: float | None = tolerance_option("contact_tol"),
+    penetration_tol: float | None = tolerance_option("penetration_tol"),
 ) -> None:
     """Plan an assembly end to end: relations, state graph, game, robust plan, CP-SAT."""
     from asmplan import pipeline
