@@ -39,7 +39,7 @@ def plan_summary(result) -> list[str]:
     if result.relations_summary:
         lines.append("part relations (contacts with directions; free directions in the assembly):")
         lines.append(relations_summary_text(result.relations_summary))
-    lines += units_text(result.units)
+    lines += units_text(result.units, graph.spec)
     lines.append(
         f"state graph: {graph.n_states:,} states, {graph.n_transitions:,} transitions, "
         f"{result.sequences:,} feasible sequences"
@@ -83,15 +83,22 @@ def plan_summary(result) -> list[str]:
     return lines
 
 
-def units_text(units: list[dict]) -> list[str]:
+def units_text(units: list[dict], spec=None) -> list[str]:
     """The subassemblies of a plan (``plan.json``'s ``units``): used ones with their parts
-    and where they come from, the CAD file's unused ones with the reason."""
+    and where they come from (and, for one built upside down, its workspace's gravity:
+    ``spec.unit_gravity``), the CAD file's unused ones with the reason."""
     if not units:
         return []
     source = {"spec": "the spec", "cad": "the CAD file", "automatic": "found automatically"}
+    turned = dict(spec.unit_gravity) if spec is not None else {}
     lines = ["subassemblies (each built on its own, then inserted as one unit):"]
     for u in units:
         head = f"  {u['id']} [{', '.join(u['parts'])}] from {source[u['source']]}"
+        if u["used"] and u["id"] in turned:
+            head += (
+                f"; built upside down (gravity {turned[u['id']]} in its workspace), then turned "
+                f"over and inserted"
+            )
         lines.append(head + ("" if u["used"] else f": not used, {u['reason']}"))
     return lines
 

@@ -18,7 +18,8 @@ tests each insertion with python-fcl. The rules (``geometry``):
   jumped over), never collides with the parts already in its workspace, both eroded;
 - **touching**: the gap to those parts is at most the pair's contact tolerance
   (``min(contact_reach[i], contact_reach[j])``, else ``contact_tol``), or they overlap;
-- **supported** (unless ``held``): moved along ``gravity`` by ``support_travel_factor``
+- **supported** (unless ``held``): moved along ``gravity`` (the workspace's own, for a
+  unit built in another orientation) by ``support_travel_factor``
   times the pair's tolerance, the eroded body collides with them (it rests on something),
   or it is fitted: the same move in each of the four directions across gravity collides (a
   bearing pressed in a holder, a nut on its bolt). The fit rule is more lenient than the
@@ -138,6 +139,8 @@ class Replay:
         self.reach = geo.get("contact_reach")
         self.factor = float(geo.get("support_travel_factor", SUPPORT_FACTOR))
         self.gravity = vector(plan["gravity"])
+        # a unit built in another orientation (upside down) has its own gravity
+        self.down = {w["id"]: vector(w.get("gravity", plan["gravity"])) for w in plan["workspaces"]}
         self.extra = {(f["inner"], f["outer"]): f["extra_shrink"] for f in geo.get("fits", [])}
         self.plain = {p: Solid(m) for p, m in self.meshes.items()}
         self.solid = {p: Solid(eroded(m, self.shrink[p])) for p, m in self.meshes.items()}
@@ -219,10 +222,11 @@ class Replay:
             raise Rejected(f"{where}: {body} touches none of {there} ({p}-{j} gap {gap:.3f} mm)")
         if ins["held"]:
             return "held"
-        if self.falls_into(body, there, self.gravity):
+        down = self.down.get(ins["workspace"], self.gravity)
+        if self.falls_into(body, there, down):
             return "rests"
         across = [vector(s + a) for a in "xyz" for s in "+-"]
-        if all(self.falls_into(body, there, v) for v in across if abs(v @ self.gravity) < 0.5):
+        if all(self.falls_into(body, there, v) for v in across if abs(v @ down) < 0.5):
             return "fitted"  # a bearing pressed in its holder, a nut on its bolt
         raise Rejected(f"{where}: {body} is not supported (it would fall along gravity)")
 
