@@ -753,7 +753,10 @@ def workspace_records(spec, operations: dict, principal: list[dict]) -> list[dic
     Each: ``id``, ``parts`` (its parts, in the order the principal line places them; main:
     its ``initial`` parts first, then every part placed into it, a unit's members at its
     insertion), ``operations`` (in principal-line order), ``inserted_by`` and ``into``
-    (a unit: the operation inserting it, into ``MAIN``; main: null).
+    (a unit: the operation inserting it, into ``MAIN``; main: null), and ``gravity``: the
+    direction a part falls along in that workspace, in the product's frame (main: the
+    spec's; a unit built upside down: the opposite, :mod:`asp.orientation`), the direction
+    its support is tested along.
     """
     placed = {p for info in operations.values() for p in info["parts"]}
     initial = [p.id for p in spec.parts if p.id not in placed]
@@ -779,6 +782,7 @@ def workspace_records(spec, operations: dict, principal: list[dict]) -> list[dic
                 "initial": rec.get("initial", []),
                 "inserted_by": inserted_by.get(sid) if unit else None,
                 "into": MAIN if unit else None,
+                "gravity": spec.build_gravity(sid if unit else ""),
             }
         )
     return out
