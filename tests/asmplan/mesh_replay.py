@@ -5,7 +5,8 @@ plan file (README, "The plan file": ``workspaces``, each step's ``insertions``,
 ``gravity``, ``geometry``, ``parts[].source``), loads the meshes it names with trimesh and
 tests each insertion with python-fcl. The rules (``geometry``):
 
-- **meshes**: each part's mesh from ``parts[].source``, times ``scale`` (mm), its
+- **meshes**: each part's mesh from ``parts[].source``, times its ``scale`` (else
+  ``geometry.scale``: mm per coordinate as trimesh reads the file), its
   coincident vertices merged when ``merge_vertices`` (a STEP or 3DXML tessellation gives
   every face its own vertices; an unmerged mesh cannot be eroded: every vertex would move
   along its own face only, leaving the edges in place);
@@ -72,7 +73,7 @@ def load_meshes(plan: dict) -> dict[str, trimesh.Trimesh]:
                 scenes[path] = trimesh.load(path, force="scene")
             transform, geometry = scenes[path].graph[src["node"]]
             mesh = scenes[path].geometry[geometry].copy().apply_transform(transform)
-        mesh = mesh.apply_scale(geo["scale"])
+        mesh = mesh.apply_scale(src.get("scale") or geo["scale"])
         if geo.get("merge_vertices", False):
             mesh.merge_vertices()
         out[part["id"]] = mesh
