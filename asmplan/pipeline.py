@@ -428,6 +428,7 @@ def state_graph(
     asp.state_graph.StateGraph
     """
     from asp.errors import SpecError
+    from asp.orientation import orient_units
     from asp.symmetry import reduce_exact, reduced_state_graph
     from asp.units import (
         build_with_units,
@@ -442,6 +443,8 @@ def state_graph(
     say = on_step or (lambda _line: None)
     given_up = refuted_units(spec, rel, on_unit=say) if spec.generated else set()
     first, choices = with_cad_units(spec, rel, given_up) if spec.generated else (spec, ())
+    turned: list[str] = []  # said with the file's units, once the graph uses them
+    first = orient_units(first, rel, turned.append)  # as build_with_units prepares units
     try:
         graph = reduced_state_graph(
             built_in_turn(hold_unsupported_units(first, rel)),
@@ -450,8 +453,8 @@ def state_graph(
             max_states=max_states,
         )
         if graph is not None:
-            for unit in choices:
-                say(hierarchy_line(unit))
+            for line in [*map(hierarchy_line, choices), *turned]:
+                say(line)
             return graph
     except SpecError as exc:
         if "infeasible assembly" not in str(exc):
