@@ -23,9 +23,15 @@ from asmplan.cli.options import (
     seed_option,
     time_limit_option,
 )
+from asp.concurrent import AUTO_PATIENCE, AUTO_TIME_LIMIT
 from asp.spec import TURN_MODELS
 
 TurnModel = choices("TurnModel", TURN_MODELS, "Turn model of the game.")
+AUTO_TIME_LIMIT_HELP = (
+    "Seconds for CP-SAT's minimum-makespan search. Default: automatic, the whole schedule "
+    f"stage within {AUTO_TIME_LIMIT:g} s, stopping once the best schedule has not improved for "
+    f"{AUTO_PATIENCE:g} s or is proven optimal; give a number to let CP-SAT search that long."
+)
 
 
 def plan_summary(result) -> list[str]:
@@ -109,7 +115,7 @@ def plan_command(
         None, "--output", "-o", help="Folder for plan.json, dag.png (and manifest.json)."
     ),
     cost: CostModel | None = typer.Option(None, "--cost", help="Cost model (default: spec's)."),
-    time_limit: float = time_limit_option(30.0),
+    time_limit: float | None = time_limit_option(None, AUTO_TIME_LIMIT_HELP),
     seed: int = seed_option("CP-SAT random seed."),
     turn_model: TurnModel | None = typer.Option(
         None, "--turn-model", help="alternate (the paper's turns) or concurrent (default: spec's)."
