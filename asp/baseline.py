@@ -604,10 +604,12 @@ class _ReplayLoop:
             if left <= 0:
                 break
             if self.solves and self.best is not None:
-                # After a cut: only a shorter schedule is of use now. (The first solve is
-                # plain CP-SAT, so a job it solves outright gets the optimum it always got.)
+                # After a cut: only a shorter schedule is of use now, and the best one so
+                # far is CP-SAT's hint. (The first solve is plain CP-SAT, so a job it solves
+                # outright gets the optimum it always got: which of several optima it
+                # returns decides how that schedule fares against a deviating person.)
                 self.model.add(self.makespan <= self.best[0] - 1)
-            self.hint()  # the best schedule so far (e.g. the list schedule) is the hint
+                self.hint()
 
             class Replayed(cp_model.CpSolverSolutionCallback):
                 def __init__(self):
