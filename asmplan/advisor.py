@@ -38,6 +38,12 @@ from asmplan.planfile import check_plan
 EVENT_KINDS = ("started", "finished")
 
 
+def placed_parts(operations: dict[str, dict], done: list[str]) -> list[str]:
+    """The parts the operations ``done`` have placed, each once, in the order placed (a
+    unit's members are placed in its workspace, then inserted with it)."""
+    return list(dict.fromkeys(p for op in done for p in operations.get(op, {}).get("parts", [])))
+
+
 class ObservationError(GameError):
     """An observation the plan cannot explain; the advisor's state is unchanged."""
 
@@ -254,7 +260,7 @@ class Advisor:
             state=i,
             turn=states["turn"][i],
             done=done,
-            parts=[p for op in done for p in self._operations.get(op, {}).get("parts", [])],
+            parts=placed_parts(self._operations, done),
             tools=tools,
             running=running,
             robots=robots,
@@ -486,7 +492,7 @@ class ConcurrentAdvisor(Advisor):
             state=i,
             turn="end" if self.finished else "human",
             done=done,
-            parts=[p for op in done for p in self._operations.get(op, {}).get("parts", [])],
+            parts=placed_parts(self._operations, done),
             tools=self._tools(i),
             running=running,
             robots=[

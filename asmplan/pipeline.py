@@ -269,16 +269,13 @@ def load(
     """:func:`load_assembly` and, when the spec has meshes, its :func:`relations`.
 
     A generated spec (no ``assembly.yaml``) is announced through ``on_step``, else as a
-    warning; its gravity is chosen from the relations (:mod:`asp.gravity`: the format's
-    own down unless another direction is clearly better), said in a note; its placements
-    of parts nothing can keep from falling become ``held``
-    (:func:`asp.generate.hold_unsupported`) and, when no complete sequence can start
-    from its base part, another base is taken (:func:`asp.generate.workable_base`), each
-    named in a note. ``contact_tol`` and
+    warning; the decisions that need its relations (:func:`asp.generate.decide_generated`:
+    gravity, base part, ``held`` placements of parts nothing can keep from falling) are
+    each said in a note. ``contact_tol`` and
     ``penetration_tol`` (mm) replace the spec's tolerances when given.
     """
     from asp.feasibility import load_relations
-    from asp.generate import HELD_REASON, orient_generated, spec_geometry, workable_base
+    from asp.generate import decide_generated, spec_geometry
 
     spec = with_tolerances(load_assembly(source), contact_tol, penetration_tol)
 
@@ -302,15 +299,10 @@ def load(
             on_step(f"computing part relations of {len(spec.parts)} parts ...")
         geometry = spec_geometry(spec)
         rel = load_relations(spec, progress=progress, geometry=geometry)
-        spec, choice = orient_generated(spec, rel, geometry)
-        if choice is not None:
-            note(f"generated spec: gravity {choice.gravity}: {choice.reason}")
-        spec, rebased = workable_base(spec, rel)
-        if rebased:
-            note(rebased)
-        held = tuple(p for op in spec.operations if op.held for p in op.parts)
-        if held and spec.generated:
-            note(f"generated spec: held: true for {', '.join(held)} ({HELD_REASON})")
+        decided = decide_generated(spec, rel, geometry)
+        spec = decided.spec
+        for line in decided.notes():
+            note(line)
     return Assembly(spec=spec, relations=rel)
 
 

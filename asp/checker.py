@@ -20,7 +20,10 @@ insertion operation has ``unit`` set, or ``units={op id: parts}``) is checked as
 free along ``d`` iff each member is free from each part of ``S``, touching iff some member
 touches, supported iff some member is supported. The operations placing a spec unit's
 members are checked against the members already in the unit's own workspace (the first
-stands on the fixture), not against the main assembly.
+stands on the fixture), not against the main assembly. A unit built in another orientation
+than it has in the product (``spec.unit_gravity``, or ``gravity={unit id: direction}``: a
+die set's upper half built upside down, then turned over and inserted) has its members
+tested for support along its own gravity there; its insertion is tested along the spec's.
 """
 
 from __future__ import annotations
@@ -48,7 +51,12 @@ class CheckedStep:
 
 
 def check_line(
-    spec, relations, operations: Iterable[str], *, units: Mapping[str, Iterable[str]] = ()
+    spec,
+    relations,
+    operations: Iterable[str],
+    *,
+    units: Mapping[str, Iterable[str]] = (),
+    gravity: Mapping[str, str] = (),
 ) -> list[CheckedStep]:
     """Replay ``operations`` (ids, in order) and verify every insertion.
 
@@ -62,6 +70,9 @@ def check_line(
         A complete line (every operation once).
     units : mapping, optional
         Operation id -> parts it inserts as one rigid unit.
+    gravity : mapping, optional
+        Unit id -> the gravity in its workspace (product frame; default: the spec's
+        ``unit_gravity``, else ``spec.gravity``), as ``plan.json``'s ``workspaces`` give it.
 
     Returns
     -------
@@ -76,6 +87,7 @@ def check_line(
     members = dict(spec.subassemblies)
     units.update({op.id: members[op.unit] for op in spec.operations if op.unit})
     owner = {m: u for u, ms in members.items() for m in ms}
+    down = {**dict(getattr(spec, "unit_gravity", ())), **dict(gravity)}
     workspaces: dict[str, list[str]] = {u: [] for u in members}
     ids = [str(o) for o in operations]
     c = spec.constraints
@@ -100,7 +112,8 @@ def check_line(
             there = workspaces[unit] if unit else assembled
             direction = ""
             if relations is not None:
-                direction = _check_body(spec, relations, body, there, op.held, where, unit)
+                g = down.get(unit, spec.gravity) if unit else spec.gravity
+                direction = _check_body(spec, relations, body, there, op.held, where, unit, g)
             out.append(CheckedStep(op_id, body, direction))
             there.extend(body)
         done.add(op_id)
@@ -110,7 +123,7 @@ def check_line(
     return out
 
 
-def _check_body(spec, relations, body, assembled, held, where, unit="") -> str:
+def _check_body(spec, relations, body, assembled, held, where, unit="", gravity="") -> str:
     """The direction a body leaves along, after checking it may go into ``assembled``."""
     rel_ids = [str(p) for p in relations.parts]
     idx = {p: k for k, p in enumerate(rel_ids)}
@@ -125,7 +138,7 @@ def _check_body(spec, relations, body, assembled, held, where, unit="") -> str:
     tt = np.asarray(relations.tt, dtype=bool)
     sp = getattr(relations, "sp", None)
     sp = tc if sp is None else np.asarray(sp, dtype=bool)
-    g = DIRECTIONS.index(spec.gravity)
+    g = DIRECTIONS.index(gravity or spec.gravity)
     members = [idx[p] for p in body]
     others = [idx[j] for j in assembled]
     touch = rest = False
@@ -144,7 +157,8 @@ def _check_body(spec, relations, body, assembled, held, where, unit="") -> str:
     if not touch:
         raise PlanCheckError(f"{where}: {names} touches none of {', '.join(assembled)}")
     if c.stability and not held and not rest:
-        raise PlanCheckError(f"{where}: {names} is not supported (it would fall)")
+        fall = "" if g == DIRECTIONS.index(spec.gravity) else f" along {DIRECTIONS[g]}"
+        raise PlanCheckError(f"{where}: {names} is not supported (it would fall{fall})")
     return DIRECTIONS[ways[0]]
 
 

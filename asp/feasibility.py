@@ -14,8 +14,10 @@ and the enabled optimisation constraints hold (switches in the spec):
 - topological: the base part is placed first (every other part needs it in ``S``), and
   the explicit ``after`` predecessors are done;
 - stability (support): ``p`` cannot fall, ``SP_g(p, j)`` for some ``j`` in ``S`` with ``g`` the
-  gravity direction: a short move along ``g`` would drive it into ``j``, or it is threaded on
-  ``j`` (:mod:`cad.support`; skipped for operations marked ``held``: an agent holds the part).
+  gravity direction (in a unit's workspace, the unit's build gravity ``spec.unit_gravity``,
+  e.g. ``+z`` for a die set's upper half built upside down): a short move along ``g`` would
+  drive it into ``j``, or it is threaded on ``j`` (:mod:`cad.support`; skipped for
+  operations marked ``held``: an agent holds the part).
   Relations without a support table (built by hand) fall back to contact along gravity,
   ``TC_g(p, j)``;
 - functional: the free direction must be one the gripper approaches from
@@ -277,6 +279,16 @@ def insertion_oracle(spec: AssemblySpec, relations=None) -> InsertionOracle:
         for table in (contact, support, blocked):
             table[u] = table[idx].any(axis=0)
             table[u, ..., idx] = False
+    if geometric and spec.unit_gravity:
+        # a unit built in another orientation: its members rest along its own gravity
+        # (their rows serve its workspace only; the unit's row above keeps the product's)
+        for uid, down in spec.unit_gravity:
+            idx = [parts.index(m) for m in dict(spec.subassemblies)[uid] if m in where]
+            rows = np.array([where[parts[k]] for k in idx], dtype=np.int64)
+            turned = sp[np.ix_(rows, r)][:, :, DIRECTIONS.index(down)]
+            support[np.ix_(idx, known)] = turned
+            contact[np.ix_(idx, known)] = tc[np.ix_(rows, r)].any(axis=2) | turned
+            support[idx, idx] = contact[idx, idx] = False
     base = parts.index(spec.base_part) if spec.base_part in parts else -1
     return InsertionOracle(
         parts=parts,

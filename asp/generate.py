@@ -40,7 +40,7 @@ from __future__ import annotations
 import math
 import os
 from collections import Counter
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -349,13 +349,59 @@ def orient_generated(spec: AssemblySpec, relations, geometry):
     choice = gravity_choice(relations, geometry, spec.gravity)
     if choice.gravity == spec.gravity:
         return spec, choice
-    from dataclasses import replace
-
     with warnings.catch_warnings():  # the same files again: their warnings were given
         warnings.simplefilter("ignore")
         turned = generated_spec(spec.source, gravity=choice.gravity)
     tolerances = {"contact_tol": spec.contact_tol, "penetration_tol": spec.penetration_tol}
     return replace(turned, **tolerances), choice
+
+
+@dataclass(frozen=True)
+class Decisions:
+    """What a generated spec decides once its part relations are known.
+
+    Attributes
+    ----------
+    spec : AssemblySpec
+        The spec along the chosen gravity, on a workable base, ``held`` applied.
+    gravity : asp.gravity.GravityChoice or None
+        The gravity choice and its reason (None: a user's spec, or no support table).
+    rebased : str
+        Why another base part was taken ("" when the lowest large part was kept).
+    """
+
+    spec: AssemblySpec
+    gravity: object | None
+    rebased: str
+
+    @property
+    def held(self) -> tuple[str, ...]:
+        """The parts whose placement is ``held`` (in operation order)."""
+        return tuple(p for op in self.spec.operations if op.held for p in op.parts)
+
+    def notes(self) -> list[str]:
+        """One line per decision, as a person reads them."""
+        out = []
+        if self.gravity is not None:
+            out.append(f"generated spec: gravity {self.gravity.gravity}: {self.gravity.reason}")
+        if self.rebased:
+            out.append(self.rebased)
+        if self.held and self.spec.generated:
+            out.append(f"generated spec: held: true for {', '.join(self.held)} ({HELD_REASON})")
+        return out
+
+
+def decide_generated(spec: AssemblySpec, relations, geometry) -> Decisions:
+    """The decisions of a generated spec that need its relations, in this order: gravity
+    (:func:`orient_generated`), then the base part and ``held`` (:func:`workable_base`).
+
+    ``asmplan plan`` (:func:`asmplan.pipeline.load`) and ``asmplan init``
+    (:func:`spec_text`) both take them here, so the file written plans as the file read.
+    A user's spec comes back unchanged.
+    """
+    oriented, choice = orient_generated(spec, relations, geometry)
+    decided, rebased = workable_base(oriented, relations)
+    return Decisions(decided, choice, rebased)
 
 
 def spec_text(
@@ -372,7 +418,8 @@ def spec_text(
     Part files are relative to ``spec_folder``, where the file will be written. Tolerances
     given (mm) are written as the spec's ``contact_tol`` / ``penetration_tol`` and used for
     the ``held`` marks; else both keys are written commented out. ``on_note`` (optional) is
-    called with a line saying which gravity was chosen and why. ``decide_units(spec,
+    called with a line for each decision of :func:`decide_generated` (gravity, base part,
+    ``held``). ``decide_units(spec,
     relations)`` (:func:`asp.units.cad_units`, given by the caller: it sits above this
     module) decides which of the file's sub-assemblies are written as ``subassemblies:``;
     without it they are all written commented.
@@ -386,20 +433,20 @@ def spec_text(
     relations = cad.compute_relations(
         assembly, contact_tol=contact_tol, penetration_tol=penetration_tol
     )
-    choice = gravity_choice(relations, assembly, data["gravity"])
-    if choice.gravity != data["gravity"]:
+    generated = replace(spec_from_dict(data, source=str(path)), generated=True)
+    decided = decide_generated(generated, relations, assembly)
+    spec = decided.spec
+    if spec.gravity != data["gravity"]:  # the records along the chosen gravity
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            data, assembly = spec_data(path, spec_folder, gravity=choice.gravity)
+            data, assembly = spec_data(path, spec_folder, gravity=spec.gravity)
     if on_note is not None:
-        on_note(f"gravity {choice.gravity}: {choice.reason}")
-    generated = replace(spec_from_dict(data, source=str(path)), generated=True)
-    spec, rebased = workable_base(generated, relations)
-    if rebased:
-        data["base_part"] = spec.base_part
-        first = [op for op in data["operations"] if op["part"] == spec.base_part]
-        data["operations"] = first + [op for op in data["operations"] if op not in first]
-    held = set(unsupported_parts(relations, data["gravity"], data["base_part"]))
+        for line in decided.notes():
+            on_note(line)
+    data["base_part"] = spec.base_part
+    first = [op for op in data["operations"] if op["part"] == spec.base_part]
+    data["operations"] = first + [op for op in data["operations"] if op not in first]
+    reason = decided.gravity.reason if decided.gravity is not None else "the format's own down"
     path = Path(path)
     lines = [
         f"# Assembly spec generated by `asmplan init` from {path.name}: edit it, then run",
@@ -438,11 +485,11 @@ def spec_text(
         f"base_part: {data['base_part']}      # placed first: "
         + (
             f"no complete sequence starts from {generated.base_part}, the lowest large part"
-            if rebased
+            if decided.rebased
             else "the lowest of the large parts"
         ),
         f"gravity: {data['gravity']}                # direction of gravity in the file's frame:",
-        f"#   {choice.reason} (asp/gravity.py)",
+        f"#   {reason} (asp/gravity.py)",
         "gripper_approach: [+x, -x, +y, -y, +z, -z]   # directions a part may be inserted from",
         "constraints: {topological: true, stability: true, functional: true}",
         "turn_model: alternate",
@@ -452,14 +499,13 @@ def spec_text(
         "",
         "operations:   # one placement per part: base first, then from the lowest part up",
     ]
-    for op in data["operations"]:
-        agents = ", ".join(f"{a}: {d}" for a, d in op["agents"].items())
-        hold = op["part"] in held
-        if hold:
+    for op in spec.operations:
+        agents = ", ".join(f"{a}: {json_number(d)}" for a, d in op.durations)
+        if op.held:
             lines.append(f"    # held: {HELD_REASON}")
         lines.append(
-            f"  - {{id: {_scalar(op['id'])}, description: {_scalar(op['description'])}, "
-            f"agents: {{{agents}}}, part: {op['part']}" + (", held: true}" if hold else "}")
+            f"  - {{id: {_scalar(op.id)}, description: {_scalar(op.description)}, "
+            f"agents: {{{agents}}}, part: {op.parts[0]}" + (", held: true}" if op.held else "}")
         )
     return "\n".join(lines) + "\n"
 

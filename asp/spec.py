@@ -25,6 +25,8 @@ An ``assembly.yaml`` names everything the planner needs besides the part geometr
                                        # --contact-tol / --penetration-tol override them)
     subassemblies:                     # built on their own, then inserted as one unit
       motor_unit: [MT, PC]             # an operation "motor_unit" inserting it is added
+      upper_die: {parts: [TP, PH], gravity: +z}   # built upside down: gravity +z in its
+                                       # workspace (default: the spec's), turned, inserted
     operations:
       - id: "1.2"                      # ids are strings (1.10 stays "1.10")
         description: Replace hex bit with cross bit on R1
@@ -197,6 +199,12 @@ class AssemblySpec:
     generated: bool = False
     subassemblies: tuple[tuple[str, tuple[str, ...]], ...] = ()
     """Units built in their own workspace and inserted whole: (unit id, member part ids)."""
+    unit_gravity: tuple[tuple[str, str], ...] = ()
+    """(unit id, direction): a unit built in another orientation than it has in the product
+    (a die set's upper half built upside down, then turned over and inserted). Its members
+    are tested for support along that direction (product frame) in its workspace; units
+    not listed are built as they sit in the product (``gravity``). See
+    :mod:`asp.orientation`."""
     contact_tol: float | None = None
     """Contact tolerance (mm) for every pair; None: the per-part rule of cad.tolerances."""
     penetration_tol: float | None = None
@@ -214,6 +222,10 @@ class AssemblySpec:
 
     def operation(self, op_id: str) -> Operation:
         return self.operations[self.op_index(op_id)]
+
+    def build_gravity(self, unit: str) -> str:
+        """The gravity in the workspace of ``unit`` (product frame; ``""``: main)."""
+        return dict(self.unit_gravity).get(unit, self.gravity) if unit else self.gravity
 
     def agent(self, name: str) -> Agent:
         for a in self.agents:
@@ -416,12 +428,20 @@ class _Parser:
         raw_units = self.mapping(data.get("subassemblies"), "subassemblies")
         if not raw_units:
             return spec
-        units = []
+        units, turned = [], []
         for uid, members in raw_units.items():
+            where = f"subassemblies.{uid}"
+            if isinstance(members, dict):
+                refuse_unknown_keys(members, ("parts", "gravity"), f"{self.source}: {where}")
+                if "gravity" in members:
+                    g = self.direction(members["gravity"], f"{where}.gravity")
+                    if g != spec.gravity:
+                        turned.append((str(uid), g))
+                members = members.get("parts")
             if not isinstance(members, list):
-                raise self.fail(f"subassemblies.{uid}", "expected a list of part ids")
-            units.append((str(uid), tuple(self.text(m, f"subassemblies.{uid}") for m in members)))
-        return with_subassemblies(spec, units)
+                raise self.fail(where, "expected a list of part ids or {parts: [...], gravity}")
+            units.append((str(uid), tuple(self.text(m, where) for m in members)))
+        return replace(with_subassemblies(spec, units), unit_gravity=tuple(turned))
 
     def parts(self, raw) -> tuple[Part, ...]:
         if raw is None:

@@ -122,6 +122,7 @@ def build_with_units(
     StateGraph
         Its ``spec`` holds the units used (``spec.subassemblies``).
     """
+    from asp.orientation import orient_units
     from asp.state_graph import build_state_graph
 
     say = on_unit or (lambda _line: None)
@@ -137,6 +138,7 @@ def build_with_units(
         found: list[tuple[str, ...]] = []
         current = base
         for _ in range(MAX_ROUNDS + 1):
+            current = orient_units(current, relations, say)  # upside down where better
             current = built_in_turn(hold_unsupported_units(current, relations))
             try:
                 return build_state_graph(current, relations, **kwargs)

@@ -7,7 +7,7 @@ from pathlib import Path
 import typer
 
 from asmplan.cli.app import app
-from asmplan.cli.options import check_output, contact_tol_option, penetration_tol_option
+from asmplan.cli.options import check_output, tolerance_option
 
 
 @app.command("init")
@@ -19,8 +19,8 @@ def init_command(
         Path("assembly.yaml"), "--output", "-o", help="Spec file to write."
     ),
     force: bool = typer.Option(False, "--force", help="Overwrite an existing spec file."),
-    contact_tol: float | None = contact_tol_option(),
-    penetration_tol: float | None = penetration_tol_option(),
+    contact_tol: float | None = tolerance_option("contact_tol"),
+    penetration_tol: float | None = tolerance_option("penetration_tol"),
 ) -> None:
     """Generate assembly.yaml from CAD: parts, a default cell (H, R1), one placement each."""
     import yaml

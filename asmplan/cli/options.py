@@ -13,6 +13,7 @@ import typer
 
 from asmplan.cli.app import choices
 from asp.rules import COST_MODELS
+from asp.spec import TURN_MODELS
 
 SEED_MAX = 2**32 - 1
 """Seeds are 32-bit: numpy, torch and CP-SAT all accept them."""
@@ -23,6 +24,7 @@ TIME_LIMIT_MAX = 86_400.0
 WORKERS_MAX = 1_024
 
 CostModel = choices("CostModel", COST_MODELS, "Cost of a move.")
+TurnModel = choices("TurnModel", TURN_MODELS, "Turn model of the game.")
 
 
 def time_limit_option(default: float | None, help: str = "CP-SAT time limit, seconds."):
@@ -49,28 +51,29 @@ def _tolerance(name: str):
     return check
 
 
-def contact_tol_option():
-    """``--contact-tol``: one definition for every command that computes relations."""
+TOLERANCE_HELP = {
+    "contact_tol": "Contact tolerance in mm for every pair: the largest gap that counts as "
+    "touching (default: the spec's contact_tol, else per pair 2% of the smaller part's "
+    "bounding-box diagonal, 0.01 to 0.2 mm, so clearance fits touch; cad/tolerances.py).",
+    "penetration_tol": "Penetration tolerance in mm for every pair: the largest overlap that "
+    "counts as touching (default: the spec's penetration_tol, else per part, scaled with its "
+    "size and thickness, a pair gets the sum, at most 0.5 mm; cad/tolerances.py).",
+}
+"""Help of ``--contact-tol`` and ``--penetration-tol`` (the spec keys of the same names)."""
+
+
+def tolerance_option(name: str):
+    """``--contact-tol`` or ``--penetration-tol`` (``name``: the spec key): one definition
+    for every command that computes relations."""
     return typer.Option(
-        None,
-        "--contact-tol",
-        callback=_tolerance("contact_tol"),
-        help="Contact tolerance in mm for every pair: the largest gap that counts as touching "
-        "(default: the spec's contact_tol, else per pair 2% of the smaller part's "
-        "bounding-box diagonal, 0.01 to 0.2 mm, so clearance fits touch; cad/tolerances.py).",
+        None, "--" + name.replace("_", "-"), callback=_tolerance(name), help=TOLERANCE_HELP[name]
     )
 
 
-def penetration_tol_option():
-    """``--penetration-tol``: one definition for every command that computes relations."""
-    return typer.Option(
-        None,
-        "--penetration-tol",
-        callback=_tolerance("penetration_tol"),
-        help="Penetration tolerance in mm for every pair: the largest overlap that counts as "
-        "touching (default: the spec's penetration_tol, else per part, scaled with its size "
-        "and thickness, a pair gets the sum, at most 0.5 mm; cad/tolerances.py).",
-    )
+def turn_model_option(help: str):
+    """``--turn-model`` (:data:`TurnModel`, default None: the spec's); ``help`` says what it
+    chooses for that command."""
+    return typer.Option(None, "--turn-model", help=help)
 
 
 def finite_or_none(value: float | None) -> float | None:

@@ -12,21 +12,20 @@ from pathlib import Path
 
 import typer
 
-from asmplan.cli.app import app, choices
+from asmplan.cli.app import app
 from asmplan.cli.graph import say
 from asmplan.cli.options import (
     CostModel,
+    TurnModel,
     check_output,
-    contact_tol_option,
     finite_or_none,
-    penetration_tol_option,
     seed_option,
     time_limit_option,
+    tolerance_option,
+    turn_model_option,
 )
 from asp.concurrent import AUTO_PATIENCE, AUTO_TIME_LIMIT
-from asp.spec import TURN_MODELS
 
-TurnModel = choices("TurnModel", TURN_MODELS, "Turn model of the game.")
 AUTO_TIME_LIMIT_HELP = (
     "Seconds for CP-SAT's minimum-makespan search. Default: automatic, the whole schedule "
     f"stage within {AUTO_TIME_LIMIT:g} s, stopping once the best schedule has not improved for "
@@ -47,7 +46,7 @@ def plan_summary(result) -> list[str]:
     if result.relations_summary:
         lines.append("part relations (contacts with directions; free directions in the assembly):")
         lines.append(relations_summary_text(result.relations_summary))
-    lines += units_text(result.units)
+    lines += units_text(result.units, graph.spec)
     lines.append(
         f"state graph: {graph.n_states:,} states, {graph.n_transitions:,} transitions, "
         f"{result.sequences:,} feasible sequences"
@@ -91,15 +90,22 @@ def plan_summary(result) -> list[str]:
     return lines
 
 
-def units_text(units: list[dict]) -> list[str]:
+def units_text(units: list[dict], spec=None) -> list[str]:
     """The subassemblies of a plan (``plan.json``'s ``units``): used ones with their parts
-    and where they come from, the CAD file's unused ones with the reason."""
+    and where they come from (and, for one built upside down, its workspace's gravity:
+    ``spec.unit_gravity``), the CAD file's unused ones with the reason."""
     if not units:
         return []
     source = {"spec": "the spec", "cad": "the CAD file", "automatic": "found automatically"}
+    turned = dict(spec.unit_gravity) if spec is not None else {}
     lines = ["subassemblies (each built on its own, then inserted as one unit):"]
     for u in units:
         head = f"  {u['id']} [{', '.join(u['parts'])}] from {source[u['source']]}"
+        if u["used"] and u["id"] in turned:
+            head += (
+                f"; built upside down (gravity {turned[u['id']]} in its workspace), then turned "
+                f"over and inserted"
+            )
         lines.append(head + ("" if u["used"] else f": not used, {u['reason']}"))
     return lines
 
@@ -117,8 +123,8 @@ def plan_command(
     cost: CostModel | None = typer.Option(None, "--cost", help="Cost model (default: spec's)."),
     time_limit: float | None = time_limit_option(None, AUTO_TIME_LIMIT_HELP),
     seed: int = seed_option("CP-SAT random seed."),
-    turn_model: TurnModel | None = typer.Option(
-        None, "--turn-model", help="alternate (the paper's turns) or concurrent (default: spec's)."
+    turn_model: TurnModel | None = turn_model_option(
+        "alternate (the paper's turns) or concurrent (default: spec's)."
     ),
     max_k: int | None = typer.Option(
         None,
@@ -138,8 +144,8 @@ def plan_command(
     max_states: int | None = typer.Option(
         None, "--max-states", min=1, help="State graph limit (default: spec's, else 20,000,000)."
     ),
-    contact_tol: float | None = contact_tol_option(),
-    penetration_tol: float | None = penetration_tol_option(),
+    contact_tol: float | None = tolerance_option("contact_tol"),
+    penetration_tol: float | None = tolerance_option("penetration_tol"),
 ) -> None:
     """Plan an assembly end to end: relations, state graph, game, robust plan, CP-SAT."""
     from asmplan import pipeline

@@ -7,7 +7,7 @@ from pathlib import Path
 import typer
 
 from asmplan.cli.app import TableFormat, app
-from asmplan.cli.options import contact_tol_option, penetration_tol_option
+from asmplan.cli.options import tolerance_option
 
 
 @app.command("relations")
@@ -16,8 +16,8 @@ def relations_command(
         ..., help="Folder of part meshes, multi-body scene (GLB/glTF/3MF/STEP) or assembly.yaml."
     ),
     fmt: TableFormat = typer.Option(TableFormat.text, "--format", help="Output format."),
-    contact_tol: float | None = contact_tol_option(),
-    penetration_tol: float | None = penetration_tol_option(),
+    contact_tol: float | None = tolerance_option("contact_tol"),
+    penetration_tol: float | None = tolerance_option("penetration_tol"),
     units: str | None = typer.Option(
         None, "--units", help="Unit of mesh files that declare none (default mm)."
     ),

@@ -13,7 +13,7 @@ import typer
 
 from asmplan.cli.app import app
 from asmplan.cli.graph import say
-from asmplan.cli.plan import TurnModel
+from asmplan.cli.options import TurnModel, turn_model_option
 
 LOCAL_HOSTS = ("127.0.0.1", "localhost", "::1")
 
@@ -60,8 +60,8 @@ def serve_command(
     questionnaire: Path | None = typer.Option(
         None, "--questionnaire", help="JSON list of questionnaire items (default: built in)."
     ),
-    turn_model: TurnModel | None = typer.Option(
-        None, "--turn-model", help="An assembly's turn model when planned here (default: spec's)."
+    turn_model: TurnModel | None = turn_model_option(
+        "An assembly's turn model when planned here (default: spec's)."
     ),
 ) -> None:
     """Serve the advisor's JSON API and the page to play the plan (FastAPI + uvicorn)."""

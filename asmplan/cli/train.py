@@ -3,24 +3,22 @@
 from __future__ import annotations
 
 import json
-from enum import StrEnum
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import typer
 
 from asmplan.cli.app import OutputFormat, app
-from asmplan.cli.options import GAMES_MAX, check_output, seed_option
+from asmplan.cli.options import (
+    GAMES_MAX,
+    TurnModel,
+    check_output,
+    seed_option,
+    turn_model_option,
+)
 
 if TYPE_CHECKING:  # pragma: no cover - types only
     from asp.dag import GameDAG
-
-
-class TurnModel(StrEnum):
-    """The game trained on: the paper's alternating turns, or the concurrent game."""
-
-    alternate = "alternate"
-    concurrent = "concurrent"
 
 
 SOURCE_HELP = (
@@ -77,7 +75,7 @@ EVALUATE_KEYS = (
 @app.command("train")
 def train_command(
     graph: Path = typer.Argument(..., help=SOURCE_HELP),
-    turn_model: TurnModel | None = typer.Option(None, "--turn-model", help=TURN_MODEL_HELP),
+    turn_model: TurnModel | None = turn_model_option(TURN_MODEL_HELP),
     config: str = typer.Option("paper", "--config", help="Training configuration: paper|fast."),
     seed: int = seed_option("Seed of models, environments and torch."),
     output: Path = typer.Option(..., "--output", "-o", help="Run folder (models, log, plots)."),
@@ -126,7 +124,7 @@ def train_command(
 @app.command("evaluate")
 def evaluate_command(
     graph: Path = typer.Argument(..., help="Game DAG or assembly the model was trained on."),
-    turn_model: TurnModel | None = typer.Option(None, "--turn-model", help=TURN_MODEL_HELP),
+    turn_model: TurnModel | None = turn_model_option(TURN_MODEL_HELP),
     model: Path = typer.Option(..., "--model", help="Run folder written by 'asmplan train'."),
     fmt: OutputFormat = typer.Option(OutputFormat.text, "--format", help="Output format."),
     games: int = typer.Option(

@@ -215,6 +215,8 @@ def report_html(plan: dict, figures: dict[str, bytes] | None = None) -> str:
     if "gantt_schedule" in figures:
         body.append("<h2>CP-SAT schedule</h2>")
         body.append(_img(_data_uri(figures["gantt_schedule"]), "CP-SAT Gantt chart"))
+    if sched.get("status_note"):
+        body.append(f"<p class='note'>CP-SAT: {esc(sched['status_note'])}</p>")
 
     principal = plan.get("robust_plan", [])
     body.append("<h2>The principal line (the person follows the plan)</h2>")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from dataclasses import replace
 from pathlib import Path
 
 from typer.testing import CliRunner
@@ -10,20 +11,34 @@ from typer.testing import CliRunner
 from asmplan import pipeline
 from asmplan.cli import app
 from asp.checker import check_line, plan_operations
+from asp.spec import with_subassemblies
 
 
 def plan_and_check(source: Path, out: Path, *options: str) -> dict:
     """Run ``asmplan plan SOURCE -o OUT [options]`` with defaults and check its line.
 
     Asserts the command succeeds, the principal line does every operation of the spec
-    loaded afresh from ``source``, and :func:`asp.checker.check_line` accepts it (with the
-    plan's subassemblies). Returns ``plan.json`` as a dict.
+    loaded afresh from ``source`` (with the units the plan used: the CAD file's and the
+    automatic ones are decided while planning; each inserted by an operation named as the
+    unit), and :func:`asp.checker.check_line` accepts it (the units built in their own
+    workspaces along the gravity ``plan.json``'s ``workspaces`` give, ``held`` as the plan's
+    operations say: what the plan claims an agent holds). Returns ``plan.json`` as a dict.
     """
     result = CliRunner().invoke(app, ["plan", str(source), "-o", str(out), *options])
     assert result.exit_code == 0, result.output
     doc = json.loads((out / "plan.json").read_text())
     ops = plan_operations(doc)
     assembly = pipeline.load(source, on_step=lambda _: None)
-    assert sorted(ops) == sorted(assembly.spec.op_ids)
-    check_line(assembly.spec, assembly.relations, ops, units=doc["subassemblies"])
+    spec = assembly.spec
+    own = {u for u, _ in spec.subassemblies}
+    spec = with_subassemblies(
+        spec, [(u, ms) for u, ms in doc["subassemblies"].items() if u not in own]
+    )
+    held = {op: bool(info.get("held")) for op, info in doc["operations"].items()}
+    spec = replace(
+        spec, operations=tuple(replace(op, held=held.get(op.id, op.held)) for op in spec.operations)
+    )
+    assert sorted(ops) == sorted(spec.op_ids)
+    down = {w["id"]: w["gravity"] for w in doc["workspaces"] if w["id"] != "main"}
+    check_line(spec, assembly.relations, ops, units=doc["subassemblies"], gravity=down)
     return doc

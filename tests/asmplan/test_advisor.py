@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from asmplan.advisor import Advisor, ObservationError
+from asmplan.advisor import Advisor, ObservationError, placed_parts
 from asp.dag import HUMAN, ROBOT
 from tests.asmplan.plans import cell_game, cell_plan
 
@@ -119,3 +119,23 @@ def test_replay_restores_the_state():
         advisor.observe({"kind": "finished", **_pick(move)})
     again = Advisor.replay(doc, advisor.history)
     assert again.advice() == advisor.advice()
+
+
+@pytest.mark.parametrize(
+    ("done", "expected"),
+    [
+        ([], []),
+        (["1"], ["base"]),
+        # a unit's members are placed in its workspace, then inserted with it: each once
+        (["1", "2", "3", "U"], ["base", "shaft", "bearing"]),
+        (["1", "2", "U", "3"], ["base", "shaft", "bearing"]),
+    ],
+)
+def test_placed_parts_lists_each_part_once_in_order(done, expected):
+    operations = {
+        "1": {"parts": ["base"]},
+        "2": {"parts": ["shaft"]},
+        "3": {"parts": ["bearing"]},
+        "U": {"parts": ["shaft", "bearing"]},
+    }
+    assert placed_parts(operations, done) == expected

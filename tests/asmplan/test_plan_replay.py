@@ -91,6 +91,8 @@ class Replay:
         self.shrink = geo["part_shrink"]
         self.contact_tol = geo["contact_tol"]
         self.gravity = vector(plan["gravity"])
+        # a unit built in another orientation (upside down) has its own gravity
+        self.down = {w["id"]: vector(w.get("gravity", plan["gravity"])) for w in plan["workspaces"]}
         self.solid = {p: eroded(m, self.shrink[p]) for p, m in self.meshes.items()}
         thinnest = min(float(np.min(m.extents)) for m in self.meshes.values())
         self.step = float(np.clip(thinnest / 4, 0.05, 1.0))
@@ -135,10 +137,11 @@ class Replay:
         tol = max(self.shrink[p] for p in body) + max(self.shrink[p] for p in there)
         travel = SUPPORT_FACTOR * tol
         fall = np.linspace(travel / 8, travel, 8)[:, None]
-        if self.hits(solid, body, fall * self.gravity):
+        down = self.down.get(ins["workspace"], self.gravity)
+        if self.hits(solid, body, fall * down):
             return
         across = [vector(s + a) for a in "xyz" for s in "+-"]
-        across = [v for v in across if abs(v @ self.gravity) < 0.5]
+        across = [v for v in across if abs(v @ down) < 0.5]
         if all(self.hits(solid, body, fall * v) for v in across):
             return  # fitted: a bearing pressed in its holder, a nut on its bolt
         raise Rejected(f"{where}: {body} is not supported (it would fall along gravity)")

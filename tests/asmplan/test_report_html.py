@@ -41,3 +41,11 @@ def test_pump_report_pictures_each_step_that_places_parts():
     assert page.count("<figure>") == len(steps) == 7
     assert "step 6: 1.4 by H" in page
     assert _external_references(page) == []
+
+
+def test_report_shows_the_cp_sat_status_note():
+    note = "not proven optimal within 30 s: the best schedule found, replayed"
+    schedule = {"status": "FEASIBLE", "objective": 105, "bound": 86, "lower_bound": 80}
+    with_note = {**cell_plan(), "schedule": {**schedule, "status_note": note}}
+    assert f"CP-SAT: {note}" in report_html(with_note, {})
+    assert "CP-SAT: " not in report_html({**cell_plan(), "schedule": schedule}, {})

@@ -274,3 +274,75 @@ BUILDERS = {
     "bolted_bracket": bolted_bracket,
     "gear_pair": gear_pair,
 }
+
+
+def die_set(detail: float = 1.0, stripper: bool = True) -> dict[str, trimesh.Trimesh]:
+    """A shear die set (mm, z up, drawn open) built as a toolmaker builds one.
+
+    Lower half: a bottom plate with two guide pins standing in blind holes (press fit,
+    0.05 mm), a die block on it fixed by two screws from above (heads in counterbores).
+    Upper half: a top plate with two flanged guide bushings pressed in from below (flange
+    under the plate), a punch holder under it fixed by two screws from below (heads in the
+    holder's counterbores, threads in blind holes of the top plate), the punch hanging in
+    the holder by its head and, with ``stripper``, a stripper plate around the punch
+    hanging on two stripper bolts driven up into the holder. Right side up every bushing
+    and screw of the upper half falls out; upside down (top plate on the bench) each rests
+    on what is already there. The upper half slides down the guide pins and, drawn open,
+    rests on nothing of the lower half.
+    """
+    n = max(1, round(detail))
+    pins, screws = [(-80.0, -55.0), (80.0, 55.0)], [(-35.0, -28.0), (35.0, 28.0)]
+    tops, bolts = [(-35.0, 28.0), (35.0, -28.0)], [(0.0, 30.0), (0.0, -30.0)]
+    parts = {
+        "bottom_plate": difference(
+            box((-100, -75, 0), (100, 75, 20)),
+            *(cylinder(8, 6, 21, 48 * n, xy) for xy in pins),
+            *(cylinder(4, 5, 21, 32 * n, xy) for xy in screws),
+        ),
+        "die_block": difference(
+            box((-50, -40, 20), (50, 40, 45)),
+            box((-20, -10, 19), (20, 10, 46)),
+            *(cylinder(4, 19, 46, 32 * n, xy) for xy in screws),
+            *(cylinder(6.5, 37, 46, 40 * n, xy) for xy in screws),
+        ),
+        "top_plate": difference(
+            box((-100, -75, 130), (100, 75, 150)),
+            *(cylinder(11, 129, 151, 56 * n, xy) for xy in pins),
+            *(cylinder(4, 129, 142, 32 * n, xy) for xy in tops),
+        ),
+        "punch_holder": difference(
+            box((-50, -40, 115), (50, 40, 130)),
+            box((-20, -10, 114), (20, 10, 131)),
+            box((-24, -14, 126), (24, 14, 131)),  # pocket of the punch head
+            *(cylinder(4, 114, 131, 32 * n, xy) for xy in tops),
+            *(cylinder(6.5, 114, 120, 40 * n, xy) for xy in tops),
+            *(cylinder(3, 114, 131, 28 * n, xy) for xy in bolts),
+        ),
+        "punch": union(box((-20, -10, 50), (20, 10, 130)), box((-24, -14, 126), (24, 14, 130))),
+    }
+    for k, xy in enumerate(pins, 1):
+        parts[f"guide_pin_{k}"] = cylinder(8.05, 6, 120, 40 * n, xy)
+        parts[f"bushing_{k}"] = union(
+            annulus(8, 11, 100, 150, 40 * n, 56 * n, xy),
+            annulus(8, 13, 127, 130, 40 * n, 64 * n, xy),
+        )
+    for k, (xy, up) in enumerate(zip(screws, tops, strict=True), 1):
+        parts[f"screw_{k}"] = union(
+            cylinder(4, 8, 37, 24 * n, xy), cylinder(6.5, 37, 45, 40 * n, xy)
+        )
+        xy = up
+        parts[f"top_screw_{k}"] = union(
+            cylinder(4, 120, 142, 24 * n, xy), cylinder(6.5, 115, 120, 40 * n, xy)
+        )
+    if stripper:
+        parts["stripper_plate"] = difference(
+            box((-50, -40, 55), (50, 40, 65)),
+            box((-20, -10, 54), (20, 10, 66)),
+            *(cylinder(3, 54, 66, 28 * n, xy) for xy in bolts),
+            *(cylinder(5, 54, 58, 36 * n, xy) for xy in bolts),
+        )
+        for k, xy in enumerate(bolts, 1):
+            parts[f"stripper_bolt_{k}"] = union(
+                cylinder(3, 58, 128, 24 * n, xy), cylinder(5, 54, 58, 36 * n, xy)
+            )
+    return parts
