@@ -337,6 +337,7 @@ def min_makespan(
     replay=None,
     incumbent: list[dict] | None = None,
     patience: float | None = None,
+    more_cuts=None,
 ) -> BaselineResult:
     """Minimum-makespan schedule with CP-SAT.
 
@@ -356,6 +357,10 @@ def min_makespan(
     ``detail["found_by"]`` says which schedule is reported (``CP-SAT`` or the incumbent's
     source), ``detail["cuts"]`` and ``detail["solves"]`` how the loop went,
     ``detail["improvements"]`` when each better schedule came (``[seconds, makespan]``).
+
+    ``more_cuts`` (optional): ``more_cuts(rows)`` of a schedule that failed the replay
+    returns further cuts (each a list of pairs as above, each holding for every feasible
+    schedule), added with the replay's own, so one solve rules out several faults.
 
     ``patience`` (optional, seconds): stop once the best schedule has not improved for that
     long (the status is then ``FEASIBLE`` unless proven); ``time_limit`` still caps the whole
@@ -472,6 +477,7 @@ def min_makespan(
         present=present,
         makespan=makespan,
         replay=replay,
+        more_cuts=more_cuts,
     )
     if incumbent:
         loop.offer(incumbent, source="list schedule along a state-graph path")
@@ -513,10 +519,14 @@ class _ReplayLoop:
     ``UNKNOWN`` (no schedule). Every reported schedule passed the replay.
     """
 
-    def __init__(self, *, model, tasks, scale, start, end, present, makespan, replay):
+    def __init__(
+        self, *, model, tasks, scale, start, end, present, makespan, replay, more_cuts=None
+    ):
         self.model, self.tasks, self.scale = model, tasks, scale
         self.start, self.end, self.present, self.makespan = start, end, present, makespan
         self.replay = replay
+        self.more_cuts = more_cuts
+        self.added: set[frozenset] = set()  # the cuts in the model
         self.best: tuple[int, list[dict]] | None = None  # (scaled makespan, rows)
         self.source = ""
         self.bound: int | None = None
@@ -570,6 +580,15 @@ class _ReplayLoop:
             self.prec[y, x] = lit
         return self.prec[y, x]
 
+    def add_cut(self, cut) -> None:
+        """Add the cut "one of these precedences ``(y, x)``" (once)."""
+        key = frozenset(cut)
+        if not key or key in self.added:
+            return
+        self.added.add(key)
+        self.cuts += 1
+        self.model.add_bool_or([self.precedes(y, x) for y, x in sorted(key)])
+
     def hint(self) -> None:
         self.model.clear_hints()
         if self.best is None:
@@ -615,12 +634,13 @@ class _ReplayLoop:
                 def __init__(self):
                     super().__init__()
                     self.cut = None
+                    self.failed_rows = None
 
                 def on_solution_callback(self):
                     rows, modes = loop.rows(self.value, self.boolean_value)
                     cut = loop.offer(rows, source="CP-SAT", modes=modes)
                     if cut is not None:
-                        self.cut = cut
+                        self.cut, self.failed_rows = cut, rows
                         self.stop_search()
 
             callback = Replayed()
@@ -643,8 +663,10 @@ class _ReplayLoop:
             if not callback.cut:
                 self.stalled = False
                 break  # a failure no precedence can mend: nothing more to try
-            self.cuts += 1
-            self.model.add_bool_or([self.precedes(y, x) for y, x in callback.cut])
+            self.add_cut(callback.cut)
+            if self.more_cuts is not None:
+                for cut in self.more_cuts(callback.failed_rows):
+                    self.add_cut(cut)
         wall = time.perf_counter() - t0
         if self.best is not None and proven:
             status_name = "OPTIMAL"

@@ -263,7 +263,8 @@ class ReplayModel:
 def replay_model(spec: AssemblySpec, graph: StateGraph, *, cuts: bool = True) -> ReplayModel:
     """The :class:`ReplayModel` of a spec and its state graph (with the short cuts)."""
     steps = LiveSteps(graph)
-    short = PlacementCuts(graph, steps) if cuts else None
+    positive = all(d > 0 for op in spec.operations for _, d in op.durations)
+    short = PlacementCuts(graph, steps, combined=positive) if cuts else None
     return ReplayModel(spec, spec_workers(spec), steps, tool_conflicts(spec), short)
 
 
@@ -1176,6 +1177,14 @@ def assembly_makespan(
         found = schedule_violation(model, rows)
         return None if found is None else found[1]
 
+    index = {oid: i for i, oid in enumerate(spec.op_ids)}
+
+    def more_cuts(rows):
+        start, end = [0.0] * len(index), [0.0] * len(index)
+        for r in rows:
+            start[index[r["task"]]], end[index[r["task"]]] = float(r["start"]), float(r["end"])
+        return model.cuts.early(start, end)
+
     starts = [list_schedule(model, sched.problem)]
     if sequence is not None:
         starts.append(list_schedule(model, sched.problem, sequence))
@@ -1192,6 +1201,7 @@ def assembly_makespan(
         replay=replay,
         incumbent=incumbent,
         patience=patience,
+        more_cuts=more_cuts if model.cuts.combined else None,  # positive durations (asp.cuts)
     )
     result.detail["stage_s"] = round(time.perf_counter() - t0, 3)
     return sched, result

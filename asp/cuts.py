@@ -36,6 +36,8 @@ shrinking starts again (a few rounds at most), so a cut costs a few passes over 
 
 from __future__ import annotations
 
+import time
+
 import numba
 import numpy as np
 
@@ -46,7 +48,9 @@ SAMPLE = 4096
 """Sets of ``B`` the shrinking starts from (evenly spaced)."""
 ADD = 256
 """Most sets that break a shrunk cut added to the sample per round."""
-CACHE_ROWS = 16_000_000
+EARLY_S = 0.5
+"""Seconds :meth:`PlacementCuts.early` spends on one schedule at most."""
+CACHE_ROWS = 8_000_000
 """Most done sets (rows of ``B``) kept between cuts, over all operations (16 bytes each
 with two words)."""
 
@@ -59,10 +63,14 @@ class PlacementCuts:
     graph : StateGraph
     steps : LiveSteps, optional
         The graph's live transitions (built when not given).
+    combined : bool
+        Whether cuts with both ``Y`` and ``X`` are allowed (their proof needs every
+        operation to take time); else only ``X`` or ``Y`` empty.
     """
 
-    def __init__(self, graph, steps: LiveSteps | None = None):
+    def __init__(self, graph, steps: LiveSteps | None = None, *, combined: bool = True):
         self.graph = graph
+        self.combined = combined
         self.steps = LiveSteps(graph) if steps is None else steps
         self.n = graph.model.n_ops
         keys = np.asarray(graph.keys, dtype=np.uint64)
@@ -106,7 +114,10 @@ class PlacementCuts:
         found = []
         for x_first in (True, False):
             y, x = self._shrink(rows, ys, xs, x_first)
-            found.append((len(y) * (len(x) + 1) + len(x), y, x))
+            if self.combined or not (y and x):
+                found.append((len(y) * (len(x) + 1) + len(x), y, x))
+        if not found:
+            return None
         _, y, x = min(found, key=lambda f: f[0])
         return y, x
 
@@ -118,6 +129,32 @@ class PlacementCuts:
             return None
         ys, xs = found
         return [(y, x) for x in [b, *xs] for y in ys] + [(b, x) for x in xs]
+
+    def early(
+        self, start: list[float], end: list[float], seconds: float = EARLY_S
+    ) -> list[list[tuple[int, int]]]:
+        """Cuts for the operations a schedule starts too early.
+
+        Every feasible schedule may place ``b`` right after the operations that end by the
+        time it starts (``D``), so ``D`` is in ``B``; for each ``b`` (in start order) where it
+        is not, the short cut for ``b`` after ``D``. Stops after ``seconds`` (the done sets
+        of each operation, once read, are kept for the next call).
+
+        Parameters
+        ----------
+        start, end : list of float, [n_ops]
+            The schedule.
+        """
+        t0 = time.perf_counter()
+        out = []
+        for b in sorted(range(self.n), key=lambda o: (start[o], o)):
+            if time.perf_counter() - t0 > seconds:
+                break
+            done = {o for o in range(self.n) if o != b and end[o] <= start[b]}
+            cut = self.cut(done, b)
+            if cut:
+                out.append(cut)
+        return out
 
     def _shrink(self, rows, ys, xs, x_first: bool) -> tuple[list[int], list[int]]:
         k = rows.shape[0]
