@@ -533,8 +533,8 @@ def schedule(
     time_limit : float or None
         Seconds for CP-SAT's search. ``None`` (the default): the automatic budget of
         :func:`asp.concurrent.assembly_makespan`, the whole stage within
-        :data:`asp.concurrent.AUTO_TIME_LIMIT` seconds, stopping once the best schedule has
-        not improved for :data:`asp.concurrent.AUTO_PATIENCE` seconds.
+        :data:`asp.concurrent.AUTO_TIME_LIMIT` seconds, stopping once neither a better
+        schedule nor a new cut has come for :data:`asp.concurrent.AUTO_PATIENCE` seconds.
     workers : int
         CP-SAT workers (1: repeatable).
     seed : int

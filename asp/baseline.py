@@ -362,9 +362,9 @@ def min_makespan(
     returns further cuts (each a list of pairs as above, each holding for every feasible
     schedule), added with the replay's own, so one solve rules out several faults.
 
-    ``patience`` (optional, seconds): stop once the best schedule has not improved for that
-    long (the status is then ``FEASIBLE`` unless proven); ``time_limit`` still caps the whole
-    loop. Without it the loop runs until proven or ``time_limit``.
+    ``patience`` (optional, seconds): stop once neither a better schedule nor a new cut
+    has come for that long (the status is then ``FEASIBLE`` unless proven); ``time_limit``
+    still caps the whole loop. Without it the loop runs until proven or ``time_limit``.
 
     Tool states as sequence-dependent setups: for a tool ``T``, a *setter* is a task that
     sets ``T`` and a *user* a task that requires a value of ``T``. Every setter is ordered
@@ -536,7 +536,7 @@ class _ReplayLoop:
         self.prec: dict[tuple[int, int], object] = {}
         self.modes: list[int] | None = None  # the incumbent's mode per task
         self.t0 = time.perf_counter()
-        self.improved_at = 0.0  # seconds after t0 of the last better schedule
+        self.progress_at = 0.0  # seconds after t0 of the last better schedule or new cut
         self.improvements: list[list[float]] = []  # [seconds, makespan] of each better one
         self.stalled = False  # stopped by the patience
 
@@ -569,8 +569,8 @@ class _ReplayLoop:
                 agent = {r["task"]: r["agent"] for r in rows}
                 modes = [[a for a, _ in t.modes].index(agent[t.id]) for t in self.tasks]
             self.best, self.source, self.modes = (span, rows), source, list(modes)
-            self.improved_at = time.perf_counter() - self.t0
-            self.improvements.append([round(self.improved_at, 3), span / self.scale])
+            self.progress_at = time.perf_counter() - self.t0
+            self.improvements.append([round(self.progress_at, 3), span / self.scale])
         return None
 
     def precedes(self, y: int, x: int):
@@ -587,6 +587,7 @@ class _ReplayLoop:
             return
         self.added.add(key)
         self.cuts += 1
+        self.progress_at = time.perf_counter() - self.t0
         self.model.add_bool_or([self.precedes(y, x) for y, x in sorted(key)])
 
     def hint(self) -> None:
@@ -609,7 +610,7 @@ class _ReplayLoop:
 
         loop = self
         t0 = self.t0 = time.perf_counter()
-        self.improved_at = 0.0
+        self.progress_at = 0.0
         self.improvements = [[0.0, self.best[0] / self.scale]] if self.best else []
         proven = infeasible = False
         last = "UNKNOWN"
@@ -617,7 +618,7 @@ class _ReplayLoop:
             elapsed = time.perf_counter() - t0
             left = time_limit - elapsed
             if patience is not None and self.best is not None:
-                wait = self.improved_at + patience - elapsed
+                wait = self.progress_at + patience - elapsed
                 self.stalled = wait < left  # this solve stops by the patience, if it does
                 left = min(left, wait)
             if left <= 0:
@@ -657,7 +658,7 @@ class _ReplayLoop:
             if callback.cut is None:
                 proven = status in (cp_model.OPTIMAL, cp_model.INFEASIBLE)
                 infeasible = status == cp_model.INFEASIBLE and self.best is None
-                if not proven and patience is not None and self.improved_at > began:
+                if not proven and patience is not None and self.progress_at > began:
                     continue  # stopped by the patience while still improving: go on
                 break
             if not callback.cut:
@@ -700,7 +701,8 @@ class _ReplayLoop:
             low = f"; the optimum is at least {self.bound / self.scale:g}" if self.bound else ""
             replayed = ", replayed through the state graph" if self.replay is not None else ""
             within = (
-                f"in {time.perf_counter() - self.t0:.1f} s (no better schedule for {patience:g} s)"
+                f"in {time.perf_counter() - self.t0:.1f} s (no better schedule nor cut for "
+                f"{patience:g} s)"
                 if self.stalled
                 else f"within {time_limit:g} s"
             )

@@ -89,8 +89,8 @@ AUTO_TIME_LIMIT = 20.0
 """Seconds for the whole CP-SAT makespan stage by default (:func:`assembly_makespan` with
 ``time_limit=None``), its preparation included."""
 AUTO_PATIENCE = 4.0
-"""By default the CP-SAT makespan stage stops once its best schedule has not improved for
-this many seconds (or when it is proven optimal)."""
+"""By default the CP-SAT makespan stage stops once neither a better schedule nor a new cut
+has come for this many seconds (or when it is proven optimal)."""
 MIN_SOLVE_S = 0.5
 """The least time the automatic budget leaves CP-SAT after a long preparation."""
 
@@ -1164,7 +1164,7 @@ def assembly_makespan(
         for the whole call, preparation included, with ``patience`` defaulting to
         :data:`AUTO_PATIENCE`.
     patience : float, optional
-        Stop once the best schedule has not improved for this many seconds
+        Stop once neither a better schedule nor a new cut has come for this many seconds
         (:func:`asp.baseline.min_makespan`).
     """
     t0 = time.perf_counter()

@@ -36,6 +36,7 @@ shrinking starts again (a few rounds at most), so a cut costs a few passes over 
 
 from __future__ import annotations
 
+import bisect
 import time
 
 import numba
@@ -136,9 +137,11 @@ class PlacementCuts:
         """Cuts for the operations a schedule starts too early.
 
         Every feasible schedule may place ``b`` right after the operations that end by the
-        time it starts (``D``), so ``D`` is in ``B``; for each ``b`` (in start order) where it
-        is not, the short cut for ``b`` after ``D``. Stops after ``seconds`` (the done sets
-        of each operation, once read, are kept for the next call).
+        time it starts (``D``, a prefix of the operations in order of their ends), so ``D``
+        is in ``B``. The state of each prefix is found by one walk along that order; for
+        each ``b`` whose ``D`` is a state without a step ``b``, the short cut for ``b``
+        after ``D``. Stops after ``seconds`` (reading the done sets ``B`` of an operation
+        is the cost; they are kept for the next call).
 
         Parameters
         ----------
@@ -146,12 +149,22 @@ class PlacementCuts:
             The schedule.
         """
         t0 = time.perf_counter()
+        order = sorted(range(self.n), key=lambda o: (end[o], start[o], o))
+        ends = [end[o] for o in order]
+        path = [0]  # path[p]: the state after the first p operations of ``order``
+        for o in order:
+            nxt = self.steps.get((path[-1], o))
+            if nxt is None:
+                break
+            path.append(nxt[0])
         out = []
         for b in sorted(range(self.n), key=lambda o: (start[o], o)):
+            p = bisect.bisect_right(ends, start[b])
+            if p >= len(path) or self.steps.get((path[p], b)) is not None:
+                continue
             if time.perf_counter() - t0 > seconds:
                 break
-            done = {o for o in range(self.n) if o != b and end[o] <= start[b]}
-            cut = self.cut(done, b)
+            cut = self.cut(set(order[:p]) - {b}, b)
             if cut:
                 out.append(cut)
         return out

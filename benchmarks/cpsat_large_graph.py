@@ -3,11 +3,12 @@
 The stage is :func:`asp.concurrent.assembly_makespan` (``asmplan plan``'s step 4: the
 precedences the state graph implies, the replay tables, the list schedules, then CP-SAT with
 lazy cuts from the replay). Each case runs with the default of ``asmplan plan`` (``auto``:
-the whole stage within :data:`asp.concurrent.AUTO_TIME_LIMIT` seconds, stopping once the best
-schedule has not improved for :data:`asp.concurrent.AUTO_PATIENCE` seconds) and with each
-``--limits`` value (a CP-SAT time limit in seconds, as ``--time-limit`` gives). Printed per
-run: the stage's wall time, status, makespan, proven lower bound, cuts and solves, and who
-found the schedule; every schedule printed has passed the replay (checked again here).
+the whole stage within :data:`asp.concurrent.AUTO_TIME_LIMIT` seconds, stopping once neither a
+better schedule nor a new cut has come for :data:`asp.concurrent.AUTO_PATIENCE` seconds) and
+with each ``--limits`` value (a CP-SAT time limit in seconds, as ``--time-limit`` gives).
+Printed per run: the stage's wall time, status, makespan, proven lower bound, cuts and
+solves, and who found the schedule; every schedule printed has passed the replay (checked
+again here).
 
 Cases (those whose files are missing are skipped):
 

@@ -28,8 +28,9 @@ from asp.concurrent import AUTO_PATIENCE, AUTO_TIME_LIMIT
 
 AUTO_TIME_LIMIT_HELP = (
     "Seconds for CP-SAT's minimum-makespan search. Default: automatic, the whole schedule "
-    f"stage within {AUTO_TIME_LIMIT:g} s, stopping once the best schedule has not improved for "
-    f"{AUTO_PATIENCE:g} s or is proven optimal; give a number to let CP-SAT search that long."
+    f"stage within {AUTO_TIME_LIMIT:g} s, stopping once neither a better schedule nor a new cut "
+    f"has come for {AUTO_PATIENCE:g} s, or when proven optimal; give a number to let CP-SAT "
+    "search that long."
 )
 
 
