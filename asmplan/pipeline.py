@@ -536,7 +536,7 @@ def schedule(
     assembly: Assembly,
     graph: StateGraph,
     *,
-    time_limit: float = 30.0,
+    time_limit: float | None = None,
     workers: int = 1,
     seed: int = 0,
     sequence: list[str] | None = None,
@@ -553,8 +553,11 @@ def schedule(
     assembly : Assembly
     graph : asp.state_graph.StateGraph
         Gives the implied precedences and the lower bounds.
-    time_limit : float
-        CP-SAT time limit, seconds.
+    time_limit : float or None
+        Seconds for CP-SAT's search. ``None`` (the default): the automatic budget of
+        :func:`asp.concurrent.assembly_makespan`, the whole stage within
+        :data:`asp.concurrent.AUTO_TIME_LIMIT` seconds, stopping once neither a better
+        schedule nor a new cut has come for :data:`asp.concurrent.AUTO_PATIENCE` seconds.
     workers : int
         CP-SAT workers (1: repeatable).
     seed : int
@@ -584,7 +587,7 @@ def plan(
     source: str | os.PathLike[str] | Assembly,
     *,
     cost: str | None = None,
-    time_limit: float = 30.0,
+    time_limit: float | None = None,
     seed: int = 0,
     turn_model: str | None = None,
     max_k: int | None = None,
@@ -602,8 +605,8 @@ def plan(
         An assembly (see :func:`load_assembly`) or one already loaded.
     cost : {"steps", "time"}, optional
         Cost model of the game (default: the spec's).
-    time_limit : float
-        CP-SAT time limit, seconds.
+    time_limit : float or None
+        Seconds for CP-SAT's search (default: the automatic budget, see :func:`schedule`).
     seed : int
         CP-SAT random seed.
     turn_model : {"alternate", "concurrent"}, optional
