@@ -46,10 +46,11 @@ class LiveSteps:
         """``change(src, op)``: the tool-change time of the live transitions with those
         sources and operations (optional; default 0)."""
         alive = graph.coreachable()
-        keep = alive[graph.src] & alive[graph.dst]
-        src = graph.src[keep]
-        self.dst = graph.dst[keep]
-        self.op = graph.op[keep]
+        if alive.all():  # no dead ends (a reduced graph drops them): the graph's own arrays
+            src, self.dst, self.op = graph.src, graph.dst, graph.op
+        else:
+            keep = alive[graph.src] & alive[graph.dst]
+            src, self.dst, self.op = graph.src[keep], graph.dst[keep], graph.op[keep]
         self.change = np.zeros(self.dst.size, dtype=np.int64)
         if change is not None and src.size:
             self.change = np.asarray(change(src, self.op), dtype=np.int64)
