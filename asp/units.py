@@ -315,7 +315,11 @@ def _new_units(
                 smallest = min(candidates, key=len)
                 drop |= {owner[m] for m in smallest if m in owner}
                 continue
-            candidates = [c for c in candidates if not c & set(owner) and not c <= grouped]
+            # a group inside one unit adds nothing; one spanning several units merges them
+            # (a stripper plate hanging on the bolts of one and the punch of the other)
+            candidates = [
+                c for c in candidates if not c & set(owner) and not any(c <= g for g in groups)
+            ]
             if not candidates:
                 continue
             group = min(candidates, key=lambda c: (len(c - grouped), len(c)))

@@ -130,3 +130,21 @@ operations:
     path.write_text(yaml.replace("gravity: +z}", "gravity: +z, side: 1}"))
     with pytest.raises(Exception, match="side"):
         load_spec(path)
+
+
+def test_a_die_set_without_product_tree_finds_its_upper_half(tmp_path):
+    """From a folder of STL parts (no hierarchy) the upper half is found automatically: its
+    parts can never go in one by one (the screws driven up into the top plate would have
+    to pass through the die block); the groups of the stuck parts that span both first
+    guesses merge into one unit, which is built upside down."""
+    from cad import Assembly
+    from tests.cad.test_loading import write_folder
+
+    source = write_folder(tmp_path / "die_set", Assembly.from_meshes(die_set()))
+    plan = plan_and_check(source, tmp_path / "out", "--time-limit", "5")
+    (uid, members), *others = plan["subassemblies"].items()
+    assert not others
+    assert {"top_plate", "punch_holder", "punch", "stripper_plate", "top_screw_1"} <= set(members)
+    spaces = {w["id"]: w for w in plan["workspaces"]}
+    assert spaces[uid]["gravity"] == "+z" and spaces[uid]["parts"][0] == "top_plate"
+    assert plan["line_check"] == {"robust_plan": None, "worst_line": None}
