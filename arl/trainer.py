@@ -141,8 +141,11 @@ class _EpisodeRecorder(BaseCallback):
 def graph_summary(dag: GameDAG) -> dict:
     """Size, ends, cost model and a fingerprint of the arrays (checked on resume)."""
     digest = hashlib.sha256()
-    for arr in (dag.indptr, dag.targets, dag.costs, dag.sides):
-        digest.update(np.ascontiguousarray(arr).tobytes())
+    # Hashed as int64 / float64 whatever the DAG stores (asp.dag keeps them narrow when
+    # exact), so a fingerprint depends on the game only.
+    arrays = ((dag.indptr, np.int64), (dag.targets, np.int64), (dag.costs, np.float64))
+    for arr, dtype in (*arrays, (dag.sides, np.int8)):
+        digest.update(np.ascontiguousarray(arr, dtype=dtype).tobytes())
     digest.update(f"{dag.start},{dag.end}".encode())
     return {
         "nodes": dag.n_nodes,

@@ -36,7 +36,7 @@ import numpy as np
 
 from asp import rules
 from asp.atomic import write_text
-from asp.dag import HUMAN, ROBOT, GameDAG
+from asp.dag import HUMAN, ROBOT, CodedLabels, GameDAG
 from asp.errors import FormatError
 from asp.metrics import adversarial_tax
 from asp.numbers import plain
@@ -56,7 +56,7 @@ StateDescriber = Callable[[int], dict]
 # --------------------------------------------------------------------------- state names
 
 
-def alternate_states(graph, dag: GameDAG) -> StateDescriber:
+def alternate_states(graph, dag: GameDAG) -> AlternateStates:
     """The structured state of each node of ``game_dag(graph)`` (turn model ``alternate``).
 
     Node ``i < n - 1`` is the ``i``-th state that can still be completed and is not
@@ -67,19 +67,47 @@ def alternate_states(graph, dag: GameDAG) -> StateDescriber:
     complete = graph.complete
     inner = np.flatnonzero(alive & ~complete)
     ends = np.flatnonzero(alive & complete)
+    del alive, complete
     if inner.size + 1 != dag.n_nodes:
         raise ValueError(
             f"state names: the game has {dag.n_nodes} nodes, the state graph "
             f"{inner.size + 1} (was the game built from this graph?)"
         )
-    model = graph.model
-    state_of = np.append(inner, ends[:1])
+    return AlternateStates(graph, np.append(inner, ends[:1]))
 
-    def describe(v: int) -> dict:
-        key = graph.keys[int(state_of[v])]
+
+class AlternateStates:
+    """A :data:`StateDescriber` of the nodes of an ``alternate`` game of a state graph, that
+    also names the done operations of many nodes at once (:meth:`done_matrix`).
+
+    Attributes
+    ----------
+    graph : asp.state_graph.StateGraph
+    state_of : (n,) int64
+        The state graph state of each game node.
+    """
+
+    def __init__(self, graph, state_of: np.ndarray):
+        self.graph = graph
+        self.state_of = state_of
+
+    def __call__(self, v: int) -> dict:
+        model = self.graph.model
+        key = self.graph.keys[int(self.state_of[v])]
         return {"done": model.done_ops(key), "tools": model.tool_state(key), "running": []}
 
-    return describe
+    @property
+    def op_ids(self) -> tuple[str, ...]:
+        """The operation ids, in the order of :meth:`done_matrix`'s columns."""
+        return self.graph.spec.op_ids
+
+    @property
+    def has_tools(self) -> bool:
+        return bool(self.graph.model.tool_names)
+
+    def done_matrix(self, nodes: np.ndarray) -> np.ndarray:
+        """(k, n_ops) bool: the operations done at each of the game nodes ``nodes``."""
+        return self.graph.model.done_matrix(self.graph.keys[self.state_of[nodes]])
 
 
 # --------------------------------------------------------------------------- policy table
@@ -227,38 +255,38 @@ def policy_document(
         return _concurrent_policy(game, solution, table)
     op_names = _operation_names(dag, describe)
     op_index = {op: k for k, op in enumerate(op_names)}
-    agent_names = sorted(set(dag.agents or ()))
+    agent_names = sorted(_labels_used(dag.agents))
     agent_index = {a: k for k, a in enumerate(agent_names)}
-    edge_op = np.array([op_index.get(op, -1) for op in (dag.operations or ())], dtype=np.int64)
-    edge_agent = np.array([agent_index.get(a, -1) for a in (dag.agents or ())], dtype=np.int64)
     moves = table.edge >= 0
     move_op = np.full(table.edge.shape, -1, dtype=np.int64)
     move_agent = np.full(table.edge.shape, -1, dtype=np.int64)
     move_cost = np.zeros(table.edge.shape)
-    if edge_op.size:
-        move_op[moves] = edge_op[table.edge[moves]]
-        move_agent[moves] = edge_agent[table.edge[moves]]
-    move_cost[moves] = rules.move_costs(dag)[table.edge[moves]]
+    if dag.operations is not None and len(dag.operations):
+        move_op[moves] = _label_indices(dag.operations, table.edge[moves], op_index)
+        if dag.agents is not None:
+            move_agent[moves] = _label_indices(dag.agents, table.edge[moves], agent_index)
+    move_cost[moves] = rules.move_costs(dag, table.edge[moves])
     states = _state_columns(table, describe or _anonymous, op_index, agent_index)
 
+    ptr, turns = table.ptr.tolist(), table.turn.tolist()
+    ops, agents = move_op.tolist(), move_agent.tolist()
     robots: list[list] = []
     instruction: list = []
-    for i, t in enumerate(table.turn.tolist()):
-        lo = int(table.ptr[i])
-        if t == ROBOT and table.ptr[i + 1] > lo and move_op[lo] >= 0:
-            robots.append([[int(move_op[lo]), int(move_agent[lo])]])
+    for i, j in enumerate(table.instruction.tolist()):
+        lo = ptr[i]
+        if turns[i] == ROBOT and ptr[i + 1] > lo and ops[lo] >= 0:
+            robots.append([[ops[lo], agents[lo]]])
         else:
             robots.append([])
-        j = int(table.instruction[i])
-        instruction.append(None if j < 0 else [int(move_op[j]), int(move_agent[j])])
+        instruction.append(None if j < 0 else [ops[j], agents[j]])
     states.update(robots=robots, instruction=instruction)
     return {
         **_policy_head(dag, table, op_names, agent_names, states.pop("_tools")),
-        "states": {"node": [plain(dag.node_ids[v]) for v in table.node.tolist()], **states},
+        "states": {"node": _node_ids(dag, table.node), **states},
         "moves": {
-            "ptr": table.ptr.tolist(),
-            "operation": move_op.tolist(),
-            "agent": move_agent.tolist(),
+            "ptr": ptr,
+            "operation": ops,
+            "agent": agents,
             "cost": _numbers(move_cost),
             "next": table.next.tolist(),
         },
@@ -278,8 +306,51 @@ def _policy_head(dag, table, op_names, agent_names, tools, turn_model=None) -> d
     }
 
 
+def _node_ids(dag: GameDAG, nodes: np.ndarray) -> list:
+    """The original ids of the nodes ``nodes`` (JSON scalars)."""
+    ids = dag.node_ids
+    if isinstance(ids, range):
+        return (ids.start + nodes.astype(np.int64) * ids.step).tolist()
+    return [plain(ids[v]) for v in nodes.tolist()]
+
+
+def _labels_used(labels) -> list[str]:
+    """The distinct edge labels, in the order of their first edge (none: empty)."""
+    if labels is None:
+        return []
+    if not isinstance(labels, CodedLabels):
+        return list(dict.fromkeys(labels))
+    first: dict[int, int] = {}
+    step = 1 << 20
+    for lo in range(0, len(labels), step):
+        codes, at = np.unique(labels.codes[lo : lo + step], return_index=True)
+        for c, k in zip(codes.tolist(), at.tolist(), strict=True):
+            first.setdefault(c, lo + k)
+        if len(first) == len(labels.names):
+            break
+    return [labels.names[c] for c in sorted(first, key=first.__getitem__)]
+
+
+def _label_indices(labels, edges: np.ndarray, index: dict) -> np.ndarray:
+    """(k,) int64: ``index`` of the label of each edge of ``edges`` (-1: not in ``index``)."""
+    if isinstance(labels, CodedLabels):
+        table = np.array([index.get(name, -1) for name in labels.names], dtype=np.int64)
+        return table[labels.codes[edges]]
+    return np.array([index.get(labels[e], -1) for e in edges.tolist()], dtype=np.int64)
+
+
 def _state_columns(table: PolicyTable, describe, op_index: dict, agent_index: dict) -> dict:
     """``turn``, ``done``, ``tools``, ``running``, ``bound`` (and ``_tools``: tool -> values)."""
+    if isinstance(describe, AlternateStates) and not describe.has_tools:
+        n = table.node.size
+        return {
+            "turn": np.array(TURN_NAMES, dtype=object)[table.turn].tolist(),
+            "done": _done_masks(describe, table.node, op_index),
+            "tools": [[] for _ in range(n)],
+            "running": [[] for _ in range(n)],
+            "bound": _numbers(table.bound),
+            "_tools": {},
+        }
     tools: dict[str, list[str]] = {}
     done_col, tools_col, running_col = [], [], []
     cache: dict[int, tuple] = {}
@@ -309,6 +380,19 @@ def _state_columns(table: PolicyTable, describe, op_index: dict, agent_index: di
         "bound": _numbers(table.bound),
         "_tools": tools,
     }
+
+
+def _done_masks(describe: AlternateStates, nodes: np.ndarray, op_index: dict) -> list[str]:
+    """The hexadecimal done mask of each node of ``nodes`` (bit ``op_index[op]``: ``op``
+    done), as :func:`_state_columns` writes it, computed for many nodes at once."""
+    uniq, inverse = np.unique(nodes, return_inverse=True)
+    done = describe.done_matrix(uniq)
+    bit_of = np.array([op_index[op] for op in describe.op_ids], dtype=np.int64)
+    bits = np.zeros((uniq.size, max(op_index.values(), default=-1) + 1), dtype=bool)
+    bits[:, bit_of] = done  # an operation done at some node is always one of op_index
+    packed = np.packbits(bits, axis=1, bitorder="little")
+    texts = [format(int.from_bytes(row, "little"), "x") for row in map(bytes, packed)]
+    return [texts[k] for k in inverse.ravel().tolist()]
 
 
 def _concurrent_policy(game, solution: Solution, table: PolicyTable) -> dict:
@@ -370,7 +454,7 @@ def _concurrent_policy(game, solution: Solution, table: PolicyTable) -> dict:
             "ptr": table.ptr.tolist(),
             "starts": starts_col,
             "deviations": deviations,
-            "cost": _numbers(rules.move_costs(dag)[np.maximum(table.edge, 0)] * (table.edge >= 0)),
+            "cost": _numbers(rules.move_costs(dag, np.maximum(table.edge, 0)) * (table.edge >= 0)),
             "next": table.next.tolist(),
         },
     }
@@ -382,7 +466,7 @@ def _number(x: float):
 
 
 def _operation_names(dag: GameDAG, describe: StateDescriber | None) -> list[str]:
-    names = dict.fromkeys(op for op in (dag.operations or ()) if op)
+    names = dict.fromkeys(op for op in _labels_used(dag.operations) if op)
     if describe is not None:
         names.update(dict.fromkeys(describe(dag.end)["done"]))
     return list(names)

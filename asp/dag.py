@@ -5,6 +5,14 @@ Nodes are indexed ``0 .. n-1``; each keeps its original id (an int or a string) 
 ``indptr[v]:indptr[v+1]``, with their heads in ``targets``, their costs in ``costs`` and the
 side that may take them in ``sides``.
 
+The edge arrays are as narrow as they can be without changing a value (a game of an
+assembly has tens of millions of edges): ``targets`` are int32 while the node count is at
+most :data:`INT32_NODES` (so that a game state ``2 * node + player`` still fits), and
+``costs`` are float32 when every cost is exactly a float32 (1 per step, whole or binary
+fraction seconds), else float64 (:func:`index_dtype`, :func:`compact_costs`). Arithmetic on
+them in the solvers is done in float64 (a float32 widens exactly), so every result is the
+same as with int64/float64 arrays; :func:`asp.rules.move_costs` gives the costs as float64.
+
 The rules of play on it (who may take which edge, passes, the turn, the cost of a move) are
 :mod:`asp.rules`; the side codes ``ROBOT``, ``HUMAN`` and ``ANY`` come from there. On a
 synthetic DAG every edge is ``ANY``.
@@ -17,11 +25,15 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 import networkx as nx
+import numba
 import numpy as np
 
 from asp import rules
 from asp.errors import GraphError
 from asp.rules import ANY, HUMAN, PLAYERS, ROBOT, SIDE_NAMES, side_from_name
+
+INT32_NODES = 2**30
+"""Up to this many nodes, node indices (``targets``, ``sources``) are stored as int32."""
 
 MAX_COST = 1e12
 """Largest cost of one move (seconds or steps): sums over any path stay exact enough in
@@ -30,14 +42,18 @@ float64 and within CP-SAT's integers; larger numbers are refused when a DAG is b
 __all__ = [
     "ANY",
     "HUMAN",
+    "INT32_NODES",
     "MAX_COST",
     "PLAYERS",
     "ROBOT",
     "SIDE_NAMES",
     "GameDAG",
+    "compact_costs",
     "from_arrays",
     "from_edges",
     "from_networkx",
+    "index_dtype",
+    "ids_topological",
     "reachable",
     "side_from_name",
     "topological_order",
@@ -99,14 +115,17 @@ class GameDAG:
 
     Attributes
     ----------
-    node_ids : tuple, length n
-        The original id of each node (int or str).
+    node_ids : tuple or range, length n
+        The original id of each node (int or str); a ``range`` when the ids are the indices
+        (a game of an assembly: no tuple of millions of ints).
     indptr : (n + 1,) int64
         CSR row pointer: the out-edges of node ``v`` are ``indptr[v]:indptr[v + 1]``.
-    targets : (m,) int64
-        Head node index of each edge.
-    costs : (m,) float64
-        Cost of each edge (``>= 0``).
+    targets : (m,) int32 or int64
+        Head node index of each edge (:func:`index_dtype`: int32 up to
+        :data:`INT32_NODES` nodes).
+    costs : (m,) float32 or float64
+        Cost of each edge (``>= 0``; :func:`compact_costs`: float32 only when every cost is
+        exactly a float32, so a cost read from it is the cost given).
     sides : (m,) int8
         Who may take each edge: ``ROBOT``, ``HUMAN`` or ``ANY``.
     start, end : int
@@ -146,10 +165,19 @@ class GameDAG:
 
     @cached_property
     def sources(self) -> np.ndarray:
-        """(m,) int64, read-only: tail node index of each edge (computed once)."""
-        src = np.repeat(np.arange(self.n_nodes, dtype=np.int64), np.diff(self.indptr))
+        """(m,) int, read-only: tail node index of each edge (computed once and kept: on a
+        large game prefer :meth:`edge_sources` or a loop over ``indptr``). Same dtype as
+        ``targets``."""
+        index = np.arange(self.n_nodes, dtype=self.targets.dtype)
+        src = np.repeat(index, np.diff(self.indptr))
         src.flags.writeable = False
         return src
+
+    def edge_sources(self, edges) -> np.ndarray:
+        """Tail node index (int64) of each edge in ``edges`` (an index array), without
+        building :attr:`sources`."""
+        edges = np.asarray(edges, dtype=np.int64)
+        return np.searchsorted(self.indptr, edges, side="right").astype(np.int64) - 1
 
     def out_edges(self, v: int) -> range:
         """Edge indices leaving node ``v``."""
@@ -291,6 +319,49 @@ def _resolve(index: dict, nid, what: str) -> int:
     raise GraphError(f"{what} node {nid!r} is not in the graph")
 
 
+def index_dtype(n_nodes: int) -> type:
+    """The dtype of node indices of a DAG with ``n_nodes`` nodes: int32 up to
+    :data:`INT32_NODES` (``2 * node + 1`` then still fits), else int64."""
+    return np.int32 if n_nodes <= INT32_NODES else np.int64
+
+
+def compact_costs(costs: np.ndarray) -> np.ndarray:
+    """``costs`` as float32 when every value is exactly a float32, else as float64.
+
+    A float32 widens exactly to float64, so the solvers (which add in float64) give the
+    same numbers either way.
+    """
+    costs = np.asarray(costs)
+    if costs.dtype == np.float32:
+        return np.ascontiguousarray(costs)
+    costs = np.ascontiguousarray(costs, dtype=np.float64)
+    if _fits_float32(costs):
+        return costs.astype(np.float32)
+    return costs
+
+
+def _fits_float32(values: np.ndarray) -> bool:
+    step = 1 << 20
+    return all(
+        np.array_equal(chunk.astype(np.float32), chunk)
+        for chunk in (values[lo : lo + step] for lo in range(0, values.size, step))
+    )
+
+
+def ids_topological(dag: GameDAG) -> bool:
+    """Whether every edge goes from a lower to a higher node index (without :attr:`sources`)."""
+    return dag.n_edges == 0 or _ids_topological(dag.indptr, dag.targets)
+
+
+@numba.njit(cache=True)
+def _ids_topological(indptr, targets):  # pragma: no cover - compiled
+    for v in range(indptr.shape[0] - 1):
+        for e in range(indptr[v], indptr[v + 1]):
+            if targets[e] <= v:
+                return False
+    return True
+
+
 def from_arrays(
     node_ids: Sequence,
     src: np.ndarray,
@@ -312,20 +383,24 @@ def from_arrays(
     Parameters
     ----------
     node_ids : sequence, length n
+        A ``range`` is kept as it is; anything else becomes a tuple.
     src, dst : (m,) int
         Tail and head node index of each edge. Edges are stably sorted by tail.
     costs : (m,) float, optional (default 1)
     sides : (m,) int8, optional (default ``ANY``)
+
+    The DAG's ``targets`` and ``costs`` are stored narrow when that loses nothing
+    (:func:`index_dtype`, :func:`compact_costs`).
     """
     n = len(node_ids)
     if n == 0:
         raise GraphError("empty graph: expected at least one node")
-    src = np.asarray(src, dtype=np.int64)
-    dst = np.asarray(dst, dtype=np.int64)
+    src = _indices(src)
+    dst = _indices(dst)
     m = src.shape[0]
     if dst.shape != (m,):
         raise GraphError(f"src and dst: expected equal lengths, got {m} and {dst.shape[0]}")
-    costs = np.ones(m) if costs is None else np.asarray(costs, dtype=np.float64)
+    costs = np.ones(m, np.float32) if costs is None else compact_costs(costs)
     sides = np.full(m, ANY, np.int8) if sides is None else np.asarray(sides, dtype=np.int8)
     if m and (min(src.min(), dst.min()) < 0 or max(src.max(), dst.max()) >= n):
         raise GraphError(f"edge endpoints: expected node indices in [0, {n}), got out of range")
@@ -335,6 +410,7 @@ def from_arrays(
         operations, agents = (_reorder(x, order) for x in (operations, agents))
     indptr = np.zeros(n + 1, dtype=np.int64)
     np.cumsum(np.bincount(src, minlength=n), out=indptr[1:])
+    del src
     if start is None:
         start = _unique_node(
             np.flatnonzero(np.bincount(dst, minlength=n) == 0), node_ids, "start", "in-edges"
@@ -342,9 +418,9 @@ def from_arrays(
     if end is None:
         end = _unique_node(np.flatnonzero(np.diff(indptr) == 0), node_ids, "end", "out-edges")
     dag = GameDAG(
-        node_ids=tuple(node_ids),
+        node_ids=node_ids if isinstance(node_ids, range) else tuple(node_ids),
         indptr=indptr,
-        targets=dst,
+        targets=np.ascontiguousarray(dst, dtype=index_dtype(n)),
         costs=costs,
         sides=sides,
         start=int(start),
@@ -358,6 +434,12 @@ def from_arrays(
     if validate:
         validate_dag(dag)
     return dag
+
+
+def _indices(x) -> np.ndarray:
+    """An index array as given (any integer dtype), else as int64."""
+    x = np.asarray(x)
+    return x if x.dtype.kind in "iu" else x.astype(np.int64)
 
 
 def _reorder(labels, order: np.ndarray):

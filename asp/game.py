@@ -11,10 +11,11 @@ passes) is the solver's business (:mod:`asp.solve`).
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 
 from asp import rules
-from asp.dag import ANY, HUMAN, ROBOT, CodedLabels, GameDAG, from_arrays
+from asp.dag import ANY, HUMAN, ROBOT, CodedLabels, GameDAG, index_dtype
 from asp.errors import GameError
 from asp.state_graph import StateGraph
 
@@ -59,44 +60,35 @@ def game_dag(
     done = graph.complete
     # New index: alive states in order, complete ones merged into the last index.
     keep = alive & ~done
-    new_id = np.full(graph.n_states, -1, dtype=np.int64)
     n_inner = int(keep.sum())
-    new_id[keep] = np.arange(n_inner)
-    new_id[done] = n_inner
     n = n_inner + 1
-    edge_ok = keep[graph.src] & alive[graph.dst]
-    e_src = graph.src[edge_ok]
-    e_dst = graph.dst[edge_ok]
-    e_op = graph.op[edge_ok].astype(np.int64)
+    index = index_dtype(n)
+    new_id = np.full(graph.n_states, -1, dtype=index)
+    new_id[keep] = np.arange(n_inner, dtype=index)
+    new_id[done] = n_inner
+    del done
 
-    # One edge per (transition, allowed agent).
+    # One edge per (transition, allowed agent), written straight into the CSR arrays (the
+    # transitions are sorted by source and ``new_id`` keeps their order).
     ops = spec.operations
     agent_names = [a.name for a in spec.agents]
     agent_side = np.array([_SIDE_CODE[a.side] for a in spec.agents], dtype=np.int8)
     per_op = np.array([len(op.durations) for op in ops], dtype=np.int64)
     op_first = np.concatenate([[0], np.cumsum(per_op)])
+    agent_code = np.int8 if len(agent_names) <= np.iinfo(np.int8).max else np.int16
     flat_agent = np.array(
-        [agent_names.index(a) for op in ops for a, _ in op.durations], dtype=np.int64
+        [agent_names.index(a) for op in ops for a, _ in op.durations], dtype=agent_code
     )
     flat_time = np.array([d for op in ops for _, d in op.durations], dtype=np.float64)
-    if np.all(per_op == 1):  # one agent per operation: one edge per transition
-        base = slice(None)
-        slot = e_op
-    else:
-        reps = per_op[e_op]
-        base = np.repeat(np.arange(e_op.shape[0]), reps)
-        within = np.arange(base.shape[0]) - np.repeat(np.cumsum(reps) - reps, reps)
-        slot = op_first[e_op[base]] + within
-    agent_idx = flat_agent[slot].astype(np.int16)
-    sides = agent_side[agent_idx]
-    costs = np.ones(slot.shape[0]) if cost == "steps" else flat_time[slot]
-    del slot
+    if cost == "steps":
+        flat_time = np.ones_like(flat_time)
+    extra = np.zeros(0)
     if cost != "steps" and model.tool_names:
-        change = np.array([spec.tool(t).change_time for t in model.tool_names])
-        changed = model.tool_changes(graph.keys[e_src], e_op)
-        costs += (changed @ change)[base]
-    src = new_id[e_src][base]
-    dst = new_id[e_dst][base]
+        extra = _tool_change_costs(graph, keep, alive)
+    indptr, targets, costs, sides, op_codes, agent_idx, ordered = _build_edges(
+        graph, keep, alive, new_id, n, per_op, op_first, flat_agent, flat_time, agent_side, extra
+    )
+    del new_id, extra
     if labels is None:
         labels = n <= LABEL_LIMIT
     node_labels = None
@@ -119,20 +111,125 @@ def game_dag(
     meta.update(metadata or {})
     if not alive[0]:
         raise GameError(f"{spec.source}: no complete sequence: the game has no path to the end")
-    if src.size and not (np.all(src < dst) and np.all(np.isfinite(costs)) and costs.min() >= 0):
+    if not ordered:
         raise GameError(f"{spec.source}: internal: the game DAG is not in topological order")
-    return from_arrays(
-        list(range(n)),
-        src,
-        dst,
-        costs,
-        sides,
+    if costs.size and not (np.all(np.isfinite(costs)) and costs.min() >= 0):
+        raise GameError(f"{spec.source}: internal: a move has a negative or non-finite cost")
+    # Built as a DAG in topological order (checked above): no validation pass needed.
+    return GameDAG(
+        node_ids=range(n),
+        indptr=indptr,
+        targets=targets,
+        costs=costs,
+        sides=sides,
         start=0,
         end=n - 1,
-        operations=CodedLabels(e_op.astype(np.int16)[base], spec.op_ids),
+        operations=CodedLabels(op_codes, spec.op_ids),
         agents=CodedLabels(agent_idx, agent_names),
         node_labels=node_labels,
         cost_model=cost,
         metadata=meta,
-        validate=False,  # checked below: the construction makes it a DAG in topological order
     )
+
+
+def _tool_change_costs(graph: StateGraph, keep: np.ndarray, alive: np.ndarray) -> np.ndarray:
+    """(E,) float64: per transition, the change time of every tool its operation changes
+    (0 for the transitions the game drops); computed in chunks of transitions."""
+    spec, model = graph.spec, graph.model
+    change = np.array([spec.tool(t).change_time for t in model.tool_names])
+    out = np.zeros(graph.n_transitions)
+    step = 1 << 20
+    for lo in range(0, graph.n_transitions, step):
+        src, dst = graph.src[lo : lo + step], graph.dst[lo : lo + step]
+        ok = np.flatnonzero(keep[src] & alive[dst])
+        if ok.size:
+            changed = model.tool_changes(graph.keys[src[ok]], graph.op[lo : lo + step][ok])
+            out[lo + ok] = changed @ change
+    return out
+
+
+def _build_edges(
+    graph, keep, alive, new_id, n, per_op, op_first, flat_agent, flat_time, side, extra
+):
+    """The game's CSR arrays: ``indptr, targets, costs, sides, operation codes, agent codes``
+    and whether every edge goes to a higher node index.
+
+    Costs are float32 when every one is exactly a float32 (:func:`asp.dag.compact_costs`),
+    else float64: built as float32 first, again as float64 when one is not exact.
+    """
+    counts = _edge_counts(graph.src, graph.dst, graph.op, keep, alive, new_id, per_op, n)
+    indptr = np.zeros(n + 1, dtype=np.int64)
+    np.cumsum(counts, out=indptr[1:])
+    del counts
+    m = int(indptr[-1])
+    tables = (graph.src, graph.dst, graph.op, keep, alive, new_id, op_first, flat_agent)
+    for cost_type in (np.float32, np.float64):
+        arrays = (
+            np.empty(m, new_id.dtype),
+            np.empty(m, cost_type),
+            np.empty(m, np.int8),
+            np.empty(m, np.int16),
+            np.empty(m, flat_agent.dtype),
+        )
+        exact, ordered = _fill_edges(*tables, flat_time, side, extra, *arrays)
+        if exact:
+            return (indptr, *arrays, ordered)
+        del arrays
+    raise AssertionError("unreachable: float64 costs are exact")
+
+
+@numba.njit(cache=True)
+def _edge_counts(src, dst, op, keep, alive, new_id, per_op, n):  # pragma: no cover - compiled
+    counts = np.zeros(n, np.int64)
+    for t in range(src.shape[0]):
+        s = src[t]
+        if keep[s] and alive[dst[t]]:
+            counts[new_id[s]] += per_op[op[t]]
+    return counts
+
+
+@numba.njit(cache=True)
+def _fill_edges(
+    src,
+    dst,
+    op,
+    keep,
+    alive,
+    new_id,
+    op_first,
+    flat_agent,
+    flat_time,
+    side,
+    extra,
+    targets,
+    costs,
+    sides,
+    op_codes,
+    agent_codes,
+):  # pragma: no cover - compiled
+    k = 0
+    exact = True
+    ordered = True
+    has_extra = extra.shape[0] > 0
+    for t in range(src.shape[0]):
+        s = src[t]
+        if not (keep[s] and alive[dst[t]]):
+            continue
+        o = op[t]
+        head = new_id[dst[t]]
+        if head <= new_id[s]:
+            ordered = False
+        for slot in range(op_first[o], op_first[o + 1]):
+            c = flat_time[slot]
+            if has_extra:
+                c = c + extra[t]
+            costs[k] = c
+            if costs[k] != c:
+                exact = False
+            targets[k] = head
+            a = flat_agent[slot]
+            agent_codes[k] = a
+            sides[k] = side[a]
+            op_codes[k] = o
+            k += 1
+    return exact, ordered

@@ -48,7 +48,7 @@ def fast_greedy_policy(dag: GameDAG, solution: Solution) -> np.ndarray:
     if ok.size == 0:
         return policy
     src = dag.sources[ok]
-    val = np.round(rules.move_costs(dag)[ok] + solution.coop[dag.targets[ok], HUMAN], 9)
+    val = np.round(rules.move_costs(dag, ok) + solution.coop[dag.targets[ok], HUMAN], 9)
     order = np.lexsort((ok, val, src))
     first = np.ones(order.size, dtype=bool)
     first[1:] = src[order][1:] != src[order][:-1]

@@ -106,18 +106,23 @@ def cost_at_most(a, b, tol: float = COST_TOL):
     return np.less_equal(a, b) | costs_close(a, b, tol)
 
 
-def move_costs(dag) -> np.ndarray:
-    """(m,) float64: the cost of taking each edge, in the DAG's cost model.
+def move_costs(dag, edges=None) -> np.ndarray:
+    """(m,) float64: the cost of taking each edge (or each of ``edges``, an index array),
+    in the DAG's cost model.
 
     The edge's cost under both ``steps`` and ``time``: a ``steps`` DAG says 1 per move
-    unless its file gives other costs, and then the game is played on those.
+    unless its file gives other costs, and then the game is played on those. A DAG may
+    store its costs as float32 (:func:`asp.dag.compact_costs`, exact): they are widened
+    here (a copy; pass ``edges`` to widen only those); the compiled kernels take them as
+    stored (:func:`kernel_tables`).
     """
-    return dag.costs
+    costs = dag.costs if edges is None else dag.costs[edges]
+    return np.asarray(costs, dtype=np.float64)
 
 
 def move_cost(dag, edge: int) -> float:
     """The cost of taking ``edge`` (:data:`PASS_COST` for :data:`PASS`)."""
-    return PASS_COST if edge == PASS else float(move_costs(dag)[edge])
+    return PASS_COST if edge == PASS else float(dag.costs[edge])
 
 
 # ----------------------------------------------------------------------- moves
@@ -224,10 +229,11 @@ class KernelTables:
     ----------
     indptr : (n + 1,) int64
         CSR row pointer of out-edges.
-    targets : (m,) int64
-        Head of each edge (the next node).
-    cost : (m,) float64
-        Cost of each move (:func:`move_costs`).
+    targets : (m,) int32 or int64
+        Head of each edge (the next node), as the DAG stores it.
+    cost : (m,) float32 or float64
+        Cost of each move (:func:`move_costs`) as the DAG stores it (float32 only when
+        exact); the kernels add costs in float64.
     may : (2, m) bool
         ``may[player, edge]`` (:func:`move_masks`).
     tol : float
@@ -246,7 +252,7 @@ def kernel_tables(dag) -> KernelTables:
     return KernelTables(
         indptr=dag.indptr,
         targets=dag.targets,
-        cost=np.ascontiguousarray(move_costs(dag), dtype=np.float64),
+        cost=np.ascontiguousarray(dag.costs),
         may=move_masks(dag),
         tol=COST_TOL,
     )

@@ -106,7 +106,9 @@ def layer_counts(dag: GameDAG) -> tuple[np.ndarray, np.ndarray]:
     layer = node_layers(dag)
     n_layers = int(layer.max()) + 1
     nodes = np.bincount(layer, minlength=n_layers)
-    edges = np.bincount(layer[dag.sources], minlength=n_layers) if dag.n_edges else nodes * 0
+    # Edges leaving a layer: the out-degrees of its nodes (no per-edge array).
+    degree = np.diff(dag.indptr)
+    edges = np.bincount(layer, weights=degree, minlength=n_layers).round().astype(np.int64)
     return nodes.astype(np.int64), edges.astype(np.int64)
 
 
@@ -145,7 +147,7 @@ def plot_layers(
         )
     if highlight:
         hl = np.asarray(highlight, dtype=np.int64)
-        layers = np.unique(np.concatenate([layer[dag.sources[hl]], layer[dag.targets[hl]]]))
+        layers = np.unique(np.concatenate([layer[dag.edge_sources(hl)], layer[dag.targets[hl]]]))
         ax.scatter(layers, nodes[layers], s=30, c="#d62728", zorder=4, label="robust plan")
     ax.set_xlabel("layer (longest path from the start)")
     ax.set_ylabel("count (log)")
