@@ -148,3 +148,19 @@ def test_a_die_set_without_product_tree_finds_its_upper_half(tmp_path):
     spaces = {w["id"]: w for w in plan["workspaces"]}
     assert spaces[uid]["gravity"] == "+z" and spaces[uid]["parts"][0] == "top_plate"
     assert plan["line_check"] == {"robust_plan": None, "worst_line": None}
+
+
+def test_a_half_that_stands_right_side_up_is_not_turned(tmp_path):
+    """The die block with its screws from above needs no hold right side up (the heads
+    rest in the counterbores); upside down a screw would fall out: it stays."""
+    from cad import Assembly
+    from tests.cad.test_loading import write_folder
+
+    source = write_folder(tmp_path / "die_set", Assembly.from_meshes(die_set()))
+    assembly = pipeline.load(source, on_step=lambda _: None)
+    lower = ("die_block", "screw_1", "screw_2")
+    spec = with_subassemblies(assembly.spec, [("lower", lower)])
+    o = unit_orientation(spec, assembly.relations, "lower")
+    assert (o.gravity, o.upside_down, o.held) == ("-z", False, ())
+    assert o.held_other == 1
+    assert orient_units(spec, assembly.relations) == spec
