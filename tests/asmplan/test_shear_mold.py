@@ -164,3 +164,19 @@ def test_a_half_that_stands_right_side_up_is_not_turned(tmp_path):
     assert (o.gravity, o.upside_down, o.held) == ("-z", False, ())
     assert o.held_other == 1
     assert orient_units(spec, assembly.relations) == spec
+
+
+def test_init_writes_the_upside_down_build_and_the_spec_reads_it(tmp_path):
+    from asp.spec import load_spec
+
+    source = die_set_glb(tmp_path)
+    spec_path = tmp_path / "assembly.yaml"
+    result = CliRunner().invoke(app, ["init", str(source), "-o", str(spec_path)])
+    assert result.exit_code == 0, result.output
+    text = spec_path.read_text()
+    assert "upper_die_set: {parts: [" in text and "gravity: +y, held: true}" in text
+    spec = load_spec(spec_path)
+    assert spec.unit_gravity == (("upper_die_set", "+y"),)
+    assert spec.operation("upper_die_set").held
+    plan = plan_and_check(spec_path, tmp_path / "out", "--time-limit", "5")
+    assert {w["id"]: w["gravity"] for w in plan["workspaces"]}["upper_die_set"] == "+y"
