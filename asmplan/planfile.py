@@ -762,15 +762,25 @@ def _opposite(direction: str) -> str:
 
 
 def geometry_record(spec, relations) -> dict | None:
-    """The length unit, scale, frame and tolerances of the geometry (None without it).
+    """The length unit, scale, frame, tolerances and mesh rules of the geometry (None
+    without it): what a checker replaying a line from the meshes alone needs.
 
     Coordinates are the source file's own frame (its node transforms applied, no axis
     changed) times ``scale`` (millimetres per file unit; null when the files declare
     different units); tolerances are in millimetres; a pair ``(i, j)`` tolerates an
-    overlap of ``part_shrink[i] + part_shrink[j]`` (:mod:`cad.tolerances`).
+    overlap of ``part_shrink[i] + part_shrink[j]`` (:mod:`cad.tolerances`), and counts a
+    gap of ``min(contact_reach[i], contact_reach[j])`` as touching (``contact_tol`` for
+    every pair when ``contact_reach`` is null). ``merge_vertices``: each mesh's coincident
+    vertices are merged before anything (a STEP or 3DXML tessellation gives every face its
+    own vertices; eroding such a mesh leaves its edges where they were). ``erosion``: how a
+    part is shrunk. ``fits``: pairs whose inner part is shrunk further for that pair only
+    (:mod:`cad.fits`). ``support_travel_factor``: a part is supported if a fall of that
+    many times the pair's tolerance meets a part below (:mod:`cad.support`).
+    ``open_parts``: parts not closed after merging (their relations are approximate).
     """
     if relations is None:
         return None
+    from cad.relations import replay_rules
     from cad.units import unit_scale
 
     file_unit = str(getattr(relations, "units", "mm"))
@@ -789,6 +799,7 @@ def geometry_record(spec, relations) -> dict | None:
         "contact_tol": float(relations.contact_tol),
         "penetration_tol": float(relations.penetration_tol),
         "part_shrink": dict(zip(map(str, relations.parts), map(float, shrink), strict=True)),
+        **replay_rules(relations),
     }
 
 

@@ -14,7 +14,7 @@ from cad.errors import GeometryError
 from cad.fits import find_fits
 from cad.freedom import eroded_meshes
 from cad.freedom import translational_freedom as _freedom
-from cad.support import support_relation
+from cad.support import SUPPORT_TRAVEL_FACTOR, support_relation
 from cad.tolerances import resolve_tolerances
 
 
@@ -37,6 +37,13 @@ class Relations:
         given); pair ``(i, j)`` tolerates ``part_shrink[i] + part_shrink[j]``.
     part_shrink : tuple[float, ...]
         Shrink of each part in mm (:mod:`cad.tolerances`).
+    part_reach : tuple[float, ...]
+        Contact reach of each part in mm: pair ``(i, j)`` counts a gap of up to
+        ``min(part_reach[i], part_reach[j])`` as touching; empty when ``contact_tol``
+        applies to every pair (an explicit contact tolerance).
+    open_parts : tuple[str, ...]
+        Parts whose mesh is not closed (watertight) after its duplicate vertices were
+        merged: their erosion, and so their relations, are approximate.
     units : str
         Source length unit of the assembly (tables do not depend on it).
     directions : tuple[str, ...]
@@ -56,6 +63,8 @@ class Relations:
     penetration_tol: float = 0.0
     units: str = "mm"
     part_shrink: tuple[float, ...] = ()
+    part_reach: tuple[float, ...] = ()
+    open_parts: tuple[str, ...] = ()
     directions: tuple[str, ...] = DIRECTIONS
     sp: np.ndarray | None = None
     fits: tuple[tuple[str, str, float], ...] = ()
@@ -93,6 +102,7 @@ class Relations:
             "contact_tol_mm": self.contact_tol,
             "penetration_tol_mm": self.penetration_tol,
             "part_shrink_mm": list(self.part_shrink),
+            **({} if not self.part_reach else {"part_reach_mm": list(self.part_reach)}),
             "tc": self.tc.tolist(),
             "tt": self.tt.tolist(),
             **({} if self.sp is None else {"sp": self.sp.tolist()}),
@@ -150,9 +160,38 @@ def compute_relations(
         penetration_tol=tols.penetration,
         units=assembly.units,
         part_shrink=tuple(float(x) for x in tols.shrink),
+        part_reach=() if tols.reach is None else tuple(float(x) for x in tols.reach),
+        open_parts=tuple(p.id for p in assembly.parts if not p.mesh.is_watertight),
         sp=sp,
-        fits=tuple((ids[f.inner], ids[f.outer], round(float(f.extra), 4)) for f in fits),
+        fits=tuple((ids[f.inner], ids[f.outer], _up(float(f.extra))) for f in fits),
     )
+
+
+def replay_rules(relations: Relations) -> dict:
+    """How the relations treat the meshes, for a checker replaying a plan from them alone.
+
+    Returns
+    -------
+    dict
+        ``merge_vertices`` (true: coincident vertices of each mesh are merged first),
+        ``erosion`` (how a part is shrunk by its ``part_shrink``), ``contact_reach``
+        (part -> mm, or None when ``contact_tol`` holds for every pair),
+        ``support_travel_factor``, ``fits`` (``inner, outer, extra_shrink`` mm: the inner
+        part is shrunk by that much more against the outer one only) and ``open_parts``.
+    """
+    ids = [str(p) for p in relations.parts]
+    reach = tuple(getattr(relations, "part_reach", ()))
+    return {
+        "merge_vertices": True,
+        "erosion": "face_planes",
+        "contact_reach": dict(zip(ids, map(float, reach), strict=True)) if reach else None,
+        "support_travel_factor": SUPPORT_TRAVEL_FACTOR,
+        "fits": [
+            {"inner": str(i), "outer": str(o), "extra_shrink": float(e)}
+            for i, o, e in getattr(relations, "fits", ())
+        ],
+        "open_parts": [str(p) for p in getattr(relations, "open_parts", ())],
+    }
 
 
 def _indices(
@@ -182,3 +221,8 @@ def tt_set(relations: Relations, p: str | int, S: Iterable[str | int]) -> np.nda
 def rtt(relations: Relations, p: str | int, S: Iterable[str | int]) -> bool:
     """Eq. 5: ``RTT(p, S) = OR_d TT_d(p, S)`` (some straight direction is free)."""
     return bool(tt_set(relations, p, S).any())
+
+
+def _up(mm: float) -> float:
+    """``mm`` rounded up to 0.1 micrometre (a fit's extra shrink, never below the one used)."""
+    return float(np.ceil(mm * 1e4) / 1e4)

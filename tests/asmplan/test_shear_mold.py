@@ -21,7 +21,7 @@ from asp.checker import PlanCheckError, check_line, plan_operations
 from asp.orientation import opposite, orient_units, unit_orientation
 from asp.spec import with_subassemblies
 from tests.asmplan.checked import plan_and_check
-from tests.asmplan.test_plan_replay import replayed
+from tests.asmplan.mesh_replay import replayed
 from tests.cad.real_shapes import die_set
 from tests.cad.test_subassemblies import write_glb
 

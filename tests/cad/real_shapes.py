@@ -70,6 +70,14 @@ def revolve(profile, sections: int) -> trimesh.Trimesh:
     )
 
 
+def unmerged(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+    """``mesh`` as STEP and 3DXML exports tessellate it: no vertex shared between faces
+    (here every triangle has its own three), so as read it is not watertight and a
+    vertex-normal erosion would leave every edge where it was."""
+    corners = np.asarray(mesh.triangles, dtype=float).reshape(-1, 3)
+    return trimesh.Trimesh(corners, np.arange(len(corners)).reshape(-1, 3), process=False)
+
+
 def _seg(n: float, detail: float) -> int:
     return max(3, int(round(n * detail)))
 
