@@ -555,10 +555,9 @@ def _hierarchy_lines(data: dict, assembly, relations, spec_folder, decide) -> li
 
 def _unit_ways(spec, relations, used) -> tuple[dict[str, str], set[str]]:
     """For the used units: those built upside down (unit id -> the gravity of its
-    workspace, :mod:`asp.orientation`) and those held while inserted
-    (:func:`asp.units.hold_unsupported_units`), as the planner decides them."""
-    from asp.orientation import unit_orientation
-    from asp.units import hold_unsupported_units
+    workspace) and those held while inserted (:func:`asp.orientation.loose_units`), as the
+    planner decides them."""
+    from asp.orientation import loose_units, unit_orientation
 
     if relations is None or getattr(relations, "sp", None) is None or not used:
         return {}, set()
@@ -571,8 +570,7 @@ def _unit_ways(spec, relations, used) -> tuple[dict[str, str], set[str]]:
         o = unit_orientation(with_units, relations, u.id)
         if o.upside_down:
             turned[u.id] = o.gravity
-    held = hold_unsupported_units(replace(with_units, generated=True), relations)
-    return turned, {op.unit for op in held.operations if op.unit and op.held}
+    return turned, loose_units(with_units, relations)
 
 
 def _tolerance_line(key: str, value: float | None, meaning: str) -> str:

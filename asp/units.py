@@ -185,22 +185,11 @@ def hold_unsupported_units(spec: AssemblySpec, relations) -> AssemblySpec:
     :func:`asp.generate.hold_unsupported` does for single parts; other specs unchanged."""
     if not spec.generated or not spec.constraints.stability or relations is None:
         return spec
-    sp = getattr(relations, "sp", None)
-    if sp is None:
-        return spec
     from dataclasses import replace
 
-    from asp.spec import DIRECTIONS
+    from asp.orientation import loose_units
 
-    index = {str(p): k for k, p in enumerate(relations.parts)}
-    rests = np.asarray(sp, dtype=bool)[:, :, DIRECTIONS.index(spec.gravity)]
-    loose = set()
-    for uid, members in spec.subassemblies:
-        rows = [index[m] for m in members if m in index]
-        outside = np.ones(len(index), dtype=bool)
-        outside[rows] = False
-        if rows and not rests[np.ix_(rows, np.flatnonzero(outside))].any():
-            loose.add(uid)
+    loose = loose_units(spec, relations)
     if not loose:
         return spec
     ops = [replace(op, held=True) if op.unit in loose else op for op in spec.operations]
