@@ -163,7 +163,8 @@ def policy_table(dag: GameDAG, solution: Solution) -> PolicyTable:
         t.indptr,
         t.targets,
         t.cost,
-        t.may,
+        t.sides,
+        t.may_side,
         t.tol,
         policy,
         nodes,
@@ -186,7 +187,7 @@ def policy_table(dag: GameDAG, solution: Solution) -> PolicyTable:
 
 @numba.njit(cache=True)
 def _moves_kernel(
-    indptr, targets, costs, may, tol, policy, nodes, turns, index, value, coop, end
+    indptr, targets, costs, sides, may_side, tol, policy, nodes, turns, index, value, coop, end
 ):  # pragma: no cover - compiled
     s_count = nodes.shape[0]
     ptr = np.zeros(s_count + 1, np.int64)
@@ -198,7 +199,7 @@ def _moves_kernel(
                 k = 1
             else:
                 for e in range(indptr[v], indptr[v + 1]):
-                    if may[HUMAN, e]:
+                    if may_side[sides[e], HUMAN]:
                         k += 1
                 k = max(k, 1)
         ptr[i + 1] = ptr[i] + k
@@ -217,7 +218,7 @@ def _moves_kernel(
             continue
         best, best_coop = np.inf, np.inf
         for e in range(indptr[v], indptr[v + 1]):
-            if may[HUMAN, e]:
+            if may_side[sides[e], HUMAN]:
                 t = targets[e]
                 edge[j] = e
                 nxt[j] = index[t, ROBOT]

@@ -75,7 +75,7 @@ def game_dag(
     agent_side = np.array([_SIDE_CODE[a.side] for a in spec.agents], dtype=np.int8)
     per_op = np.array([len(op.durations) for op in ops], dtype=np.int64)
     op_first = np.concatenate([[0], np.cumsum(per_op)])
-    agent_code = np.int8 if len(agent_names) <= np.iinfo(np.int8).max else np.int16
+    agent_code = _code_type(len(agent_names))
     flat_agent = np.array(
         [agent_names.index(a) for op in ops for a, _ in op.durations], dtype=agent_code
     )
@@ -132,6 +132,11 @@ def game_dag(
     )
 
 
+def _code_type(n_names: int) -> type:
+    """The narrowest integer type of a code into ``n_names`` names (int8 or int16)."""
+    return np.int8 if n_names <= np.iinfo(np.int8).max else np.int16
+
+
 def _tool_change_costs(graph: StateGraph, keep: np.ndarray, alive: np.ndarray) -> np.ndarray:
     """(E,) float64: per transition, the change time of every tool its operation changes
     (0 for the transitions the game drops); computed in chunks of transitions."""
@@ -168,7 +173,7 @@ def _build_edges(
             np.empty(m, new_id.dtype),
             np.empty(m, cost_type),
             np.empty(m, np.int8),
-            np.empty(m, np.int16),
+            np.empty(m, _code_type(len(graph.spec.operations))),
             np.empty(m, flat_agent.dtype),
         )
         exact, ordered = _fill_edges(*tables, flat_time, side, extra, *arrays)

@@ -234,8 +234,12 @@ class KernelTables:
     cost : (m,) float32 or float64
         Cost of each move (:func:`move_costs`) as the DAG stores it (float32 only when
         exact); the kernels add costs in float64.
-    may : (2, m) bool
-        ``may[player, edge]`` (:func:`move_masks`).
+    sides : (m,) int8
+        The side of each edge.
+    may_side : (3, 2) bool
+        ``may_side[side, player]``: whether ``player`` may take an edge of ``side``
+        (:func:`may_take`); a kernel asks ``may_side[sides[e], player]`` (no per-edge
+        table of a large game's size).
     tol : float
         Cost tolerance (:data:`COST_TOL`).
     """
@@ -243,8 +247,20 @@ class KernelTables:
     indptr: np.ndarray
     targets: np.ndarray
     cost: np.ndarray
-    may: np.ndarray
+    sides: np.ndarray
+    may_side: np.ndarray
     tol: float
+
+    @property
+    def may(self) -> np.ndarray:
+        """(2, m) bool: ``may[player, edge]`` (:func:`move_masks`; built on each call)."""
+        return self.may_side[self.sides.astype(np.intp)].T.copy()
+
+
+def side_table() -> np.ndarray:
+    """(3, 2) bool: ``[side, player]``, whether ``player`` may take an edge of ``side``."""
+    sides = np.arange(len(SIDE_NAMES))[:, None]
+    return np.asarray(may_take(sides, np.array(PLAYERS)[None, :]), dtype=bool)
 
 
 def kernel_tables(dag) -> KernelTables:
@@ -253,13 +269,14 @@ def kernel_tables(dag) -> KernelTables:
         indptr=dag.indptr,
         targets=dag.targets,
         cost=np.ascontiguousarray(dag.costs),
-        may=move_masks(dag),
+        sides=np.ascontiguousarray(dag.sides, dtype=np.int8),
+        may_side=side_table(),
         tol=COST_TOL,
     )
 
 
 @numba.njit(cache=True)
-def _reachable_kernel(indptr, targets, may, policy, start, end):  # pragma: no cover
+def _reachable_kernel(indptr, targets, sides, may_side, policy, start, end):  # pragma: no cover
     n = indptr.shape[0] - 1
     seen = np.zeros((n, 2), np.bool_)
     stack_v = np.empty(2 * n + 2, np.int64)
@@ -274,7 +291,7 @@ def _reachable_kernel(indptr, targets, may, policy, start, end):  # pragma: no c
             continue
         moved = False
         for e in range(indptr[v], indptr[v + 1]):
-            if not may[p, e]:
+            if not may_side[sides[e], p]:
                 continue
             moved = True
             if p == ROBOT and e != policy[v]:
@@ -296,7 +313,7 @@ def reachable_states(dag, robot_policy: np.ndarray) -> np.ndarray:
     against any human (the end node's states included)."""
     t = kernel_tables(dag)
     policy = np.asarray(robot_policy, dtype=np.int64)
-    return _reachable_kernel(t.indptr, t.targets, t.may, policy, dag.start, dag.end)
+    return _reachable_kernel(t.indptr, t.targets, t.sides, t.may_side, policy, dag.start, dag.end)
 
 
 __all__ = [
@@ -331,5 +348,6 @@ __all__ = [
     "reachable_states",
     "settle",
     "side_from_name",
+    "side_table",
     "step",
 ]

@@ -74,7 +74,7 @@ def solve(dag: GameDAG) -> Solution:
     """Solve the game exactly: TCT, W*, the robust robot policy and the human's best reply."""
     t = rules.kernel_tables(dag)
     value, coop, expected, robot, human = _solve_kernel(
-        t.indptr, t.targets, t.cost, t.may, node_order(dag), t.tol
+        t.indptr, t.targets, t.cost, t.sides, t.may_side, node_order(dag), t.tol
     )
     return Solution(
         tct=float(coop[dag.start, ROBOT]),
@@ -127,7 +127,7 @@ def evaluate_policy(dag: GameDAG, robot_policy: np.ndarray | Mapping) -> PolicyE
     policy = as_policy_array(dag, robot_policy)
     t = rules.kernel_tables(dag)
     worst, expected, best, reply = _evaluate_kernel(
-        t.indptr, t.targets, t.cost, t.may, node_order(dag), policy, t.tol
+        t.indptr, t.targets, t.cost, t.sides, t.may_side, node_order(dag), policy, t.tol
     )
     bad = _first_invalid_state(dag, policy, worst)
     if bad >= 0:
@@ -213,7 +213,9 @@ def robust_path(dag: GameDAG, solution: Solution) -> list:
 
 
 @numba.njit(cache=True)
-def _solve_kernel(indptr, targets, costs, may, order, tol):  # pragma: no cover - compiled
+def _solve_kernel(
+    indptr, targets, costs, sides, may_side, order, tol
+):  # pragma: no cover - compiled
     n = indptr.shape[0] - 1
     value = np.zeros((n, 2))
     coop = np.zeros((n, 2))
@@ -232,7 +234,7 @@ def _solve_kernel(indptr, targets, costs, may, order, tol):  # pragma: no cover 
         for e in range(lo, hi):
             t = targets[e]
             c = costs[e]
-            if may[ROBOT, e]:
+            if may_side[sides[e], ROBOT]:
                 val = c + value[t, HUMAN]
                 ex = c + expected[t, HUMAN]
                 better = r_arg < 0 or (val < r_val and not _close(val, r_val, tol))
@@ -240,7 +242,7 @@ def _solve_kernel(indptr, targets, costs, may, order, tol):  # pragma: no cover 
                 if better or tie_better:
                     r_val, r_exp, r_arg = val, ex, e
                 r_coop = min(r_coop, c + coop[t, HUMAN])
-            if may[HUMAN, e]:
+            if may_side[sides[e], HUMAN]:
                 val = c + value[t, ROBOT]
                 if h_arg < 0 or (val > h_val and not _close(val, h_val, tol)):
                     h_val, h_arg = val, e
@@ -270,7 +272,9 @@ def _solve_kernel(indptr, targets, costs, may, order, tol):  # pragma: no cover 
 
 
 @numba.njit(cache=True)
-def _evaluate_kernel(indptr, targets, costs, may, order, policy, tol):  # pragma: no cover
+def _evaluate_kernel(
+    indptr, targets, costs, sides, may_side, order, policy, tol
+):  # pragma: no cover
     n = indptr.shape[0] - 1
     worst = np.zeros((n, 2))
     expected = np.zeros((n, 2))
@@ -286,9 +290,9 @@ def _evaluate_kernel(indptr, targets, costs, may, order, policy, tol):  # pragma
         for e in range(lo, hi):
             t = targets[e]
             c = costs[e]
-            if may[ROBOT, e]:
+            if may_side[sides[e], ROBOT]:
                 robot_moves = True
-            if may[HUMAN, e]:
+            if may_side[sides[e], HUMAN]:
                 val = c + worst[t, ROBOT]
                 if h_cnt == 0 or (val > h_worst and not _close(val, h_worst, tol)):
                     h_worst = val
@@ -300,7 +304,7 @@ def _evaluate_kernel(indptr, targets, costs, may, order, policy, tol):  # pragma
             worst[v, HUMAN], expected[v, HUMAN], best[v, HUMAN] = h_worst, h_sum / h_cnt, h_best
         if robot_moves:
             e = policy[v]
-            if e < lo or e >= hi or not may[ROBOT, e]:
+            if e < lo or e >= hi or not may_side[sides[e], ROBOT]:
                 # Only an error if this state can matter: report it, the caller decides.
                 worst[v, ROBOT] = np.nan
                 expected[v, ROBOT] = np.nan
