@@ -401,7 +401,9 @@ def state_graph(
     """The assembly state graph: every feasible partial assembly and operation.
 
     A spec generated from a CAD file builds the file's sub-assemblies that can be built
-    and inserted as units (:func:`asp.units.cad_units`). Without such units the spec is first
+    and inserted as units (:func:`asp.units.cad_units`), except those the derived
+    precedences prove leave no complete sequence (:func:`asp.units.refuted_units`: given up
+    in milliseconds, said on ``on_step``). Without such units the spec is first
     reduced (:func:`asp.symmetry.reduced_state_graph`: the precedences every complete
     sequence keeps, interchangeable parts in a fixed order or, for blocks of parts that
     cannot be, only the first of equal blocks moving; same TCT and W*, far fewer states).
@@ -426,10 +428,11 @@ def state_graph(
     """
     from asp.errors import SpecError
     from asp.symmetry import reduce_exact, reduced_state_graph
-    from asp.units import build_with_units, cad_units
+    from asp.units import build_with_units, cad_units, refuted_units
 
     spec, rel = assembly.spec, assembly.relations
-    if not (spec.generated and any(u.used for u in cad_units(spec, rel))):
+    given_up = refuted_units(spec, rel, on_unit=on_step) if spec.generated else set()
+    if not (spec.generated and any(u.used for u in cad_units(spec, rel, given_up))):
         try:
             graph = reduced_state_graph(spec, rel, progress=progress, max_states=max_states)
             if graph is not None:
@@ -443,6 +446,7 @@ def state_graph(
         hierarchy=spec.generated,
         prepare=lambda with_units: reduce_exact(with_units, rel),
         on_unit=on_step,
+        given_up=given_up,
         progress=progress,
         max_states=max_states,
     )

@@ -7,8 +7,9 @@ duplicate successor keys (:func:`asp.state_graph.build_state_graph`) and the seq
 One pass over the states: for each state and operation, the key tests (not done, explicit
 predecessors done, tools ready) and then the geometric test of the part it places (touches
 the assembled parts, rests on them unless held, some allowed direction free; the base part
-first) on the state's part set, word by word. The same rules as the numpy path, which stays
-for subassemblies and operations placing several parts; the results are equal (tested).
+first) on the set it is tested against (the main assembly, without the members of units not
+yet inserted, or its unit's workspace), word by word. The same rules as the numpy path, which
+stays for operations placing several parts; the results are equal (tested).
 """
 
 from __future__ import annotations
@@ -18,19 +19,44 @@ import numpy as np
 
 
 @numba.njit(cache=True, nogil=True)
-def _free(parts, s, blocked, p, directions):
-    """Whether part ``p`` is free from state ``s``'s parts along some allowed direction."""
+def _free(cur, blocked, p, directions):
+    """Whether part ``p`` is free from the parts of the set ``cur`` along some allowed
+    direction."""
     for d in range(6):
         if not directions[d]:
             continue
         clear = True
-        for w in range(parts.shape[1]):
-            if parts[s, w] & blocked[p, d, w]:
+        for w in range(cur.shape[0]):
+            if cur[w] & blocked[p, d, w]:
                 clear = False
                 break
         if clear:
             return True
     return False
+
+
+@numba.njit(cache=True, nogil=True)
+def _main_set(keys, parts, s, op_word, op_bit, unit_op, unit_masks, main):
+    """Fill ``main`` (PW,) with state ``s``'s main assembly: its parts without the members
+    of the units not yet inserted (those are in their own workspaces)."""
+    for w in range(main.shape[0]):
+        main[w] = parts[s, w]
+    for u in range(unit_op.shape[0]):
+        i = unit_op[u]
+        if (keys[s, op_word[i]] & op_bit[i]) == np.uint64(0):
+            for w in range(main.shape[0]):
+                main[w] &= ~unit_masks[u, w]
+
+
+@numba.njit(cache=True, nogil=True)
+def _tested_set(parts, s, workspace, unit_masks, main, scratch):
+    """The set an operation building in ``workspace`` (-1: the main assembly) is tested
+    against in state ``s``."""
+    if workspace < 0:
+        return main
+    for w in range(scratch.shape[0]):
+        scratch[w] = parts[s, w] & unit_masks[workspace, w]
+    return scratch
 
 
 @numba.njit(cache=True, nogil=True)
@@ -53,6 +79,9 @@ def enabled_single(
     base_bit,
     geometric,
     stability,
+    workspace,
+    unit_op,
+    unit_masks,
     out,
 ):
     """Fill ``out`` (k, n_ops) bool: operation ``i`` may be done in state ``s``.
@@ -65,25 +94,31 @@ def enabled_single(
         Where operation ``i``'s own key bit is.
     pred, req_mask, req_value : (n_ops, W) uint64
     part_of : (n_ops,) int64
-        The part each operation places, -1 for none.
+        The part (or unit) each operation places, -1 for none.
     needs_base : (n_ops,) bool
-        The base part must be there (topological, the operation places another part).
+        The base part must be there (topological, the operation places another part into
+        the main assembly).
     held : (n_ops,) bool
     contact, support : (n, PW) uint64
     blocked : (n, 6, PW) uint64
     directions : (6,) bool
     base_word, base_bit : int, uint64
     geometric, stability : bool
+    workspace : (n_ops,) int64
+        The unit whose workspace operation ``i`` builds in (-1: the main assembly).
+    unit_op : (U,) int64
+        Each unit's insertion operation.
+    unit_masks : (U, PW) uint64
+        Each unit's members.
     """
     k, n_words = keys.shape
     pw = parts.shape[1]
     n_ops = op_word.shape[0]
     zero = np.uint64(0)
+    main = np.empty(pw, dtype=np.uint64)
+    scratch = np.empty(pw, dtype=np.uint64)
     for s in range(k):
-        empty = True
-        for w in range(pw):
-            if parts[s, w] != zero:
-                empty = False
+        _main_set(keys, parts, s, op_word, op_bit, unit_op, unit_masks, main)
         for i in range(n_ops):
             ok = (keys[s, op_word[i]] & op_bit[i]) == zero
             w = 0
@@ -94,17 +129,22 @@ def enabled_single(
                 w += 1
             p = part_of[i]
             if ok and p >= 0:
+                cur = _tested_set(parts, s, workspace[i], unit_masks, main, scratch)
+                empty = True
+                for w in range(pw):
+                    if cur[w] != zero:
+                        empty = False
                 if needs_base[i] and (parts[s, base_word] & base_bit) == zero:
                     ok = False
                 elif geometric and not empty:
                     touch = False
                     rest = not stability or held[i]
                     for w in range(pw):
-                        if parts[s, w] & contact[p, w]:
+                        if cur[w] & contact[p, w]:
                             touch = True
-                        if parts[s, w] & support[p, w]:
+                        if cur[w] & support[p, w]:
                             rest = True
-                    ok = touch and rest and _free(parts, s, blocked, p, directions)
+                    ok = touch and rest and _free(cur, blocked, p, directions)
             out[s, i] = ok
 
 
@@ -155,22 +195,31 @@ def first_rows(keys):
 
 
 @numba.njit(cache=True, nogil=True)
-def stuck(keys, parts, op_word, op_bit, part_of, blocked, directions):
-    """(k,) bool: some operation not done places a part that is blocked along every allowed
-    direction by the parts already there (it can never be done: parts are never removed).
+def stuck(
+    keys, parts, op_word, op_bit, part_of, blocked, directions, workspace, unit_op, unit_masks
+):
+    """(k,) bool: some operation not done places a part (or unit) that is blocked along
+    every allowed direction by the parts already in the set it is tested against (it can
+    never be done: parts are never removed, a workspace's members leave only with its
+    finished unit).
 
     Same arrays as :func:`enabled_single`.
     """
     k = keys.shape[0]
+    pw = parts.shape[1]
     n_ops = op_word.shape[0]
     zero = np.uint64(0)
     out = np.zeros(k, dtype=np.bool_)
+    main = np.empty(pw, dtype=np.uint64)
+    scratch = np.empty(pw, dtype=np.uint64)
     for s in range(k):
+        _main_set(keys, parts, s, op_word, op_bit, unit_op, unit_masks, main)
         for i in range(n_ops):
             p = part_of[i]
             if p < 0 or (keys[s, op_word[i]] & op_bit[i]) != zero:
                 continue
-            if not _free(parts, s, blocked, p, directions):
+            cur = _tested_set(parts, s, workspace[i], unit_masks, main, scratch)
+            if not _free(cur, blocked, p, directions):
                 out[s] = True
                 break
     return out

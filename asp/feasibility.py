@@ -508,9 +508,10 @@ class OperationModel:
         return ok
 
     def stuck(self, keys: np.ndarray, parts: np.ndarray) -> np.ndarray:
-        """(k,) bool: some operation not done places a part that the parts already there
-        block along every allowed direction, so it can never be done (a dead end). Always
-        False for specs off the compiled path (subassemblies, several parts an operation)."""
+        """(k,) bool: some operation not done places a part (or unit) that the parts already
+        in the set it is tested against block along every allowed direction, so it can never
+        be done (a dead end). Always False for specs off the compiled path (an operation
+        placing several parts)."""
         keys = self._keys(keys)
         if self._kernel_args is None:
             return np.zeros(keys.shape[0], dtype=bool)
@@ -518,18 +519,22 @@ class OperationModel:
 
         a = self._kernel_args
         sets = np.ascontiguousarray(self.oracle.sets(parts))
-        return stuck(np.ascontiguousarray(keys), sets, a[0], a[1], a[5], a[9], a[11])
+        return stuck(
+            np.ascontiguousarray(keys), sets, a[0], a[1], a[5], a[9], a[11], a[16], a[17], a[18]
+        )
 
     @functools.cached_property
     def _kernel_args(self) -> tuple | None:
         """The arrays of :func:`asp.enabled_kernel.enabled_single`, or None when an
-        operation places several parts or the spec has subassemblies (the numpy path)."""
-        if self.unit_ops or any(len(p) > 1 for p in self.part_lists):
+        operation places several parts (the numpy path)."""
+        if any(len(p) > 1 for p in self.part_lists):
             return None
         o = self.oracle
         n_ops = self.n_ops
         part_of = np.array([p[0] if p else -1 for p in self.part_lists], dtype=np.int64)
+        workspace = np.array(self.op_workspace or [-1] * n_ops, dtype=np.int64)
         needs_base = (part_of >= 0) & (part_of != o.base) & bool(o.topological and o.base >= 0)
+        needs_base &= workspace < 0
         base = max(o.base, 0)
         return (
             np.arange(n_ops, dtype=np.int64) // WORD_BITS,
@@ -548,6 +553,13 @@ class OperationModel:
             np.uint64(1 << (base % WORD_BITS)),
             bool(o.geometric),
             bool(o.stability),
+            workspace,
+            np.array(self.unit_ops, dtype=np.int64),
+            np.ascontiguousarray(
+                self.unit_masks
+                if self.unit_masks is not None and len(self.unit_ops)
+                else np.zeros((0, o.n_words), dtype=np.uint64)
+            ),
         )
 
     def _first_of_equals(self, keys: np.ndarray, ok: np.ndarray) -> None:

@@ -222,39 +222,33 @@ def build_state_graph(
         )
     chunk = max(1, _CHUNK_CELLS // max(1, n_ops))
     for layer in range(n_ops):
-        si_l, oi_l = [], []
+        # chunk by chunk: the enabled moves, their successors (distinct within the chunk,
+        # stuck ones dropped) and a lower bound on the layer being built, which stops a
+        # layer sure to go over the limit before its transitions pile up in memory
+        found = _Layer(index_type)
         for lo in range(0, keys.shape[0], chunk):
-            si, oi = np.nonzero(model.enabled(keys[lo : lo + chunk], parts[lo : lo + chunk]))
-            si_l.append(si.astype(index_type) + index_type(lo))
-            oi_l.append(oi.astype(np.int16))
-        si = np.concatenate(si_l) if len(si_l) > 1 else si_l[0]
-        oi = np.concatenate(oi_l) if len(oi_l) > 1 else oi_l[0]
-        if si.size == 0:
+            hi = min(lo + chunk, keys.shape[0])
+            si, oi = np.nonzero(model.enabled(keys[lo:hi], parts[lo:hi]))
+            if si.size:
+                si = si.astype(index_type) + index_type(lo)
+                found.add(model, keys, parts, si, oi, drop_stuck)
+            at_least = total + found.at_least(layer + 1, max_states - total)
+            if at_least > max_states:
+                raise _too_many(
+                    model, keys, max_states, _after(f"at least {at_least:,}", layer, n_ops)
+                )
+        if found.n_transitions == 0:  # nothing enabled, or every successor is stuck
             break
-        # A state of layer l + 1 has at most l + 1 predecessors: stop before building a layer
-        # that is sure to go over the limit (its successor keys alone may not fit in memory).
-        at_least = total - (-si.size // (layer + 1))
-        if at_least > max_states:
-            raise _too_many(model, keys, max_states, f"at least {at_least:,}", layer)
-        uniq, inv = _unique_rows(model.successor_keys(keys[si], oi))
-        new_parts = np.empty((uniq.shape[0], parts.shape[1]), dtype=np.uint64)
-        new_parts[inv] = parts[si] | model.op_parts[oi]
-        if drop_stuck:
-            keep = ~model.stuck(uniq, new_parts)
-            if not keep.all():
-                live = keep[inv]
-                si, oi, inv = si[live], oi[live], (np.cumsum(keep) - 1)[inv[live]]
-                uniq, new_parts = uniq[keep], new_parts[keep]
-                if uniq.shape[0] == 0:  # every successor is stuck: no complete sequence
-                    break
+        si, oi, inv, uniq, new_parts = found.join()
         if total + uniq.shape[0] > max_states:
-            raise _too_many(model, uniq, max_states, f"{total + uniq.shape[0]:,}", layer)
-        del si_l, oi_l
+            raise _too_many(
+                model, uniq, max_states, _after(f"{total + uniq.shape[0]:,}", layer, n_ops)
+            )
         n_new = int(si.size)
         src_l.append(si + index_type(offset))
         dst_l.append(inv.astype(index_type) + index_type(offset + keys.shape[0]))
         op_l.append(oi)
-        del si, oi, inv
+        del si, oi, inv, found
         offset += keys.shape[0]
         keys, parts = uniq, new_parts
         key_layers.append(keys)
@@ -266,6 +260,15 @@ def build_state_graph(
                 f"transitions ({total:,} states so far, {time.perf_counter() - t0:.1f} s)",
                 file=sys.stderr,
             )
+        sizes = [k.shape[0] for k in key_layers]
+        projected = total + _projected(sizes, n_ops - layer - 1)
+        if projected > PROJECTION_MARGIN * max_states:
+            growth = sizes[-1] / sizes[-2]
+            reached = (
+                f"{total:,} states after layer {layer + 1} of {n_ops}, the last layer {growth:.1f}"
+                f" times the one before: about {projected:,} projected"
+            )
+            raise _too_many(model, keys, max_states, reached)
     layer_ptr = np.zeros(len(key_layers) + 1, dtype=np.int64)
     np.cumsum([k.shape[0] for k in key_layers], out=layer_ptr[1:])
     graph = StateGraph(
@@ -424,6 +427,87 @@ def _dead_end(graph: StateGraph) -> str:
     )
 
 
+class _Layer:
+    """The moves out of one layer, gathered chunk by chunk (:func:`build_state_graph`).
+
+    Each chunk's successors are made distinct within the chunk; across chunks they are
+    merged only when the count so far could have crossed the limit (:meth:`at_least`), so
+    a layer bound to go over stops as soon as that is certain, with a fraction of its
+    moves in memory.
+    """
+
+    def __init__(self, index_type):
+        self.index_type = index_type
+        self.si: list[np.ndarray] = []
+        self.oi: list[np.ndarray] = []
+        self.inv: list[np.ndarray] = []
+        self.keys: list[np.ndarray] = []
+        self.parts: list[np.ndarray] = []
+        self.n_transitions = 0
+        self.n_distinct = 0  # summed over the chunks (an upper bound on the layer)
+        self.merged = np.empty((0, 1), dtype=np.uint64)  # distinct keys of merged chunks
+        self.n_merged = 0  # chunks merged into it
+        self.unmerged = 0  # chunk-distinct keys added since
+
+    def add(self, model, keys, parts, si, oi, drop_stuck: bool) -> None:
+        """The moves ``si`` (states of the layer) x ``oi`` (operations) of one chunk."""
+        oi = oi.astype(np.int16)
+        succ = model.successor_keys(keys[si], oi)
+        firsts, inv = _distinct_rows(succ)
+        succ = succ[firsts]
+        succ_parts = parts[si[firsts]] | model.op_parts[oi[firsts]]
+        if drop_stuck:
+            keep = ~model.stuck(succ, succ_parts)
+            if not keep.all():
+                live = keep[inv]
+                si, oi, inv = si[live], oi[live], (np.cumsum(keep) - 1)[inv[live]]
+                succ, succ_parts = succ[keep], succ_parts[keep]
+        if si.size == 0:
+            return
+        self.si.append(si)
+        self.oi.append(oi)
+        self.inv.append((inv + self.n_distinct).astype(np.int64))
+        self.keys.append(succ)
+        self.parts.append(succ_parts)
+        self.n_transitions += int(si.size)
+        self.n_distinct += int(succ.shape[0])
+        self.unmerged += int(succ.shape[0])
+
+    def at_least(self, in_degree: int, room: int) -> int:
+        """A lower bound on the states of the layer being built, exact enough to tell
+        whether it exceeds ``room``: the moves found over the most moves a state can be
+        reached by (``in_degree``), or the distinct successors of the chunks merged so far
+        (merged again when the chunks since could have added more than ``room`` allows)."""
+        if self.n_merged < len(self.keys) and self.merged.shape[0] + self.unmerged > room:
+            fresh = np.concatenate(self.keys[self.n_merged :])
+            both = fresh if not self.merged.size else np.concatenate([self.merged, fresh])
+            self.merged = both[_distinct_rows(both)[0]]
+            self.n_merged, self.unmerged = len(self.keys), 0
+        return max(self.merged.shape[0], -(-self.n_transitions // in_degree))
+
+    def join(self):
+        """``(si, oi, inv, keys, parts)``: the moves, the index of each one's successor in
+        the new layer, and the new layer's keys (sorted) and part sets."""
+        cat = np.concatenate
+        self.merged = None
+        uniq, rank = _unique_rows(cat(self.keys))
+        self.keys = []
+        new_parts = np.empty((uniq.shape[0], self.parts[0].shape[1]), dtype=np.uint64)
+        new_parts[rank] = cat(self.parts)
+        self.parts = []
+        inv = rank[cat(self.inv)].astype(self.index_type)
+        out = (cat(self.si).astype(self.index_type), cat(self.oi), inv, uniq, new_parts)
+        self.si = self.oi = self.inv = []
+        return out
+
+
+def _distinct_rows(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The index of each distinct row's first occurrence, and each row's distinct number."""
+    from asp.enabled_kernel import first_rows
+
+    return first_rows(np.ascontiguousarray(keys))
+
+
 def _join(layers: list[np.ndarray], dtype) -> np.ndarray:
     """Concatenate the per-layer arrays and empty the list (one array's copy at a time)."""
     out = np.concatenate(layers) if layers else np.empty(0, dtype=dtype)
@@ -448,15 +532,51 @@ def _unique_rows(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return uniq[order], rank[inv]
 
 
-def _too_many(model: OperationModel, keys: np.ndarray, limit: int, reached: str, layer: int):
+PROJECTION_MARGIN = 2
+"""A graph whose states are projected (:func:`_projected`) beyond this many times the limit
+is stopped before its next layer is built."""
+
+
+def _projected(sizes: list[int], layers_left: int) -> int:
+    """A cautious projection of the states of the layers still to come from the sizes of
+    those built (0 while fewer than four layers or no growth).
+
+    The growth ratio of the last layer is projected to fall each layer by the largest fall
+    of the last two ratios, and by at least a quarter of its excess over 1 (so at most four
+    more growing layers are counted); the layers are counted while they grow. Real graphs
+    grow smoothly and fall off more slowly than that (binomial layers of independent parts,
+    the reduced drive's 75 layers); a graph still growing several-fold a layer halfway up
+    (two independent subsystems multiplied by units built in every interleaving) is
+    hopeless long before its layers are built.
+    """
+    if len(sizes) < 4 or layers_left <= 0:
+        return 0
+    ratios = [sizes[k + 1] / sizes[k] for k in range(len(sizes) - 4, len(sizes) - 1)]
+    ratio = ratios[-1]
+    fall = max(ratios[0] - ratios[1], ratios[1] - ratios[2], (ratio - 1) / 4)
+    size, out = float(sizes[-1]), 0.0
+    for _ in range(layers_left):
+        ratio -= fall
+        if ratio <= 1:
+            break
+        size *= ratio
+        out += size
+    return int(out)
+
+
+def _after(states: str, layer: int, n_ops: int) -> str:
+    return f"{states} states after layer {layer + 1} of {n_ops}"
+
+
+def _too_many(model: OperationModel, keys: np.ndarray, limit: int, reached: str):
     """The one-line error of a state graph over ``max_states``.
 
     ``keys`` is the last layer built (or about to be): the operations done in some but not
     all of its states are the free choices that multiply the states; the parts they place
-    are named, the most balanced choices (done in about half the states) first.
+    are named, the most balanced choices (done in about half the states) first. ``reached``
+    says how many states were reached (or projected) after which layer.
     """
     spec = model.spec
-    n_ops = model.n_ops
     done = model.done_matrix(keys[:200_000]).mean(axis=0)
     free = np.flatnonzero((done > 0) & (done < 1))
     order = free[np.argsort(np.abs(done[free] - 0.5), kind="stable")]
@@ -468,8 +588,8 @@ def _too_many(model: OperationModel, keys: np.ndarray, limit: int, reached: str,
     shown = ", ".join(names[:8]) + (f" and {len(names) - 8} more" if len(names) > 8 else "")
     per_state = 8 * model.n_words + 8 * model.oracle.n_words + 8
     return SpecError(
-        f"{spec.source}: the state graph exceeds the limit of {limit:,} states: {reached} "
-        f"states after layer {layer + 1} of {n_ops}; the free order of {len(names)} parts or "
+        f"{spec.source}: the state graph exceeds the limit of {limit:,} states: {reached}; "
+        f"the free order of {len(names)} parts or "
         f"operations multiplies them ({shown or 'none'}); raise max_states (the command line's "
         f"--max-states N or the spec key max_states: N) if memory allows (about {per_state} "
         f"bytes a state plus 10 a transition), or fix their order with precedences (after:) "

@@ -87,13 +87,12 @@ def _bits(mask: int):
 
 
 def _applicable(spec: AssemblySpec, relations) -> bool:
-    """The reduction's preconditions: geometry, one part per operation, no units, a base."""
-    if relations is None or spec.subassemblies or not spec.constraints.topological:
+    """The reduction's preconditions: geometry, a base, one part per operation (or a unit's
+    insertion)."""
+    if relations is None or not spec.constraints.topological or not spec.base_part:
         return False
-    if not spec.base_part:
-        return False
-    placed = [p for op in spec.operations for p in op.parts]
-    return all(len(op.parts) <= 1 and not op.unit for op in spec.operations) and len(placed) == len(
+    placed = [p for op in spec.operations if not op.unit for p in op.parts]
+    return all(len(op.parts) <= 1 or op.unit for op in spec.operations) and len(placed) == len(
         set(placed)
     )
 
@@ -115,17 +114,58 @@ def infeasibility(spec: AssemblySpec, relations) -> str:
     return _derive(spec, relations)[1]
 
 
-def _derive(spec: AssemblySpec, relations) -> tuple[ReducedModel | None, str]:
-    """:func:`reduced_model` and :func:`infeasibility` in one pass."""
+@dataclass(frozen=True)
+class Refutation:
+    """A proof from the derived precedences that no complete sequence exists.
+
+    Attributes
+    ----------
+    why : str
+        One line (:func:`infeasibility`).
+    operation : str
+        The operation it names.
+    parts : tuple of str
+        The parts its failing test looks at before the derived precedences leave some out
+        (what it could touch, rest on, or is blocked by), or the parts of the operations of a
+        cycle of precedences: what a different grouping into units could change.
+    """
+
+    why: str
+    operation: str
+    parts: tuple[str, ...]
+
+
+def refutation(spec: AssemblySpec, relations) -> Refutation | None:
+    """The proof of :func:`infeasibility` with what it involves (None: no proof)."""
+    return _derive(spec, relations)[2]
+
+
+def _derive(spec: AssemblySpec, relations) -> tuple[ReducedModel | None, str, Refutation | None]:
+    """:func:`reduced_model`, :func:`infeasibility` and :func:`refutation` in one pass."""
     if not _applicable(spec, relations):
-        return None, ""
+        return None, "", None
     from asp.feasibility import insertion_oracle, unpack_words
 
     oracle = insertion_oracle(spec, relations)
     n_ops = len(spec.operations)
     pidx = {p: k for k, p in enumerate(oracle.parts)}
-    part_of = tuple(pidx[op.parts[0]] if op.parts else -1 for op in spec.operations)
+    # a unit is one body of the main assembly (its oracle row ORs its members'); the
+    # placements in its workspace are left alone (tested against the unit's members only)
+    members = {u: [pidx[m] for m in ms] for u, ms in spec.subassemblies}
+    in_unit = {m for ms in members.values() for m in ms}
+    part_of = tuple(
+        pidx[op.unit]
+        if op.unit
+        else (pidx[op.parts[0]] if op.parts and pidx[op.parts[0]] not in in_unit else -1)
+        for op in spec.operations
+    )
     op_of = {p: i for i, p in enumerate(part_of) if p >= 0}
+    bits_of = {p: 1 << p for p in op_of}
+    for i, op in enumerate(spec.operations):
+        if op.unit:
+            for m in members[op.unit]:
+                op_of[m] = i
+                bits_of[part_of[i]] |= 1 << m
     base = oracle.base
     initial = 0 if base in op_of or base < 0 else 1 << base
     absent = ((1 << len(oracle.parts)) - 1) & ~initial & ~sum(1 << p for p in op_of)
@@ -150,11 +190,15 @@ def _derive(spec: AssemblySpec, relations) -> tuple[ReducedModel | None, str]:
         out = initial
         for i in _bits(ops):
             if part_of[i] >= 0:
-                out |= 1 << part_of[i]
+                out |= bits_of[part_of[i]]
         return out
 
     def ops_of(parts: int) -> int:
-        return sum(1 << op_of[p] for p in _bits(parts) if p in op_of)
+        out = 0
+        for p in _bits(parts):
+            if p in op_of:
+                out |= 1 << op_of[p]
+        return out
 
     while True:
         must = _closure(must)
@@ -169,7 +213,9 @@ def _derive(spec: AssemblySpec, relations) -> tuple[ReducedModel | None, str]:
 
         cycle = [i for i in range(n_ops) if must[i] >> i & 1]
         if cycle:
-            return None, f"operation {spec.operations[cycle[0]].id} must precede itself"
+            why = f"operation {spec.operations[cycle[0]].id} must precede itself"
+            looked = parts_of(sum(1 << i for i in cycle)) & ~initial
+            return None, why, _refuted(spec, oracle, why, cycle[0], looked)
         after = [0] * n_ops
         for i in range(n_ops):
             for a in _bits(must[i]):
@@ -199,9 +245,10 @@ def _derive(spec: AssemblySpec, relations) -> tuple[ReducedModel | None, str]:
             family = frozenset(
                 b for b in sets if not any(covers(b, t) and not covers(t, b) for t in sets)
             )
-            why = _never(spec, i, tests, family)
+            why, test = _never(spec, i, tests, family)
             if why:
-                return None, why
+                looked = (contact[i], support[i], _union(blocked[i]))[test]
+                return None, why, _refuted(spec, oracle, why, i, looked)
             fams.append(family)
             # the only part it can touch or rest on comes first
             for mask in tests:
@@ -228,20 +275,40 @@ def _derive(spec: AssemblySpec, relations) -> tuple[ReducedModel | None, str]:
                 family=tuple(fams),
                 raw_near=tuple(ops_of(contact[i] | support[i]) for i in range(n_ops)),
             )
-            return model, ""
+            return model, "", None
 
 
-def _never(spec: AssemblySpec, i: int, tests: list[int], family: frozenset[int]) -> str:
-    """Why operation ``i`` can never be done once its predecessors are ("" if it can)."""
+def _never(spec: AssemblySpec, i: int, tests: list[int], family: frozenset[int]) -> tuple[str, int]:
+    """Why operation ``i`` can never be done once its predecessors are ("" if it can), and
+    the test that fails (0 contact, 1 support, 2 free direction)."""
     op = spec.operations[i]
-    what = f"part {op.parts[0]} (operation {op.id})"
+    what = f"unit {op.unit}" if op.unit else f"part {op.parts[0]} (operation {op.id})"
     if tests[0] == 0:
-        return f"{what} touches nothing that can be there before it"
+        return f"{what} touches nothing that can be there before it", 0
     if tests[1] == 0:
-        return f"{what} rests on nothing that can be there before it"
+        return f"{what} rests on nothing that can be there before it", 1
     if not family:
-        return f"{what} is blocked along every direction by parts that must be there before it"
-    return ""
+        why = f"{what} is blocked along every direction by parts that must be there before it"
+        return why, 2
+    return "", -1
+
+
+def _refuted(spec: AssemblySpec, oracle, why: str, i: int, looked: int) -> Refutation:
+    """The :class:`Refutation` naming operation ``i`` and the parts of ``looked`` (a unit's
+    row stands for its members)."""
+    members = dict(spec.subassemblies)
+    parts: list[str] = []
+    for p in _bits(looked):
+        name = oracle.parts[p]
+        parts.extend(members.get(name, (name,)))
+    return Refutation(why, spec.operations[i].id, tuple(dict.fromkeys(parts)))
+
+
+def _union(masks) -> int:
+    out = 0
+    for m in masks:
+        out |= m
+    return out
 
 
 def _closure(must: list[int]) -> list[int]:
@@ -306,6 +373,12 @@ class _Symmetry:
             for a in _bits(m.must[i]):
                 after[a] |= 1 << i
         self.relations = (near, list(m.must), after)
+        # a unit's insertion and its members' placements are never moved: the reduced model
+        # leaves the placements in a workspace untested, so it cannot tell two units alike
+        members = {p for _, ms in spec.subassemblies for p in ms}
+        self.fixed = sum(
+            1 << i for i, op in enumerate(spec.operations) if op.unit or set(op.parts) & members
+        )
 
     def _map_ops(self, perm: dict[int, int], mask: int) -> int:
         out = 0
@@ -354,6 +427,8 @@ class _Symmetry:
         """An involution swapping ``a`` and ``b`` and the operations attached to them, and
         the block of ``a`` (the operations it moves on ``a``'s side); None if none found."""
         perm = {a: b, b: a}
+        if (1 << a | 1 << b) & self.fixed:
+            return None
         if not self.breakers(perm):
             return perm, 1 << a
         side = {a: 0, b: 1}
@@ -364,7 +439,7 @@ class _Symmetry:
             for rel in self.relations:
                 if not self._pair_up(rel[x] & ~rel[y], rel[y] & ~rel[x], x, y, perm, side, queue):
                     return None
-        if self.breakers(perm):
+        if self.breakers(perm) or any(self.fixed >> i & 1 for i in perm):
             return None
         return perm, sum(1 << i for i, s in side.items() if s == 0)
 
@@ -419,7 +494,7 @@ def interchangeable_blocks(
     base = model.op_of.get(_base_index(spec, model), -1)
     groups: dict = defaultdict(list)
     for i in range(sym.n):
-        if model.part_of[i] >= 0 and i != base:
+        if model.part_of[i] >= 0 and i != base and not spec.operations[i].unit:
             groups[sym.colour[i]].append(i)
     used = 0
     out = []
@@ -468,7 +543,7 @@ def interchangeable_classes(spec: AssemblySpec, relations) -> list[list[str]]:
     """Classes (two or more operation ids, in spec order) of interchangeable operations: the
     first operation of each block of :func:`interchangeable_blocks` (or, for a spec the
     reduced model does not apply to, the operations an exact swap of table rows exchanges)."""
-    model, why = _derive(spec, relations)
+    model, why, _ = _derive(spec, relations)
     if model is None:
         return [] if why else _exact_classes(spec, relations)
     return [[b[0] for b in cls] for cls in interchangeable_blocks(spec, relations)]
@@ -558,7 +633,7 @@ def reduce_interchangeable(spec: AssemblySpec, relations) -> AssemblySpec:
     order. Otherwise the classes of an exact swap are chained. A spec the derived precedences
     prove infeasible is returned as it is (the state graph names the cause).
     """
-    model, why = _derive(spec, relations)
+    model, why, _ = _derive(spec, relations)
     if model is None:
         return spec if why else with_fixed_order(spec, _exact_classes(spec, relations))
     chains = []
@@ -577,7 +652,7 @@ def symmetry_reduction(spec: AssemblySpec, relations) -> tuple[AssemblySpec, lis
     first of equal blocks (:meth:`asp.feasibility.OperationModel.enabled`, pass the classes
     as ``operation_model(..., symmetric=...)``).
     """
-    model, why = _derive(spec, relations)
+    model, why, _ = _derive(spec, relations)
     reduced = reduce_interchangeable(spec, relations)
     if model is None:
         return reduced, []

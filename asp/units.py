@@ -84,6 +84,7 @@ def build_with_units(
     hierarchy: bool = False,
     prepare: Callable[[AssemblySpec], AssemblySpec] | None = None,
     on_unit: Callable[[str], None] | None = None,
+    given_up: Iterable[str] | None = None,
     **kwargs,
 ):
     """Build the state graph with the CAD file's sub-assemblies and, when a part can never
@@ -114,6 +115,9 @@ def build_with_units(
         interchangeable parts, :func:`asp.symmetry.reduce_interchangeable`).
     on_unit : callable, optional
         Called with a line for each unit decision (a person reads it on stderr).
+    given_up : iterable of str, optional
+        The file's sub-assemblies given up already (default: :func:`refuted_units`, whose
+        lines go to ``on_unit``).
     **kwargs
         For :func:`asp.state_graph.build_state_graph`.
 
@@ -127,7 +131,9 @@ def build_with_units(
 
     say = on_unit or (lambda _line: None)
     first_error = None
-    given_up: set[str] = set()
+    if given_up is None:
+        given_up = refuted_units(spec, relations, on_unit=say) if hierarchy else set()
+    given_up = set(given_up)
     while True:
         base, choices = with_cad_units(spec, relations, given_up) if hierarchy else (spec, ())
         optional = {u.id: set(u.members) for u in choices if u.used}
@@ -176,6 +182,54 @@ def build_with_units(
         say(
             f"the file's sub-assembl{'y' if len(drop) == 1 else 'ies'} {', '.join(sorted(drop))}"
             f": {GIVEN_UP}; planned without it"
+        )
+
+
+def refuted_units(
+    spec: AssemblySpec,
+    relations,
+    exclude: Iterable[str] = (),
+    on_unit: Callable[[str], None] | None = None,
+) -> set[str]:
+    """The CAD file's sub-assemblies to give up before any state graph is built: those the
+    derived precedences prove leave no complete sequence (:func:`asp.symmetry.refutation`,
+    milliseconds), with ``exclude``.
+
+    While the file's units (:func:`with_cad_units`, without the ones given up) admit such a
+    proof, the units it involves are given up (the unit it names, or whose members its
+    failing test looks at: what a part could rest on, touch or is blocked by; all of them
+    when it names none) and each is said with the proof on ``on_unit``; the file's inner
+    groups may then become units. When the same operation fails in the spec without units
+    (a holder blocked by its bearings, whatever the file groups), the units are not the
+    cause and are left to the state graph (:func:`build_with_units`: automatic units).
+    Sound: a proof holds for every order, so the state graph would give these units up as
+    well, after building it.
+    """
+    from asp.symmetry import refutation
+
+    say = on_unit or (lambda _line: None)
+    given_up = set(exclude)
+    while True:
+        with_units, choices = with_cad_units(spec, relations, given_up)
+        used = {u.id: set(u.members) for u in choices if u.used}
+        if not used:
+            return given_up
+        proof = refutation(hold_unsupported_units(with_units, relations), relations)
+        if proof is None:
+            return given_up
+        alone = refutation(spec, relations)
+        if alone is not None and alone.operation == proof.operation:
+            return given_up  # the same part fails without units: they are not the cause
+        op = with_units.operation(proof.operation)
+        named = set(proof.parts) | set(op.parts)
+        drop = {u for u, members in used.items() if u == op.unit or members & named}
+        drop = drop or set(used)
+        given_up |= drop
+        one = len(drop) == 1
+        say(
+            f"the file's sub-assembl{'y' if one else 'ies'} {', '.join(sorted(drop))}: no "
+            f"complete sequence with {'it as one unit' if one else 'them as units'} "
+            f"({proof.why}); planned without {'it' if one else 'them'}"
         )
 
 
@@ -559,6 +613,7 @@ __all__ = [
     "cad_units",
     "hierarchy_line",
     "host_groups",
+    "refuted_units",
     "unit_members",
     "unit_parts_of_line",
     "units_report",

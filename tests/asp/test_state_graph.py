@@ -12,7 +12,7 @@ from asp.feasibility import insertion_oracle, operation_model
 from asp.game import game_dag
 from asp.solve import solve
 from asp.spec import spec_from_dict
-from asp.state_graph import build_state_graph
+from asp.state_graph import _projected, build_state_graph
 from tests.asp.helpers_assembly import (
     brute_force_downsets,
     brute_force_sequences,
@@ -257,3 +257,15 @@ def test_figure2_unfolding_one_state_per_set_of_done_operations():
     dag = game_dag(graph)
     in_degree = np.bincount(dag.targets, minlength=dag.n_nodes)
     assert in_degree[dag.end] == 2 and dag.n_nodes == 5
+
+
+def test_a_hopeless_graph_stops_on_its_growth():
+    # 40 free operations: layers C(40, k); after layer 5 (760,099 states) the last layer
+    # is 7.2 times the one before: far more than 2 x 1,000,000 states are on their way
+    with pytest.raises(ValueError, match="exceeds the limit of 1,000,000 states") as info:
+        build_state_graph(precedence_spec(40, []), max_states=1_000_000)
+    message = str(info.value)
+    assert "760,099 states after layer 5 of 40" in message and "projected" in message
+    assert "raise max_states" in message and "\n" not in message
+    # 24 free operations fit (2**24 states): growth that dies down is not projected over
+    assert _projected([1, 24, 276, 2024, 10626], 20) < 20_000_000

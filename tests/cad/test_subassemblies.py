@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import pytest
 
 from asp.checker import check_line
@@ -378,3 +380,41 @@ def test_a_generated_spec_holds_a_unit_nothing_outside_holds_up():
     assert not held.operation("u0").held and held.operation("u1").held
     user = pairs_spec(2)
     assert hold_unsupported_units(user, rel) is user  # a user's spec is never changed
+
+
+def capped_shaft() -> dict:
+    """A base, a stepped shaft standing on it, a ring resting on the shaft's shoulder and a
+    cap on the shaft's top above the ring: the ring goes in after the shaft, before the cap."""
+    return {
+        "base": box((-20, -20, 0), (20, 20, 5)),
+        "shaft": union(cylinder(3, 5, 10, 32), cylinder(1.5, 10, 22, 24)),
+        "ring": annulus(1.5, 8, 10, 12, 24, 48),
+        "cap": cylinder(4, 22, 24, 32),
+    }
+
+
+def test_a_unit_the_derived_precedences_refute_is_given_up_before_building(tmp_path):
+    """The file groups the shaft with its cap: built and inserted as one body, the cap would
+    shut the ring out, which can rest on nothing but the shaft. The derived precedences
+    prove it without a state graph; the unit is given up, with the proof on stderr."""
+    from asmplan import pipeline
+    from asp.checker import plan_operations
+    from asp.units import GIVEN_UP, refuted_units
+
+    write_glb(
+        tmp_path / "shaft.glb",
+        capped_shaft(),
+        {"Product": ["base", "Stack", "ring"], "Stack": ["shaft", "cap"]},
+    )
+    assembly = pipeline.load(tmp_path / "shaft.glb")
+    lines = []
+    assert refuted_units(assembly.spec, assembly.relations, on_unit=lines.append) == {"stack"}
+    assert len(lines) == 1
+    assert lines[0].startswith("the file's sub-assembly stack: no complete sequence with it")
+    assert re.search(r"as one unit \((unit stack|part ring) .+\); planned without it$", lines[0])
+    result = pipeline.plan(tmp_path / "shaft.glb", time_limit=5)
+    doc = result.to_dict()
+    units = {u["id"]: u for u in doc["units"]}
+    assert units["stack"]["used"] is False and units["stack"]["reason"] == GIVEN_UP
+    assert doc["subassemblies"] == {}
+    check_line(result.assembly.spec, result.assembly.relations, plan_operations(doc))
