@@ -767,11 +767,13 @@ def geometry_record(spec, relations) -> dict | None:
     without it): what a checker replaying a line from the meshes alone needs.
 
     Coordinates are the source file's own frame (its node transforms applied, no axis
-    changed) times ``scale`` (millimetres per file unit; null when the files declare
-    different units); tolerances are in millimetres; a pair ``(i, j)`` tolerates an
-    overlap of ``part_shrink[i] + part_shrink[j]`` (:mod:`cad.tolerances`), and counts a
-    gap of ``min(contact_reach[i], contact_reach[j])`` as touching (``contact_tol`` for
-    every pair when ``contact_reach`` is null). ``merge_vertices``: each mesh's coincident
+    changed) times ``scale`` (millimetres per coordinate as trimesh reads the files, a
+    file's millimetre numbers under a wrong unit label included; null when the files
+    differ, each part's ``source.scale`` then says); tolerances are in millimetres; a
+    pair ``(i, j)`` tolerates an overlap of ``part_shrink[i] + part_shrink[j]``
+    (:mod:`cad.tolerances`), and counts a gap of ``min(contact_reach[i],
+    contact_reach[j])`` as touching (``contact_tol`` for every pair when ``contact_reach``
+    is null). ``merge_vertices``: each mesh's coincident
     vertices are merged before anything (a STEP or 3DXML tessellation gives every face its
     own vertices; eroding such a mesh leaves its edges where they were). ``erosion``: how a
     part is shrunk. ``fits``: pairs whose inner part is shrunk further for that pair only
@@ -788,10 +790,14 @@ def geometry_record(spec, relations) -> dict | None:
     shrink = tuple(getattr(relations, "part_shrink", ()))
     if len(shrink) != len(relations.parts):
         shrink = (float(relations.penetration_tol) / 2,) * len(relations.parts)
-    try:
-        scale = unit_scale(file_unit)
-    except ValueError:
-        scale = None  # "mixed": the files declare different units
+    scales = {file_scale(spec, p.file) for p in spec.parts if p.file}
+    if len(scales) == 1 and None not in scales:
+        scale = scales.pop()  # millimetre numbers under a wrong unit label included
+    else:
+        try:
+            scale = unit_scale(file_unit)
+        except ValueError:
+            scale = None  # "mixed": the files declare different units
     return {
         "unit": "mm",
         "file_unit": file_unit,
@@ -820,7 +826,8 @@ def source_folder(source: str) -> Path:
 def part_source(spec, file: str | None) -> dict | None:
     """Where a part's mesh is: ``file`` (relative to :func:`source_folder`),
     ``node`` (the part's scene-graph node, as trimesh names it, in a scene file; else
-    null), ``path`` (absolute, when it exists)."""
+    null), ``path`` (absolute, when it exists), ``scale`` (millimetres per coordinate as
+    trimesh reads the file, :func:`file_scale`)."""
     if not file:
         return None
     name, node = _split_file(file)
@@ -828,7 +835,27 @@ def part_source(spec, file: str | None) -> dict | None:
     path = (folder / name).resolve()
     if node is not None and path.is_file():
         node = _scene_node(path, node)
-    return {"file": name, "node": node, "path": str(path) if path.is_file() else None}
+    return {
+        "file": name,
+        "node": node,
+        "path": str(path) if path.is_file() else None,
+        "scale": file_scale(spec, file),
+    }
+
+
+def file_scale(spec, file: str) -> float | None:
+    """Millimetres per coordinate of a part's file as trimesh reads it (its declared unit,
+    else the spec's; millimetre numbers under a wrong label read as mm); None when the
+    file cannot be read."""
+    from cad.scene import coordinate_scale
+
+    path = (source_folder(spec.source) / _split_file(file)[0]).resolve()
+    if not path.is_file():
+        return None
+    try:
+        return coordinate_scale(path, spec.units)
+    except (OSError, ValueError):
+        return None
 
 
 def _scene_node(path: Path, part: str) -> str:

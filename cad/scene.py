@@ -26,7 +26,7 @@ import numpy as np
 import trimesh
 
 from cad.errors import GeometryError
-from cad.units import canonical_unit
+from cad.units import canonical_unit, unit_scale
 
 SCENE_SUFFIXES = (".glb", ".gltf", ".3mf", ".step", ".stp", ".3dxml")
 """Files that hold several parts (one per mesh node)."""
@@ -139,6 +139,9 @@ class SceneParts:
         Each part's scene-graph node as trimesh names it (``trimesh.load(file,
         force="scene").graph[node]`` gives its transform and geometry): what a reader of
         ``plan.json`` looks a part up by.
+    rescale : float
+        Factor from the coordinates trimesh reads to ``meshes`` (1.0 unless the file holds
+        millimetre numbers under a wrong unit label, :func:`_millimetre_numbers`).
     """
 
     ids: tuple[str, ...]
@@ -147,6 +150,7 @@ class SceneParts:
     groups: tuple[tuple[str, tuple[str, ...]], ...]
     units: str | None
     nodes: tuple[str, ...] = ()
+    rescale: float = 1.0
 
     def find(self, node: str) -> int | None:
         """Index of the part whose id or node name is ``node`` (None if there is none)."""
@@ -306,7 +310,19 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
         groups=groups,
         units=declared_units(file, scene),
         nodes=tuple(str(node) for node, _ in part_nodes),
+        rescale=rescale,
     )
+
+
+def coordinate_scale(path: str | Path, units: str | None = None) -> float:
+    """Millimetres per coordinate of ``path`` as ``trimesh.load`` reads it.
+
+    The unit is the one the file declares, else ``units`` (a spec's), else millimetres;
+    times the factor of millimetre numbers under a wrong unit label (:class:`SceneParts`
+    ``rescale``). A checker multiplies what trimesh reads by it to get the parts in mm.
+    """
+    scene = read_scene(path)
+    return unit_scale(scene.units or units or "mm") * scene.rescale
 
 
 def step_length_unit(path: Path) -> str | None:
@@ -344,14 +360,16 @@ def _millimetre_numbers(path: Path, scene: trimesh.Scene) -> float:
     (1.0 when the label is plausible), with a warning.
 
     A STEP declaring inches whose parts, read so, span more than
-    :data:`MAX_INCH_ASSEMBLY_M`: 1 / 25.4; a glTF/GLB (metres) spanning more than
-    :data:`MAX_GLTF_ASSEMBLY_M`: 1 / 1000.
+    :data:`MAX_INCH_ASSEMBLY_M`: 1 / 25.4; a glTF/GLB in metres (glTF's default: it
+    declares no other unit) spanning more than :data:`MAX_GLTF_ASSEMBLY_M`: 1 / 1000.
     """
     suffix = path.suffix.lower()
     if scene.bounds is None or suffix not in (".step", ".stp", ".glb", ".gltf"):
         return 1.0
     size = float(np.linalg.norm(np.ptp(scene.bounds, axis=0)))  # metres (cascadio, glTF)
     if suffix in (".glb", ".gltf"):
+        if declared_units(path, scene) != "m":
+            return 1.0  # the file says its unit (trimesh's extras): no default to doubt
         label, limit, factor = "metres (glTF)", MAX_GLTF_ASSEMBLY_M, 1e-3
     elif step_length_unit(path) == "in":
         label, limit, factor = "inches", MAX_INCH_ASSEMBLY_M, 1.0 / 25.4

@@ -1,4 +1,4 @@
-"""Plan a CAD source with ``asmplan plan`` and replay the plan through the checker."""
+"""Plan a CAD source with ``asmplan plan`` and replay the plan through both checkers."""
 
 from __future__ import annotations
 
@@ -12,9 +12,10 @@ from asmplan import pipeline
 from asmplan.cli import app
 from asp.checker import check_line, plan_operations
 from asp.spec import with_subassemblies
+from tests.asmplan.mesh_replay import replayed
 
 
-def plan_and_check(source: Path, out: Path, *options: str) -> dict:
+def plan_and_check(source: Path, out: Path, *options: str, stderr: list[str] | None = None) -> dict:
     """Run ``asmplan plan SOURCE -o OUT [options]`` with defaults and check its line.
 
     Asserts the command succeeds, the principal line does every operation of the spec
@@ -22,10 +23,15 @@ def plan_and_check(source: Path, out: Path, *options: str) -> dict:
     automatic ones are decided while planning; each inserted by an operation named as the
     unit), and :func:`asp.checker.check_line` accepts it (the units built in their own
     workspaces along the gravity ``plan.json``'s ``workspaces`` give, ``held`` as the plan's
-    operations say: what the plan claims an agent holds). Returns ``plan.json`` as a dict.
+    operations say: what the plan claims an agent holds), and the mesh replay
+    (:mod:`tests.asmplan.mesh_replay`: ``plan.json`` and the meshes alone) accepts both of
+    its lines. Returns ``plan.json`` as a dict; the command's stderr (its notes) is
+    appended to ``stderr`` when given.
     """
     result = CliRunner().invoke(app, ["plan", str(source), "-o", str(out), *options])
     assert result.exit_code == 0, result.output
+    if stderr is not None:
+        stderr.append(result.stderr)
     doc = json.loads((out / "plan.json").read_text())
     ops = plan_operations(doc)
     assembly = pipeline.load(source, on_step=lambda _: None)
@@ -41,4 +47,5 @@ def plan_and_check(source: Path, out: Path, *options: str) -> dict:
     assert sorted(ops) == sorted(spec.op_ids)
     down = {w["id"]: w["gravity"] for w in doc["workspaces"] if w["id"] != "main"}
     check_line(spec, assembly.relations, ops, units=doc["subassemblies"], gravity=down)
+    replayed(doc)
     return doc

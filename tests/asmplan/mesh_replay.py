@@ -5,7 +5,8 @@ plan file (README, "The plan file": ``workspaces``, each step's ``insertions``,
 ``gravity``, ``geometry``, ``parts[].source``), loads the meshes it names with trimesh and
 tests each insertion with python-fcl. The rules (``geometry``):
 
-- **meshes**: each part's mesh from ``parts[].source``, times ``scale`` (mm), its
+- **meshes**: each part's mesh from ``parts[].source``, times its ``scale`` (else
+  ``geometry.scale``: mm per coordinate as trimesh reads the file), its
   coincident vertices merged when ``merge_vertices`` (a STEP or 3DXML tessellation gives
   every face its own vertices; an unmerged mesh cannot be eroded: every vertex would move
   along its own face only, leaving the edges in place);
@@ -17,7 +18,9 @@ tests each insertion with python-fcl. The rules (``geometry``):
   to beyond everything in steps of a quarter of the thinnest part (so nothing thin is
   jumped over), never collides with the parts already in its workspace, both eroded;
 - **touching**: the gap to those parts is at most the pair's contact tolerance
-  (``min(contact_reach[i], contact_reach[j])``, else ``contact_tol``), or they overlap;
+  (``min(contact_reach[i], contact_reach[j])``, else ``contact_tol``), or they overlap, or
+  the body comes to rest on one of them (the fall of the support test below meets it: a
+  clip hanging on a barrel across its clearance touches it once settled);
 - **supported** (unless ``held``): moved along ``gravity`` (the workspace's own, for a
   unit built in another orientation) by ``support_travel_factor``
   times the pair's tolerance, the eroded body collides with them (it rests on something),
@@ -72,7 +75,7 @@ def load_meshes(plan: dict) -> dict[str, trimesh.Trimesh]:
                 scenes[path] = trimesh.load(path, force="scene")
             transform, geometry = scenes[path].graph[src["node"]]
             mesh = scenes[path].geometry[geometry].copy().apply_transform(transform)
-        mesh = mesh.apply_scale(geo["scale"])
+        mesh = mesh.apply_scale(src.get("scale") or geo["scale"])
         if geo.get("merge_vertices", False):
             mesh.merge_vertices()
         out[part["id"]] = mesh
@@ -216,14 +219,16 @@ class Replay:
                         f"{where}: {body} is not free along {ins['free_along']}: {p} meets {j} "
                         f"after {hit:.3g} mm (pair tolerance {self.tolerance(p, j):.3g} mm)"
                     )
+        down = self.down.get(ins["workspace"], self.gravity)
+        rests = self.falls_into(body, there, down)
         gaps = {(p, j): self.plain[p].gap(self.plain[j]) for p in body for j in there}
-        if not any(g <= self.contact(*pj) * 1.01 + 1e-6 for pj, g in gaps.items()):
+        touching = any(g <= self.contact(*pj) * 1.01 + 1e-6 for pj, g in gaps.items())
+        if not touching and not rests:
             (p, j), gap = min(gaps.items(), key=lambda kv: kv[1])
             raise Rejected(f"{where}: {body} touches none of {there} ({p}-{j} gap {gap:.3f} mm)")
         if ins["held"]:
             return "held"
-        down = self.down.get(ins["workspace"], self.gravity)
-        if self.falls_into(body, there, down):
+        if rests:
             return "rests"
         across = [vector(s + a) for a in "xyz" for s in "+-"]
         if all(self.falls_into(body, there, v) for v in across if abs(v @ down) < 0.5):

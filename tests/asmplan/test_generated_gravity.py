@@ -9,7 +9,6 @@ its ``-y`` unless its content is Z-up; a user's spec is never changed. Geometry 
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 
 import numpy as np
@@ -21,10 +20,10 @@ from typer.testing import CliRunner
 import cad
 from asmplan import pipeline
 from asmplan.cli import app
-from asp.checker import check_line, plan_operations
 from asp.generate import gravity_choice
 from asp.gravity import base_index, one_sequence
 from cad.assembly import prepare_part
+from tests.asmplan.checked import plan_and_check
 from tests.cad.real_shapes import bolted_bracket, box
 
 Y_UP = trimesh.transformations.rotation_matrix(-np.pi / 2, (1, 0, 0))
@@ -119,11 +118,9 @@ def test_a_y_up_export_plans_with_gravity_minus_y(tmp_path):
     assert any(n.startswith("generated spec: gravity -y: not the default -z") for n in notes)
     assert spec.operations[0].parts == ("base",)
 
-    result = CliRunner().invoke(app, ["plan", str(source), "-o", str(tmp_path / "out")])
-    assert result.exit_code == 0, result.output
-    assert "gravity -y" in result.stderr
-    doc = json.loads((tmp_path / "out" / "plan.json").read_text())
-    check_line(spec, assembly.relations, plan_operations(doc), units=doc["subassemblies"])
+    stderr: list[str] = []
+    doc = plan_and_check(source, tmp_path / "out", stderr=stderr)
+    assert "gravity -y" in stderr[0] and doc["gravity"] == "-y"
 
     out = tmp_path / "spec" / "assembly.yaml"
     result = CliRunner().invoke(app, ["init", str(source), "-o", str(out)])

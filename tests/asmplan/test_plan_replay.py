@@ -5,11 +5,12 @@ from __future__ import annotations
 import copy
 
 import pytest
+import trimesh
 
 from asmplan import pipeline
 from tests.asmplan.mesh_replay import Rejected, Replay, replayed
 from tests.asmplan.test_generated_held import plate_with_dowel
-from tests.cad.real_shapes import finger_box, unmerged
+from tests.cad.real_shapes import box, finger_box, unmerged
 from tests.cad.test_subassemblies import TOWER_TREE, rod_tower, write_glb
 
 
@@ -113,3 +114,19 @@ def test_a_face_by_face_export_replays(tmp_path, parts, tree, slide):
     assert sideways, "no body leaves sideways: the geometry does not test the slide"
     with pytest.raises(Rejected, match="is not free along"):
         Replay(tampered(plan, _without_merging)).line("robust_plan")
+
+
+def test_millimetre_numbers_under_a_metre_label_replay(tmp_path):
+    """A glTF (metres by default) holding millimetre numbers is read in mm by the planner
+    (cad/scene.py); ``geometry.scale`` and each ``parts[].source.scale`` say so, so the
+    replay reads the same millimetres (with the unit label's 1000 the parts would be a
+    thousand times too large for their tolerances)."""
+    scene = trimesh.Scene()
+    scene.add_geometry(box((0, 0, 0), (400, 300, 20)), node_name="block")
+    scene.add_geometry(box((0, 0, 20), (40, 40, 60)), node_name="cap")
+    scene.export(tmp_path / "engine.glb")
+    with pytest.warns(UserWarning, match="declares metres"):
+        plan = pipeline.plan(tmp_path / "engine.glb", time_limit=5).to_dict()
+    assert plan["geometry"]["scale"] == pytest.approx(1.0)
+    assert all(p["source"]["scale"] == pytest.approx(1.0) for p in plan["parts"])
+    replayed(plan)

@@ -290,13 +290,14 @@ def test_millimetre_numbers_under_an_inch_label_are_read_as_millimetres(tmp_path
     """A Pro/E-style STEP: the unit says INCH, the numbers are millimetres (a 400 x 400 mm
     plate that, read in inches, would be 10 m wide)."""
     pytest.importorskip("cascadio")
-    from cad.scene import step_length_unit
+    from cad.scene import coordinate_scale, step_length_unit
 
     path = _scaled_step(DATA / "table_frame_in.step", tmp_path / "frame_mm_as_in.step", 100.0)
     assert step_length_unit(path) == "in"
     with pytest.warns(UserWarning, match=r"declares inches, but read so it is .* m across"):
         assembly = load_assembly(path)
     assert np.allclose(assembly.parts[0].mesh.extents, [400, 400, 50], atol=1e-2)
+    assert coordinate_scale(path) == pytest.approx(1000 / 25.4)  # what plan.json records
     # a true inch file stays in inches (4 in = 101.6 mm)
     assert step_length_unit(DATA / "table_frame_in.step") == "in"
     assert step_length_unit(DATA / "two_boxes.step") == "mm"
@@ -311,6 +312,33 @@ def test_a_gltf_with_millimetre_numbers_is_read_in_millimetres(tmp_path):
     path = tmp_path / "engine.glb"
     scene.export(path)
     expected = r"declares metres \(glTF\), but read so it is 504 m across"
+    from cad.scene import coordinate_scale
+
     with pytest.warns(UserWarning, match=expected):
         assembly = load_assembly(path)
     assert np.allclose(assembly.parts[0].mesh.extents, [400, 300, 20], atol=1e-3)
+    assert coordinate_scale(path) == pytest.approx(1.0)  # what plan.json records
+
+
+def test_a_gltf_declaring_millimetres_keeps_its_numbers(tmp_path):
+    """trimesh writes a mesh's unit into the glTF (``extras.units``), as in a public pins
+    assembly 360 mm across: the file says millimetres, so nothing is rescaled (it was read
+    as metres taken for millimetres, 1000 times too small, with tolerances to match)."""
+    import warnings
+
+    from cad.scene import coordinate_scale
+
+    scene = trimesh.Scene()
+    for name, lo, hi in (("Block", (0, 0, 0), (400, 300, 20)), ("Cap", (0, 0, 20), (40, 40, 60))):
+        mesh = shapes.box_between(lo, hi)
+        mesh.units = "mm"
+        scene.add_geometry(mesh, node_name=name)
+    path = tmp_path / "pins.glb"
+    scene.export(path)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        assembly = load_assembly(path)
+    assert not [w for w in caught if "declares" in str(w.message)]
+    assert assembly.units == "mm"
+    assert np.allclose(assembly.parts[0].mesh.extents, [400, 300, 20], atol=1e-3)
+    assert coordinate_scale(path) == 1.0
