@@ -403,11 +403,12 @@ def state_graph(
     A spec generated from a CAD file builds the file's sub-assemblies that can be built
     and inserted as units (:func:`asp.units.cad_units`), except those the derived
     precedences prove leave no complete sequence (:func:`asp.units.refuted_units`: given up
-    in milliseconds, said on ``on_step``). Without such units the spec is first
+    in milliseconds, said on ``on_step``). The spec, with those units, is first
     reduced (:func:`asp.symmetry.reduced_state_graph`: the precedences every complete
     sequence keeps, interchangeable parts in a fixed order or, for blocks of parts that
     cannot be, only the first of equal blocks moving; same TCT and W*, far fewer states).
-    With units, or when that has no complete sequence, exactly alike parts are placed in a
+    (a unit is one body of the main assembly there, its workspace left alone). When that
+    has nothing to reduce or no complete sequence, exactly alike parts are placed in a
     fixed order (:func:`asp.symmetry.reduce_exact`) and, when a part can never be inserted
     alone, subassemblies are added automatically
     (:func:`asp.units.build_with_units`); the graph's ``spec`` holds all of it.
@@ -427,19 +428,37 @@ def state_graph(
     asp.state_graph.StateGraph
     """
     from asp.errors import SpecError
+    from asp.orientation import orient_units
     from asp.symmetry import reduce_exact, reduced_state_graph
-    from asp.units import build_with_units, cad_units, refuted_units
+    from asp.units import (
+        build_with_units,
+        built_in_turn,
+        hierarchy_line,
+        hold_unsupported_units,
+        refuted_units,
+        with_cad_units,
+    )
 
     spec, rel = assembly.spec, assembly.relations
-    given_up = refuted_units(spec, rel, on_unit=on_step) if spec.generated else set()
-    if not (spec.generated and any(u.used for u in cad_units(spec, rel, given_up))):
-        try:
-            graph = reduced_state_graph(spec, rel, progress=progress, max_states=max_states)
-            if graph is not None:
-                return graph
-        except SpecError as exc:
-            if "infeasible assembly" not in str(exc):
-                raise
+    say = on_step or (lambda _line: None)
+    given_up = refuted_units(spec, rel, on_unit=say) if spec.generated else set()
+    first, choices = with_cad_units(spec, rel, given_up) if spec.generated else (spec, ())
+    turned: list[str] = []  # said with the file's units, once the graph uses them
+    first = orient_units(first, rel, turned.append)  # as build_with_units prepares units
+    try:
+        graph = reduced_state_graph(
+            built_in_turn(hold_unsupported_units(first, rel)),
+            rel,
+            progress=progress,
+            max_states=max_states,
+        )
+        if graph is not None:
+            for line in [*map(hierarchy_line, choices), *turned]:
+                say(line)
+            return graph
+    except SpecError as exc:
+        if "infeasible assembly" not in str(exc):
+            raise
     return build_with_units(
         spec,
         rel,
@@ -517,7 +536,7 @@ def schedule(
     assembly: Assembly,
     graph: StateGraph,
     *,
-    time_limit: float = 30.0,
+    time_limit: float | None = None,
     workers: int = 1,
     seed: int = 0,
     sequence: list[str] | None = None,
@@ -534,8 +553,11 @@ def schedule(
     assembly : Assembly
     graph : asp.state_graph.StateGraph
         Gives the implied precedences and the lower bounds.
-    time_limit : float
-        CP-SAT time limit, seconds.
+    time_limit : float or None
+        Seconds for CP-SAT's search. ``None`` (the default): the automatic budget of
+        :func:`asp.concurrent.assembly_makespan`, the whole stage within
+        :data:`asp.concurrent.AUTO_TIME_LIMIT` seconds, stopping once neither a better
+        schedule nor a new cut has come for :data:`asp.concurrent.AUTO_PATIENCE` seconds.
     workers : int
         CP-SAT workers (1: repeatable).
     seed : int
@@ -565,7 +587,7 @@ def plan(
     source: str | os.PathLike[str] | Assembly,
     *,
     cost: str | None = None,
-    time_limit: float = 30.0,
+    time_limit: float | None = None,
     seed: int = 0,
     turn_model: str | None = None,
     max_k: int | None = None,
@@ -583,8 +605,8 @@ def plan(
         An assembly (see :func:`load_assembly`) or one already loaded.
     cost : {"steps", "time"}, optional
         Cost model of the game (default: the spec's).
-    time_limit : float
-        CP-SAT time limit, seconds.
+    time_limit : float or None
+        Seconds for CP-SAT's search (default: the automatic budget, see :func:`schedule`).
     seed : int
         CP-SAT random seed.
     turn_model : {"alternate", "concurrent"}, optional

@@ -25,11 +25,13 @@ import math
 import time
 from dataclasses import dataclass, field
 
+import numba
 import numpy as np
 
 from asp import rules
 from asp.dag import GameDAG
 from asp.errors import ScheduleError
+from asp.feasibility import WORD_BITS
 from asp.numbers import json_number, plain
 from asp.rules import HUMAN, ROBOT
 from asp.together import OK, TOOL, first_failure
@@ -334,6 +336,8 @@ def min_makespan(
     seed: int = 0,
     replay=None,
     incumbent: list[dict] | None = None,
+    patience: float | None = None,
+    more_cuts=None,
 ) -> BaselineResult:
     """Minimum-makespan schedule with CP-SAT.
 
@@ -351,7 +355,16 @@ def min_makespan(
     start from, e.g. :func:`list_schedule` along a state-graph path (replayed like any
     other; kept only if it passes). With it a result never lacks a schedule.
     ``detail["found_by"]`` says which schedule is reported (``CP-SAT`` or the incumbent's
-    source), ``detail["cuts"]`` and ``detail["solves"]`` how the loop went.
+    source), ``detail["cuts"]`` and ``detail["solves"]`` how the loop went,
+    ``detail["improvements"]`` when each better schedule came (``[seconds, makespan]``).
+
+    ``more_cuts`` (optional): ``more_cuts(rows)`` of a schedule that failed the replay
+    returns further cuts (each a list of pairs as above, each holding for every feasible
+    schedule), added with the replay's own, so one solve rules out several faults.
+
+    ``patience`` (optional, seconds): stop once neither a better schedule nor a new cut
+    has come for that long (the status is then ``FEASIBLE`` unless proven); ``time_limit``
+    still caps the whole loop. Without it the loop runs until proven or ``time_limit``.
 
     Tool states as sequence-dependent setups: for a tool ``T``, a *setter* is a task that
     sets ``T`` and a *user* a task that requires a value of ``T``. Every setter is ordered
@@ -464,10 +477,11 @@ def min_makespan(
         present=present,
         makespan=makespan,
         replay=replay,
+        more_cuts=more_cuts,
     )
     if incumbent:
         loop.offer(incumbent, source="list schedule along a state-graph path")
-    status, detail_loop, wall = loop.run(time_limit, workers, seed)
+    status, detail_loop, wall = loop.run(time_limit, workers, seed, patience)
     detail: dict = {"tasks": len(tasks), "scale": scale, **detail_loop}
     best = loop.best
     objective = None if best is None else best[0] / scale
@@ -505,10 +519,14 @@ class _ReplayLoop:
     ``UNKNOWN`` (no schedule). Every reported schedule passed the replay.
     """
 
-    def __init__(self, *, model, tasks, scale, start, end, present, makespan, replay):
+    def __init__(
+        self, *, model, tasks, scale, start, end, present, makespan, replay, more_cuts=None
+    ):
         self.model, self.tasks, self.scale = model, tasks, scale
         self.start, self.end, self.present, self.makespan = start, end, present, makespan
         self.replay = replay
+        self.more_cuts = more_cuts
+        self.added: set[frozenset] = set()  # the cuts in the model
         self.best: tuple[int, list[dict]] | None = None  # (scaled makespan, rows)
         self.source = ""
         self.bound: int | None = None
@@ -517,6 +535,10 @@ class _ReplayLoop:
         self.failed = 0  # schedules that failed the replay
         self.prec: dict[tuple[int, int], object] = {}
         self.modes: list[int] | None = None  # the incumbent's mode per task
+        self.t0 = time.perf_counter()
+        self.progress_at = 0.0  # seconds after t0 of the last better schedule or new cut
+        self.improvements: list[list[float]] = []  # [seconds, makespan] of each better one
+        self.stalled = False  # stopped by the patience
 
     def rows(self, value, boolean) -> tuple[list[dict], list[int]]:
         """The schedule rows of a solution (``value``/``boolean`` read it) and its modes."""
@@ -547,6 +569,8 @@ class _ReplayLoop:
                 agent = {r["task"]: r["agent"] for r in rows}
                 modes = [[a for a, _ in t.modes].index(agent[t.id]) for t in self.tasks]
             self.best, self.source, self.modes = (span, rows), source, list(modes)
+            self.progress_at = time.perf_counter() - self.t0
+            self.improvements.append([round(self.progress_at, 3), span / self.scale])
         return None
 
     def precedes(self, y: int, x: int):
@@ -555,6 +579,16 @@ class _ReplayLoop:
             self.model.add(self.end[y] <= self.start[x]).only_enforce_if(lit)
             self.prec[y, x] = lit
         return self.prec[y, x]
+
+    def add_cut(self, cut) -> None:
+        """Add the cut "one of these precedences ``(y, x)``" (once)."""
+        key = frozenset(cut)
+        if not key or key in self.added:
+            return
+        self.added.add(key)
+        self.cuts += 1
+        self.progress_at = time.perf_counter() - self.t0
+        self.model.add_bool_or([self.precedes(y, x) for y, x in sorted(key)])
 
     def hint(self) -> None:
         self.model.clear_hints()
@@ -569,21 +603,31 @@ class _ReplayLoop:
                 for m, lit in enumerate(self.present[i]):
                     self.model.add_hint(lit, m == self.modes[i])
 
-    def run(self, time_limit: float, workers: int, seed: int) -> tuple[str, dict, float]:
+    def run(
+        self, time_limit: float, workers: int, seed: int, patience: float | None = None
+    ) -> tuple[str, dict, float]:
         from ortools.sat.python import cp_model
 
         loop = self
-        t0 = time.perf_counter()
+        t0 = self.t0 = time.perf_counter()
+        self.progress_at = 0.0
+        self.improvements = [[0.0, self.best[0] / self.scale]] if self.best else []
         proven = infeasible = False
         last = "UNKNOWN"
         while True:
-            left = time_limit - (time.perf_counter() - t0)
+            elapsed = time.perf_counter() - t0
+            left = time_limit - elapsed
+            if patience is not None and self.best is not None:
+                wait = self.progress_at + patience - elapsed
+                self.stalled = wait < left  # this solve stops by the patience, if it does
+                left = min(left, wait)
             if left <= 0:
                 break
             if self.solves and self.best is not None:
                 # After a cut: only a shorter schedule is of use now, and the best one so
                 # far is CP-SAT's hint. (The first solve is plain CP-SAT, so a job it solves
-                # outright gets the optimum it always got.)
+                # outright gets the optimum it always got: which of several optima it
+                # returns decides how that schedule fares against a deviating person.)
                 self.model.add(self.makespan <= self.best[0] - 1)
                 self.hint()
 
@@ -591,16 +635,18 @@ class _ReplayLoop:
                 def __init__(self):
                     super().__init__()
                     self.cut = None
+                    self.failed_rows = None
 
                 def on_solution_callback(self):
                     rows, modes = loop.rows(self.value, self.boolean_value)
                     cut = loop.offer(rows, source="CP-SAT", modes=modes)
                     if cut is not None:
-                        self.cut = cut
+                        self.cut, self.failed_rows = cut, rows
                         self.stop_search()
 
             callback = Replayed()
             solver = _solver(left, workers, seed)
+            began = time.perf_counter() - t0
             status = solver.solve(self.model, callback)
             self.solves += 1
             last = solver.status_name(status)
@@ -612,11 +658,16 @@ class _ReplayLoop:
             if callback.cut is None:
                 proven = status in (cp_model.OPTIMAL, cp_model.INFEASIBLE)
                 infeasible = status == cp_model.INFEASIBLE and self.best is None
+                if not proven and patience is not None and self.progress_at > began:
+                    continue  # stopped by the patience while still improving: go on
                 break
             if not callback.cut:
+                self.stalled = False
                 break  # a failure no precedence can mend: nothing more to try
-            self.cuts += 1
-            self.model.add_bool_or([self.precedes(y, x) for y, x in callback.cut])
+            self.add_cut(callback.cut)
+            if self.more_cuts is not None:
+                for cut in self.more_cuts(callback.failed_rows):
+                    self.add_cut(cut)
         wall = time.perf_counter() - t0
         if self.best is not None and proven:
             status_name = "OPTIMAL"
@@ -636,10 +687,11 @@ class _ReplayLoop:
                 detail["found_by"] = self.source
             elif status_name == "UNKNOWN":
                 detail["replay"] = "no physically feasible schedule found within the time limit"
-        detail["status_note"] = self.note(status_name, time_limit)
+            detail["improvements"] = self.improvements
+        detail["status_note"] = self.note(status_name, time_limit, patience)
         return status_name, detail, wall
 
-    def note(self, status: str, time_limit: float) -> str:
+    def note(self, status: str, time_limit: float, patience: float | None = None) -> str:
         """One line saying what the status means for this result."""
         checked = " that replays through the state graph" if self.replay is not None else ""
         cuts = f", {self.cuts} cuts" if self.replay is not None else ""
@@ -648,8 +700,14 @@ class _ReplayLoop:
         if status == "FEASIBLE":
             low = f"; the optimum is at least {self.bound / self.scale:g}" if self.bound else ""
             replayed = ", replayed through the state graph" if self.replay is not None else ""
+            within = (
+                f"in {time.perf_counter() - self.t0:.1f} s (no better schedule nor cut for "
+                f"{patience:g} s)"
+                if self.stalled
+                else f"within {time_limit:g} s"
+            )
             return (
-                f"not proven optimal within {time_limit:g} s: the best schedule found "
+                f"not proven optimal {within}: the best schedule found "
                 f"(by {self.source}{cuts}){replayed}{low}"
             )
         if status == "INFEASIBLE":
@@ -799,26 +857,45 @@ def assembly_schedule(spec, graph=None) -> AssemblySchedule:
     )
 
 
-def implied_predecessors(graph, chunk: int = 1 << 20) -> list[int]:
+def implied_predecessors(graph) -> list[int]:
     """Per operation, the bitmask of operations done in every completable state where it is.
 
-    Works on the done-table of the live states in chunks of ``chunk`` states, so it needs
-    ``chunk x n_ops`` bytes whatever the key width.
+    One pass over the live states' keys (:func:`_common_done`), a few operations per state
+    and operation.
     """
-    n = graph.model.n_ops
-    live = np.flatnonzero(graph.coreachable())
-    # violated[b, a]: some live state has b done and a not done.
-    violated = np.zeros((n, n), dtype=bool)
-    present = np.zeros(n, dtype=bool)
-    for lo in range(0, live.size, chunk):
-        done = graph.model.done_matrix(graph.keys[live[lo : lo + chunk]]).astype(np.float32)
-        violated |= (done.T @ (1.0 - done)) > 0
-        present |= done.any(axis=0)
+    model = graph.model
+    n = model.n_ops
+    keys = np.ascontiguousarray(graph.keys, dtype=np.uint64).reshape(graph.keys.shape[0], -1)
+    done_bits = np.bitwise_or.reduce(np.asarray(model.op_bits, dtype=np.uint64), axis=0)
+    common, seen = _common_done(keys, graph.coreachable(), done_bits, n)
     out = []
     for b in range(n):
-        after = np.flatnonzero(~violated[b]) if present[b] else np.empty(0, dtype=np.int64)
-        out.append(sum(1 << int(a) for a in after if a != b))
+        mask = sum(int(w) << (WORD_BITS * k) for k, w in enumerate(common[b].tolist()))
+        out.append(mask & ~(1 << b) if seen[b] else 0)
     return out
+
+
+@numba.njit(cache=True)
+def _common_done(keys, alive, done_bits, n):  # pragma: no cover - compiled
+    """(n, W) uint64 AND of the done words of the live states with operation ``b`` done, and
+    (n,) bool whether any has it."""
+    width = keys.shape[1]
+    common = np.full((n, width), np.uint64(0xFFFFFFFFFFFFFFFF), dtype=np.uint64)
+    seen = np.zeros(n, dtype=np.bool_)
+    one = np.uint64(1)
+    for s in range(keys.shape[0]):
+        if not alive[s]:
+            continue
+        for w in range(width):
+            x = keys[s, w] & done_bits[w]
+            for k in range(64):
+                if (x >> np.uint64(k)) & one:
+                    b = w * 64 + k
+                    if b < n:
+                        seen[b] = True
+                        for v in range(width):
+                            common[b, v] &= keys[s, v] & done_bits[v]
+    return common, seen
 
 
 def _topo(pred: list[set[int]]) -> list[int]:
@@ -902,7 +979,7 @@ def schedule_violation(model, rows: list[dict]) -> tuple[str, list[tuple[int, in
 def _cannot_follow(model, done: set[int], b: int) -> tuple[str, list[tuple[int, int]]]:
     """The violation "``b`` cannot follow the done set" and its cut (see
     :func:`schedule_violation`): some operation outside ``done`` precedes one of
-    ``done + {b}``, or a shorter cut from ``model.cuts`` (:class:`asp.concurrent.PlacementCuts`)."""
+    ``done + {b}``, or a shorter cut from ``model.cuts`` (:class:`asp.cuts.PlacementCuts`)."""
     ids = model.spec.op_ids
     where = "{" + " ".join(ids[i] for i in sorted(done)) + "}" if done else "the start"
     short = getattr(model, "cuts", None)

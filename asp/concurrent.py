@@ -67,6 +67,7 @@ from asp.baseline import (
     min_makespan,
     schedule_violation,
 )
+from asp.cuts import PlacementCuts
 from asp.dag import HUMAN, ROBOT, GameDAG, from_arrays
 from asp.errors import GameError, SpecError
 from asp.numbers import json_number
@@ -84,6 +85,14 @@ DEFAULT_MAX_NODES = 3_000_000
 """Above this many game nodes the build stops with a ``ValueError``."""
 DEFAULT_MAX_K = 12
 """Largest deviation budget tried when looking for the flat part of the curve."""
+AUTO_TIME_LIMIT = 20.0
+"""Seconds for the whole CP-SAT makespan stage by default (:func:`assembly_makespan` with
+``time_limit=None``), its preparation included."""
+AUTO_PATIENCE = 4.0
+"""By default the CP-SAT makespan stage stops once neither a better schedule nor a new cut
+has come for this many seconds (or when it is proven optimal)."""
+MIN_SOLVE_S = 0.5
+"""The least time the automatic budget leaves CP-SAT after a long preparation."""
 
 
 @dataclass(frozen=True)
@@ -239,75 +248,6 @@ def tool_conflicts(spec: AssemblySpec) -> np.ndarray:
     return conflict
 
 
-class PlacementCuts:
-    """Short cuts for the CP-SAT replay loop, read off the state graph.
-
-    When a schedule places operation ``b`` right after the done set ``I`` and the state
-    graph has no such step, the general cut (:func:`asp.baseline.schedule_violation`) has
-    about ``|I| x (n - |I|)`` literals. Two shorter ones hold whenever the state graph says
-    so, over ``B``, the done sets of the co-reachable states with a step ``b`` into a
-    co-reachable state:
-
-    - *needs one of* ``Y``: every set in ``B`` contains an operation of ``Y`` (``Y`` starts
-      as the operations outside ``I``). Then every feasible schedule has some ``y`` of ``Y``
-      ending by the time ``b`` starts: the placement order "all operations ended by then,
-      ``b``, the rest" is consistent with the schedule, so its done set before ``b`` is in
-      ``B``. Cut: ``y -> b`` for ``y`` in ``Y``.
-    - *before one of* ``X``: no set in ``B`` contains all of ``X`` (``X`` starts as ``I``).
-      Then some ``x`` of ``X`` starts after ``b`` ends: else the order "every operation not
-      starting after ``b`` ends, ``b``, the rest" places ``b`` after all of ``X``. Cut:
-      ``b -> x`` for ``x`` in ``X``.
-
-    Each set is shrunk greedily (an operation is dropped while the condition still holds),
-    so the cut names a few operations: the supports a part waits for, or the parts that
-    would block it.
-    """
-
-    def __init__(self, graph: StateGraph, steps: LiveSteps | None = None):
-        self.graph = graph
-        steps = LiveSteps(graph) if steps is None else steps
-        self.src = steps.src
-        self.op = steps.op
-        self.n = graph.model.n_ops
-        self._rows: dict[int, np.ndarray] = {}
-
-    def rows(self, b: int) -> np.ndarray:
-        """(k, n_ops) bool: the done sets ``B`` of operation ``b`` (class docstring)."""
-        if b not in self._rows:
-            states = np.unique(self.src[self.op == b])
-            self._rows[b] = self.graph.model.done_matrix(self.graph.keys[states])
-        return self._rows[b]
-
-    def cut(self, done: set[int], b: int) -> list[tuple[int, int]] | None:
-        """The shortest of the two cuts (class docstring) for ``b`` after ``done``, or None."""
-        rows = self.rows(b)
-
-        def needs(ys: list[int]) -> bool:
-            return bool(rows[:, ys].any(axis=1).all()) if ys else not rows.shape[0]
-
-        def blocks(xs: list[int]) -> bool:
-            return not bool(rows[:, xs].all(axis=1).any()) if xs else not rows.shape[0]
-
-        found = []
-        ys = [y for y in range(self.n) if y not in done and y != b]
-        if needs(ys):
-            found.append([(y, b) for y in _shrink(ys, needs)])
-        xs = sorted(done)
-        if blocks(xs):
-            found.append([(b, x) for x in _shrink(xs, blocks)])
-        return min(found, key=len, default=None)
-
-
-def _shrink(items: list[int], holds) -> list[int]:
-    """Drop items one by one while ``holds(rest)`` stays true."""
-    out = list(items)
-    for x in items:
-        rest = [y for y in out if y != x]
-        if holds(rest):
-            out = rest
-    return out
-
-
 @dataclass(frozen=True, eq=False)
 class ReplayModel:
     """What a schedule replay needs of the concurrent rules: the spec, the workers, the
@@ -323,7 +263,8 @@ class ReplayModel:
 def replay_model(spec: AssemblySpec, graph: StateGraph, *, cuts: bool = True) -> ReplayModel:
     """The :class:`ReplayModel` of a spec and its state graph (with the short cuts)."""
     steps = LiveSteps(graph)
-    short = PlacementCuts(graph, steps) if cuts else None
+    positive = all(d > 0 for op in spec.operations for _, d in op.durations)
+    short = PlacementCuts(graph, steps, combined=positive) if cuts else None
     return ReplayModel(spec, spec_workers(spec), steps, tool_conflicts(spec), short)
 
 
@@ -1191,10 +1132,11 @@ def assembly_makespan(
     spec,
     graph,
     *,
-    time_limit: float = 60.0,
+    time_limit: float | None = 60.0,
     workers: int = 1,
     seed: int = 0,
     sequence: Sequence[str] | None = None,
+    patience: float | None = None,
 ) -> tuple[AssemblySchedule, BaselineResult]:
     """The minimum-makespan schedule of an assembly that respects the state graph.
 
@@ -1211,8 +1153,23 @@ def assembly_makespan(
     construction, it is CP-SAT's hint and the fallback. So on a large state graph, where
     CP-SAT cannot prove an optimum in ``time_limit``, the result is still a replayed
     schedule, with status ``FEASIBLE`` and the proven lower bound. ``detail`` holds
-    ``cuts``, ``solves``, ``replay`` and ``found_by``.
+    ``cuts``, ``solves``, ``replay``, ``found_by``, ``improvements`` and ``stage_s`` (the
+    whole call, seconds).
+
+    Parameters
+    ----------
+    time_limit : float or None
+        Seconds for the CP-SAT loop (after the precedences, the replay tables and the list
+        schedules are built). ``None``: the automatic budget, :data:`AUTO_TIME_LIMIT` seconds
+        for the whole call, preparation included, with ``patience`` defaulting to
+        :data:`AUTO_PATIENCE`.
+    patience : float, optional
+        Stop once neither a better schedule nor a new cut has come for this many seconds
+        (:func:`asp.baseline.min_makespan`).
     """
+    t0 = time.perf_counter()
+    if time_limit is None and patience is None:
+        patience = AUTO_PATIENCE
     sched = assembly_schedule(spec, graph)
     model = replay_model(spec, graph)
 
@@ -1220,17 +1177,31 @@ def assembly_makespan(
         found = schedule_violation(model, rows)
         return None if found is None else found[1]
 
+    index = {oid: i for i, oid in enumerate(spec.op_ids)}
+
+    def more_cuts(rows):
+        start, end = [0.0] * len(index), [0.0] * len(index)
+        for r in rows:
+            start[index[r["task"]]], end[index[r["task"]]] = float(r["start"]), float(r["end"])
+        return model.cuts.early(start, end)
+
     starts = [list_schedule(model, sched.problem)]
     if sequence is not None:
         starts.append(list_schedule(model, sched.problem, sequence))
     starts = [rows for rows in starts if rows]
     incumbent = min(starts, key=lambda rows: max(float(r["end"]) for r in rows), default=None)
+    limit = time_limit
+    if limit is None:  # the budget covers the preparation too (at least a moment for CP-SAT)
+        limit = max(AUTO_TIME_LIMIT - (time.perf_counter() - t0), MIN_SOLVE_S)
     result = min_makespan(
         sched.problem,
-        time_limit=time_limit,
+        time_limit=limit,
         workers=workers,
         seed=seed,
         replay=replay,
         incumbent=incumbent,
+        patience=patience,
+        more_cuts=more_cuts if model.cuts.combined else None,  # positive durations (asp.cuts)
     )
+    result.detail["stage_s"] = round(time.perf_counter() - t0, 3)
     return sched, result

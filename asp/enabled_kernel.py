@@ -49,14 +49,10 @@ def _main_set(keys, parts, s, op_word, op_bit, unit_op, unit_masks, main):
 
 
 @numba.njit(cache=True, nogil=True)
-def _tested_set(parts, s, workspace, unit_masks, main, scratch):
-    """The set an operation building in ``workspace`` (-1: the main assembly) is tested
-    against in state ``s``."""
-    if workspace < 0:
-        return main
-    for w in range(scratch.shape[0]):
-        scratch[w] = parts[s, w] & unit_masks[workspace, w]
-    return scratch
+def _workspace_set(parts, s, workspace, unit_masks, out):
+    """Fill ``out`` (PW,) with the members of unit ``workspace`` placed in state ``s``."""
+    for w in range(out.shape[0]):
+        out[w] = parts[s, w] & unit_masks[workspace, w]
 
 
 @numba.njit(cache=True, nogil=True)
@@ -129,7 +125,10 @@ def enabled_single(
                 w += 1
             p = part_of[i]
             if ok and p >= 0:
-                cur = _tested_set(parts, s, workspace[i], unit_masks, main, scratch)
+                cur = main
+                if workspace[i] >= 0:
+                    _workspace_set(parts, s, workspace[i], unit_masks, scratch)
+                    cur = scratch
                 empty = True
                 for w in range(pw):
                     if cur[w] != zero:
@@ -218,7 +217,10 @@ def stuck(
             p = part_of[i]
             if p < 0 or (keys[s, op_word[i]] & op_bit[i]) != zero:
                 continue
-            cur = _tested_set(parts, s, workspace[i], unit_masks, main, scratch)
+            cur = main
+            if workspace[i] >= 0:
+                _workspace_set(parts, s, workspace[i], unit_masks, scratch)
+                cur = scratch
             if not _free(cur, blocked, p, directions):
                 out[s] = True
                 break

@@ -27,11 +27,10 @@ CostModel = choices("CostModel", COST_MODELS, "Cost of a move.")
 TurnModel = choices("TurnModel", TURN_MODELS, "Turn model of the game.")
 
 
-def time_limit_option(default: float):
-    """``--time-limit``: one definition for every command that runs CP-SAT."""
-    return typer.Option(
-        default, "--time-limit", min=0.001, max=TIME_LIMIT_MAX, help="CP-SAT time limit, seconds."
-    )
+def time_limit_option(default: float | None, help: str = "CP-SAT time limit, seconds."):
+    """``--time-limit``: one definition for every command that runs CP-SAT (``help`` says
+    what the default does when it is not a number)."""
+    return typer.Option(default, "--time-limit", min=0.001, max=TIME_LIMIT_MAX, help=help)
 
 
 def seed_option(help: str, default: int | None = 0):

@@ -24,6 +24,14 @@ from asmplan.cli.options import (
     tolerance_option,
     turn_model_option,
 )
+from asp.concurrent import AUTO_PATIENCE, AUTO_TIME_LIMIT
+
+AUTO_TIME_LIMIT_HELP = (
+    "Seconds for CP-SAT's minimum-makespan search. Default: automatic, the whole schedule "
+    f"stage within {AUTO_TIME_LIMIT:g} s, stopping once neither a better schedule nor a new cut "
+    f"has come for {AUTO_PATIENCE:g} s, or when proven optimal; give a number to let CP-SAT "
+    "search that long."
+)
 
 
 def plan_summary(result) -> list[str]:
@@ -114,7 +122,7 @@ def plan_command(
         None, "--output", "-o", help="Folder for plan.json, dag.png (and manifest.json)."
     ),
     cost: CostModel | None = typer.Option(None, "--cost", help="Cost model (default: spec's)."),
-    time_limit: float = time_limit_option(30.0),
+    time_limit: float | None = time_limit_option(None, AUTO_TIME_LIMIT_HELP),
     seed: int = seed_option("CP-SAT random seed."),
     turn_model: TurnModel | None = turn_model_option(
         "alternate (the paper's turns) or concurrent (default: spec's)."

@@ -197,3 +197,28 @@ def test_short_cuts_hold_for_every_feasible_schedule(data):
                 continue
             for sched in schedules:
                 assert any(sched[y][1] <= sched[x][0] for y, x in cut), (done, b, cut)
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(resting_assemblies())
+def test_early_cuts_hold_for_every_feasible_schedule(data):
+    """The cuts for operations a schedule starts too early (:meth:`PlacementCuts.early`):
+    none for a feasible schedule, and each one found for the relaxed CP-SAT schedule is
+    satisfied by the list schedule along every complete sequence."""
+    spec, rel = data
+    graph = graph_of(spec, rel)
+    model = replay_model(spec, graph)
+    problem = assembly_schedule(spec, graph).problem
+    n = len(spec.op_ids)
+
+    def times(rows):
+        out = {spec.op_ids.index(r["task"]): (float(r["start"]), float(r["end"])) for r in rows}
+        return [out[i][0] for i in range(n)], [out[i][1] for i in range(n)]
+
+    feasible = [times(list_schedule(model, problem, s)) for s in graph.sequences(limit=50)]
+    for start, end in feasible:
+        assert model.cuts.early(start, end) == []
+    relaxed = min_makespan(problem, time_limit=10).detail["schedule"]
+    for cut in model.cuts.early(*times(relaxed)):
+        for start, end in feasible:
+            assert any(end[y] <= start[x] for y, x in cut), cut
