@@ -36,7 +36,7 @@ import numpy as np
 
 from asp import rules
 from asp.atomic import write_text
-from asp.dag import HUMAN, ROBOT, CodedLabels, GameDAG
+from asp.dag import HUMAN, ROBOT, CodedLabels, GameDAG, ids_topological, index_dtype
 from asp.errors import FormatError
 from asp.metrics import adversarial_tax
 from asp.numbers import plain
@@ -147,16 +147,18 @@ class PolicyTable:
 
 def policy_table(dag: GameDAG, solution: Solution) -> PolicyTable:
     """Every state the robust robot reaches against any human, with its moves."""
-    order = node_order(dag)
     policy = np.asarray(solution.robot_policy, dtype=np.int64)
     reach = rules.reachable_states(dag, policy)
-    rank = np.empty(dag.n_nodes, dtype=np.int64)
-    rank[order] = np.arange(dag.n_nodes)
     flat = np.flatnonzero(reach.ravel())  # index v * 2 + p
+    del reach
     nodes, turns = flat // 2, flat % 2
-    sort = np.lexsort((turns, rank[nodes]))
-    nodes, turns = nodes[sort], turns[sort]
-    index = np.full((dag.n_nodes, 2), -1, dtype=np.int64)
+    if not ids_topological(dag):  # else the node index is the topological rank
+        rank = np.empty(dag.n_nodes, dtype=np.int64)
+        rank[node_order(dag)] = np.arange(dag.n_nodes)
+        sort = np.lexsort((turns, rank[nodes]))
+        nodes, turns = nodes[sort], turns[sort]
+        del rank
+    index = np.full((dag.n_nodes, 2), -1, dtype=index_dtype(nodes.size))
     index[nodes, turns] = np.arange(nodes.size)
     t = rules.kernel_tables(dag)
     ptr, edge, nxt, instruction = _moves_kernel(

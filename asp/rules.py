@@ -276,11 +276,11 @@ def kernel_tables(dag) -> KernelTables:
 
 
 @numba.njit(cache=True)
-def _reachable_kernel(indptr, targets, sides, may_side, policy, start, end):  # pragma: no cover
+def _reachable_kernel(
+    indptr, targets, sides, may_side, policy, start, end, stack_v, stack_p
+):  # pragma: no cover - compiled
     n = indptr.shape[0] - 1
     seen = np.zeros((n, 2), np.bool_)
-    stack_v = np.empty(2 * n + 2, np.int64)
-    stack_p = np.empty(2 * n + 2, np.int64)
     stack_v[0], stack_p[0] = start, ROBOT
     seen[start, ROBOT] = True
     top = 1
@@ -313,7 +313,12 @@ def reachable_states(dag, robot_policy: np.ndarray) -> np.ndarray:
     against any human (the end node's states included)."""
     t = kernel_tables(dag)
     policy = np.asarray(robot_policy, dtype=np.int64)
-    return _reachable_kernel(t.indptr, t.targets, t.sides, t.may_side, policy, dag.start, dag.end)
+    # Each state is pushed at most once: stacks of 2n + 2 entries, as narrow as the nodes.
+    stack_v = np.empty(2 * dag.n_nodes + 2, dtype=t.targets.dtype)
+    stack_p = np.empty(2 * dag.n_nodes + 2, dtype=np.int8)
+    return _reachable_kernel(
+        t.indptr, t.targets, t.sides, t.may_side, policy, dag.start, dag.end, stack_v, stack_p
+    )
 
 
 __all__ = [

@@ -95,7 +95,18 @@ class StateGraph:
     @property
     def indptr(self) -> np.ndarray:
         """(N + 1,) int64 CSR row pointer of the transitions by source state."""
-        return np.searchsorted(self.src, np.arange(self.n_states + 1), side="left").astype(np.int64)
+        return self.src_bounds(np.arange(self.n_states + 1))
+
+    def src_bounds(self, states: np.ndarray) -> np.ndarray:
+        """(k,) int64: the first transition from each of ``states`` (or after them).
+
+        The states are searched in ``src``'s own dtype: numpy would otherwise search an int64
+        copy of all the transitions.
+        """
+        states = np.asarray(states)
+        if states.size and states.max() <= np.iinfo(self.src.dtype).max:
+            states = states.astype(self.src.dtype, copy=False)
+        return np.searchsorted(self.src, states, side="left").astype(np.int64)
 
     def coreachable(self) -> np.ndarray:
         """(N,) bool: states from which a complete state can be reached."""
@@ -103,7 +114,7 @@ class StateGraph:
         if not alive.any():
             return alive
         # Transitions go to higher indices: one sweep from the last layer back suffices.
-        bounds = np.searchsorted(self.src, self.layer_ptr)
+        bounds = self.src_bounds(self.layer_ptr)
         for layer in range(len(self.layer_ptr) - 2, -1, -1):
             lo, hi = bounds[layer], bounds[layer + 1]
             if lo == hi:
@@ -125,7 +136,7 @@ class StateGraph:
         ptr = self.layer_ptr
         # Transitions only join consecutive layers: keep the counts of one layer at a time.
         counts = np.ones((1, len(primes)), dtype=np.uint64)
-        bounds = np.searchsorted(self.src, ptr)
+        bounds = self.src_bounds(ptr)
         for layer in range(len(ptr) - 2):
             lo, hi = bounds[layer], bounds[layer + 1]
             nxt = np.zeros((int(ptr[layer + 2] - ptr[layer + 1]), len(primes)), dtype=np.uint64)

@@ -9,7 +9,8 @@ tests each insertion with python-fcl. The rules (``geometry``):
   ``geometry.scale``: mm per coordinate as trimesh reads the file), its
   coincident vertices merged when ``merge_vertices`` (a STEP or 3DXML tessellation gives
   every face its own vertices; an unmerged mesh cannot be eroded: every vertex would move
-  along its own face only, leaving the edges in place);
+  along its own face only, leaving the edges in place), a closed mesh with its normals
+  inwards turned outwards;
 - **erosion**: every part shrunk by its ``part_shrink``: each vertex moved inwards along
   its normal, never moving any face plane by more than the shrink (conservative: the
   replay tolerates at most what the plan says); the inner part of a pair in ``fits`` is
@@ -78,6 +79,8 @@ def load_meshes(plan: dict) -> dict[str, trimesh.Trimesh]:
         mesh = mesh.apply_scale(src.get("scale") or geo["scale"])
         if geo.get("merge_vertices", False):
             mesh.merge_vertices()
+        if mesh.is_watertight and mesh.volume < 0:
+            mesh.invert()  # a closed mesh drawn inside out: erode it inwards all the same
         out[part["id"]] = mesh
     return out
 

@@ -130,3 +130,16 @@ def test_millimetre_numbers_under_a_metre_label_replay(tmp_path):
     assert plan["geometry"]["scale"] == pytest.approx(1.0)
     assert all(p["source"]["scale"] == pytest.approx(1.0) for p in plan["parts"])
     replayed(plan)
+
+
+def test_an_inside_out_part_replays(tmp_path):
+    """A closed mesh drawn inside out (normals inwards) is turned outwards by the planner
+    (:func:`cad.assembly.prepare_part`) and by the replay; eroded as drawn the block would
+    grow by more than the cap shrinks, and the cap sliding on its top face would collide."""
+    parts = {"block": box((0, 0, 0), (60, 40, 10)), "cap": box((0, 0, 10), (20, 20, 30))}
+    parts["block"].invert()
+    write_glb(tmp_path / "model.glb", parts, {"Product": ["block", "cap"]})
+    plan = pipeline.plan(tmp_path / "model.glb", time_limit=5).to_dict()
+    (ins,) = [i for s in plan["robust_plan"] for i in s["insertions"] if i["parts"] == ["cap"]]
+    assert ins["free_along"][1] != plan["gravity"][1]  # it leaves sliding on the block
+    replayed(plan)
