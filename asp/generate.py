@@ -47,7 +47,7 @@ import numpy as np
 
 from asp.errors import SpecError
 from asp.numbers import json_number
-from asp.spec import SPEC_FILE, AssemblySpec, load_spec, spec_from_dict
+from asp.spec import SPEC_FILE, AssemblySpec, load_spec, spec_from_dict, with_subassemblies
 
 HUMAN_BASE_S = 3.0
 HUMAN_S_PER_MM = 1.0 / 25.0
@@ -538,10 +538,39 @@ def _hierarchy_lines(data: dict, assembly, relations, spec_folder, decide) -> li
         "# ones that cannot be units, and why.",
         "subassemblies:" if used else "# subassemblies:",
     ]
+    turned, loose = _unit_ways(spec, relations, used)
     for u in choices:
         entry = f"{u.id}: [{', '.join(u.members)}]"
+        if u.id in turned or u.id in loose:
+            more = f", gravity: {turned[u.id]}" if u.id in turned else ""
+            more += ", held: true" if u.id in loose else ""
+            entry = f"{u.id}: {{parts: [{', '.join(u.members)}]{more}}}"
+            if u.id in turned:
+                entry += "   # built upside down, then turned over and inserted"
+            if u.id in loose:
+                entry += "   # held: nothing outside it keeps it from falling"
         lines.append(f"  {entry}" if u.used else f"#   {entry}   # not used: {u.reason}")
     return lines
+
+
+def _unit_ways(spec, relations, used) -> tuple[dict[str, str], set[str]]:
+    """For the used units: those built upside down (unit id -> the gravity of its
+    workspace) and those held while inserted (:func:`asp.orientation.loose_units`), as the
+    planner decides them."""
+    from asp.orientation import loose_units, unit_orientation
+
+    if relations is None or getattr(relations, "sp", None) is None or not used:
+        return {}, set()
+    try:
+        with_units = with_subassemblies(spec, [(u.id, u.members) for u in used])
+    except ValueError:
+        return {}, set()
+    turned = {}
+    for u in used:
+        o = unit_orientation(with_units, relations, u.id)
+        if o.upside_down:
+            turned[u.id] = o.gravity
+    return turned, loose_units(with_units, relations)
 
 
 def _tolerance_line(key: str, value: float | None, meaning: str) -> str:

@@ -79,6 +79,26 @@ class UnitOrientation:
         )
 
 
+def loose_units(spec: AssemblySpec, relations) -> set[str]:
+    """The units that no part outside them can keep from falling along the product's
+    gravity (an upper die set sliding down its guide pins, drawn open): each is held while
+    it goes in (:func:`asp.units.hold_unsupported_units`; ``asmplan init`` writes
+    ``held: true``). Empty without a support table."""
+    sp = getattr(relations, "sp", None)
+    if relations is None or sp is None:
+        return set()
+    index = {str(p): k for k, p in enumerate(relations.parts)}
+    rests = np.asarray(sp, dtype=bool)[:, :, DIRECTIONS.index(spec.gravity)]
+    loose = set()
+    for uid, members in spec.subassemblies:
+        rows = [index[m] for m in members if m in index]
+        outside = np.ones(len(index), dtype=bool)
+        outside[rows] = False
+        if rows and not rests[np.ix_(rows, np.flatnonzero(outside))].any():
+            loose.add(uid)
+    return loose
+
+
 def opposite(direction: str) -> str:
     """``+z`` <-> ``-z``."""
     return ("-" if direction[0] == "+" else "+") + direction[1:]
@@ -187,4 +207,4 @@ class _Tables:
     sp: np.ndarray
 
 
-__all__ = ["UnitOrientation", "opposite", "orient_units", "unit_orientation"]
+__all__ = ["UnitOrientation", "loose_units", "opposite", "orient_units", "unit_orientation"]

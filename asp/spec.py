@@ -25,8 +25,9 @@ An ``assembly.yaml`` names everything the planner needs besides the part geometr
                                        # --contact-tol / --penetration-tol override them)
     subassemblies:                     # built on their own, then inserted as one unit
       motor_unit: [MT, PC]             # an operation "motor_unit" inserting it is added
-      upper_die: {parts: [TP, PH], gravity: +z}   # built upside down: gravity +z in its
-                                       # workspace (default: the spec's), turned, inserted
+      upper_die: {parts: [TP, PH], gravity: +z, held: true}   # built upside down
+                                       # (gravity +z in its workspace; default: the spec's),
+                                       # turned over, inserted held (it rests on nothing)
     operations:
       - id: "1.2"                      # ids are strings (1.10 stays "1.10")
         description: Replace hex bit with cross bit on R1
@@ -428,20 +429,27 @@ class _Parser:
         raw_units = self.mapping(data.get("subassemblies"), "subassemblies")
         if not raw_units:
             return spec
-        units, turned = [], []
+        units, turned, held = [], [], set()
         for uid, members in raw_units.items():
             where = f"subassemblies.{uid}"
             if isinstance(members, dict):
-                refuse_unknown_keys(members, ("parts", "gravity"), f"{self.source}: {where}")
+                keys = ("parts", "gravity", "held")
+                refuse_unknown_keys(members, keys, f"{self.source}: {where}")
                 if "gravity" in members:
                     g = self.direction(members["gravity"], f"{where}.gravity")
                     if g != spec.gravity:
                         turned.append((str(uid), g))
+                if members.get("held", False) not in (True, False):
+                    raise self.fail(f"{where}.held", "expected true or false")
+                if members.get("held"):
+                    held.add(str(uid))
                 members = members.get("parts")
             if not isinstance(members, list):
                 raise self.fail(where, "expected a list of part ids or {parts: [...], gravity}")
             units.append((str(uid), tuple(self.text(m, where) for m in members)))
-        return replace(with_subassemblies(spec, units), unit_gravity=tuple(turned))
+        spec = with_subassemblies(spec, units)
+        ops = tuple(replace(op, held=True) if op.unit in held else op for op in spec.operations)
+        return replace(spec, operations=ops, unit_gravity=tuple(turned))
 
     def parts(self, raw) -> tuple[Part, ...]:
         if raw is None:

@@ -239,22 +239,11 @@ def hold_unsupported_units(spec: AssemblySpec, relations) -> AssemblySpec:
     :func:`asp.generate.hold_unsupported` does for single parts; other specs unchanged."""
     if not spec.generated or not spec.constraints.stability or relations is None:
         return spec
-    sp = getattr(relations, "sp", None)
-    if sp is None:
-        return spec
     from dataclasses import replace
 
-    from asp.spec import DIRECTIONS
+    from asp.orientation import loose_units
 
-    index = {str(p): k for k, p in enumerate(relations.parts)}
-    rests = np.asarray(sp, dtype=bool)[:, :, DIRECTIONS.index(spec.gravity)]
-    loose = set()
-    for uid, members in spec.subassemblies:
-        rows = [index[m] for m in members if m in index]
-        outside = np.ones(len(index), dtype=bool)
-        outside[rows] = False
-        if rows and not rests[np.ix_(rows, np.flatnonzero(outside))].any():
-            loose.add(uid)
+    loose = loose_units(spec, relations)
     if not loose:
         return spec
     ops = [replace(op, held=True) if op.unit in loose else op for op in spec.operations]
@@ -369,7 +358,11 @@ def _new_units(
                 smallest = min(candidates, key=len)
                 drop |= {owner[m] for m in smallest if m in owner}
                 continue
-            candidates = [c for c in candidates if not c & set(owner) and not c <= grouped]
+            # a group inside one unit adds nothing; one spanning several units merges them
+            # (a stripper plate hanging on the bolts of one and the punch of the other)
+            candidates = [
+                c for c in candidates if not c & set(owner) and not any(c <= g for g in groups)
+            ]
             if not candidates:
                 continue
             group = min(candidates, key=lambda c: (len(c - grouped), len(c)))

@@ -130,3 +130,53 @@ operations:
     path.write_text(yaml.replace("gravity: +z}", "gravity: +z, side: 1}"))
     with pytest.raises(Exception, match="side"):
         load_spec(path)
+
+
+def test_a_die_set_without_product_tree_finds_its_upper_half(tmp_path):
+    """From a folder of STL parts (no hierarchy) the upper half is found automatically: its
+    parts can never go in one by one (the screws driven up into the top plate would have
+    to pass through the die block); the groups of the stuck parts that span both first
+    guesses merge into one unit, which is built upside down."""
+    from cad import Assembly
+    from tests.cad.test_loading import write_folder
+
+    source = write_folder(tmp_path / "die_set", Assembly.from_meshes(die_set()))
+    plan = plan_and_check(source, tmp_path / "out", "--time-limit", "5")
+    (uid, members), *others = plan["subassemblies"].items()
+    assert not others
+    assert {"top_plate", "punch_holder", "punch", "stripper_plate", "top_screw_1"} <= set(members)
+    spaces = {w["id"]: w for w in plan["workspaces"]}
+    assert spaces[uid]["gravity"] == "+z" and spaces[uid]["parts"][0] == "top_plate"
+    assert plan["line_check"] == {"robust_plan": None, "worst_line": None}
+
+
+def test_a_half_that_stands_right_side_up_is_not_turned(tmp_path):
+    """The die block with its screws from above needs no hold right side up (the heads
+    rest in the counterbores); upside down a screw would fall out: it stays."""
+    from cad import Assembly
+    from tests.cad.test_loading import write_folder
+
+    source = write_folder(tmp_path / "die_set", Assembly.from_meshes(die_set()))
+    assembly = pipeline.load(source, on_step=lambda _: None)
+    lower = ("die_block", "screw_1", "screw_2")
+    spec = with_subassemblies(assembly.spec, [("lower", lower)])
+    o = unit_orientation(spec, assembly.relations, "lower")
+    assert (o.gravity, o.upside_down, o.held) == ("-z", False, ())
+    assert o.held_other == 1
+    assert orient_units(spec, assembly.relations) == spec
+
+
+def test_init_writes_the_upside_down_build_and_the_spec_reads_it(tmp_path):
+    from asp.spec import load_spec
+
+    source = die_set_glb(tmp_path)
+    spec_path = tmp_path / "assembly.yaml"
+    result = CliRunner().invoke(app, ["init", str(source), "-o", str(spec_path)])
+    assert result.exit_code == 0, result.output
+    text = spec_path.read_text()
+    assert "upper_die_set: {parts: [" in text and "gravity: +y, held: true}" in text
+    spec = load_spec(spec_path)
+    assert spec.unit_gravity == (("upper_die_set", "+y"),)
+    assert spec.operation("upper_die_set").held
+    plan = plan_and_check(spec_path, tmp_path / "out", "--time-limit", "5")
+    assert {w["id"]: w["gravity"] for w in plan["workspaces"]}["upper_die_set"] == "+y"

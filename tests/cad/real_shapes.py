@@ -284,7 +284,9 @@ BUILDERS = {
 }
 
 
-def die_set(detail: float = 1.0, stripper: bool = True) -> dict[str, trimesh.Trimesh]:
+def die_set(
+    detail: float = 1.0, stripper: bool = True, corners: int = 2
+) -> dict[str, trimesh.Trimesh]:
     """A shear die set (mm, z up, drawn open) built as a toolmaker builds one.
 
     Lower half: a bottom plate with two guide pins standing in blind holes (press fit,
@@ -293,7 +295,8 @@ def die_set(detail: float = 1.0, stripper: bool = True) -> dict[str, trimesh.Tri
     under the plate), a punch holder under it fixed by two screws from below (heads in the
     holder's counterbores, threads in blind holes of the top plate), the punch hanging in
     the holder by its head and, with ``stripper``, a stripper plate around the punch
-    hanging on two stripper bolts driven up into the holder. Right side up every bushing
+    hanging on two stripper bolts driven up into the holder. ``corners=4``: four guide pins
+    and bushings, four screws in each half (as most die sets). Right side up every bushing
     and screw of the upper half falls out; upside down (top plate on the bench) each rests
     on what is already there. The upper half slides down the guide pins and, drawn open,
     rests on nothing of the lower half.
@@ -301,6 +304,11 @@ def die_set(detail: float = 1.0, stripper: bool = True) -> dict[str, trimesh.Tri
     n = max(1, round(detail))
     pins, screws = [(-80.0, -55.0), (80.0, 55.0)], [(-35.0, -28.0), (35.0, 28.0)]
     tops, bolts = [(-35.0, 28.0), (35.0, -28.0)], [(0.0, 30.0), (0.0, -30.0)]
+    if corners == 4:
+        signs = [(-1, -1), (1, 1), (-1, 1), (1, -1)]
+        pins = [(80.0 * a, 55.0 * b) for a, b in signs]
+        screws = [(35.0 * a, 28.0 * b) for a, b in signs]
+        tops = [(38.0 * a, 22.0 * b) for a, b in signs]
     parts = {
         "bottom_plate": difference(
             box((-100, -75, 0), (100, 75, 20)),
