@@ -647,7 +647,7 @@ def plan(
     )
     summary = relations_summary(assembly.relations) if assembly.relations is not None else []
     say("[2/5] building the assembly state graph ...")
-    graph = state_graph(assembly, max_states=max_states, on_step=on_step)
+    graph = state_graph(assembly, progress=True, max_states=max_states, on_step=on_step)
     from asp.units import units_report
 
     units = units_report(assembly.spec, assembly.relations, graph.spec.subassemblies)

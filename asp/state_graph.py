@@ -182,6 +182,10 @@ class StateGraph:
         return text
 
 
+PROGRESS_EVERY_S = 1.0
+"""With ``progress``, a layer's line is printed at most this often (seconds)."""
+
+
 def build_state_graph(
     spec: AssemblySpec,
     relations=None,
@@ -225,7 +229,8 @@ def build_state_graph(
     key_layers, part_layers = [keys], [parts]
     src_l, dst_l, op_l = [], [], []
     offset, total = 0, 1
-    t0 = time.perf_counter()
+    t0 = shown = time.perf_counter()
+    line = None  # the latest layer's progress line not yet shown
     if progress:
         print(
             f"state graph: {n_ops} operations, {model.n_bits} key bits in {n_words} word(s)",
@@ -265,12 +270,13 @@ def build_state_graph(
         key_layers.append(keys)
         part_layers.append(parts)
         total += keys.shape[0]
-        if progress:
-            print(
-                f"  layer {layer + 1}/{n_ops}: {keys.shape[0]:,} states, {n_new:,} "
-                f"transitions ({total:,} states so far, {time.perf_counter() - t0:.1f} s)",
-                file=sys.stderr,
-            )
+        line = (
+            f"  layer {layer + 1}/{n_ops}: {keys.shape[0]:,} states, {n_new:,} "
+            f"transitions ({total:,} states so far, {time.perf_counter() - t0:.1f} s)"
+        )
+        if progress and time.perf_counter() - shown >= PROGRESS_EVERY_S:
+            print(line, file=sys.stderr)
+            shown, line = time.perf_counter(), None
         sizes = [k.shape[0] for k in key_layers]
         projected = total + _projected(sizes, n_ops - layer - 1)
         if projected > PROJECTION_MARGIN * max_states:
@@ -280,6 +286,8 @@ def build_state_graph(
                 f" times the one before: about {projected:,} projected"
             )
             raise _too_many(model, keys, max_states, reached)
+    if progress and line:  # the last layer's line, unless just shown
+        print(line, file=sys.stderr)
     layer_ptr = np.zeros(len(key_layers) + 1, dtype=np.int64)
     np.cumsum([k.shape[0] for k in key_layers], out=layer_ptr[1:])
     graph = StateGraph(
