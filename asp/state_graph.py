@@ -41,6 +41,18 @@ _CHUNK_CELLS = 1 << 25
 """States x operations tested at once (bounds the enabled-table memory of a layer)."""
 
 
+def sorted_bounds(src: np.ndarray, states) -> np.ndarray:
+    """(k,) int64: the first index of ``src`` (sorted, (E,)) at or after each of ``states``.
+
+    The states are searched in ``src``'s own dtype: numpy would otherwise search an int64
+    copy of all of ``src``.
+    """
+    states = np.asarray(states)
+    if states.size and states.max() <= np.iinfo(src.dtype).max:
+        states = states.astype(src.dtype, copy=False)
+    return np.searchsorted(src, states, side="left").astype(np.int64)
+
+
 @dataclass(frozen=True, eq=False)
 class StateGraph:
     """The assembly state graph.
@@ -98,15 +110,8 @@ class StateGraph:
         return self.src_bounds(np.arange(self.n_states + 1))
 
     def src_bounds(self, states: np.ndarray) -> np.ndarray:
-        """(k,) int64: the first transition from each of ``states`` (or after them).
-
-        The states are searched in ``src``'s own dtype: numpy would otherwise search an int64
-        copy of all the transitions.
-        """
-        states = np.asarray(states)
-        if states.size and states.max() <= np.iinfo(self.src.dtype).max:
-            states = states.astype(self.src.dtype, copy=False)
-        return np.searchsorted(self.src, states, side="left").astype(np.int64)
+        """(k,) int64: the first transition from each of ``states`` (or after them)."""
+        return sorted_bounds(self.src, states)
 
     def coreachable(self) -> np.ndarray:
         """(N,) bool: states from which a complete state can be reached."""

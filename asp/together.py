@@ -20,6 +20,8 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from asp.state_graph import sorted_bounds
+
 OK = 0
 """:func:`together`: the operations may run together."""
 TOOL = 1
@@ -54,14 +56,11 @@ class LiveSteps:
         self.change = np.zeros(self.dst.size, dtype=np.int64)
         if change is not None and src.size:
             self.change = np.asarray(change(src, self.op), dtype=np.int64)
-        # the state graph's transitions are sorted by source: search, in src's own dtype
-        # (bincount would count an int64 copy of every transition)
+        # the state graph's transitions are sorted by source (bincount would count an int64
+        # copy of every transition)
         if src.size > 1 and not np.all(src[1:] >= src[:-1]):
             raise ValueError("LiveSteps: the state graph's transitions are not sorted by source")
-        states = np.arange(graph.n_states + 1)
-        if src.size and graph.n_states < np.iinfo(src.dtype).max:
-            states = states.astype(src.dtype)
-        self.indptr = np.searchsorted(src, states, side="left").astype(np.int64)
+        self.indptr = sorted_bounds(src, np.arange(graph.n_states + 1))
 
     @property
     def n_states(self) -> int:
