@@ -335,11 +335,12 @@ def gravity_choice(relations, geometry, default: str):
     return choose_gravity(relations, bounds, default)
 
 
-def orient_generated(spec: AssemblySpec, relations, geometry):
+def orient_generated(spec: AssemblySpec, relations, geometry, turn=None):
     """A generated spec with the gravity :mod:`asp.gravity` chooses, and the choice.
 
     When the choice differs from the spec's (the format's own down), the spec is
-    generated again along it (base part and operation order follow gravity). A user's
+    generated again along it (base part and operation order follow gravity) by
+    ``turn(gravity)`` (default: :func:`generated_spec` of the spec's source). A user's
     spec, or one without relations, is returned unchanged with None.
     """
     import warnings
@@ -351,7 +352,7 @@ def orient_generated(spec: AssemblySpec, relations, geometry):
         return spec, choice
     with warnings.catch_warnings():  # the same files again: their warnings were given
         warnings.simplefilter("ignore")
-        turned = generated_spec(spec.source, gravity=choice.gravity)
+        turned = (turn or (lambda g: generated_spec(spec.source, gravity=g)))(choice.gravity)
     tolerances = {"contact_tol": spec.contact_tol, "penetration_tol": spec.penetration_tol}
     return replace(turned, **tolerances), choice
 
@@ -391,15 +392,15 @@ class Decisions:
         return out
 
 
-def decide_generated(spec: AssemblySpec, relations, geometry) -> Decisions:
+def decide_generated(spec: AssemblySpec, relations, geometry, turn=None) -> Decisions:
     """The decisions of a generated spec that need its relations, in this order: gravity
     (:func:`orient_generated`), then the base part and ``held`` (:func:`workable_base`).
 
     ``asmplan plan`` (:func:`asmplan.pipeline.load`) and ``asmplan init``
     (:func:`spec_text`) both take them here, so the file written plans as the file read.
-    A user's spec comes back unchanged.
+    A user's spec comes back unchanged. ``turn``: as :func:`orient_generated` takes it.
     """
-    oriented, choice = orient_generated(spec, relations, geometry)
+    oriented, choice = orient_generated(spec, relations, geometry, turn)
     decided, rebased = workable_base(oriented, relations)
     return Decisions(decided, choice, rebased)
 
@@ -424,7 +425,6 @@ def spec_text(
     module) decides which of the file's sub-assemblies are written as ``subassemblies:``;
     without it they are all written commented.
     """
-    import warnings
     from dataclasses import replace
 
     import cad
@@ -433,13 +433,18 @@ def spec_text(
     relations = cad.compute_relations(
         assembly, contact_tol=contact_tol, penetration_tol=penetration_tol
     )
+    turned: dict = {}
+
+    def turn(gravity: str) -> AssemblySpec:
+        """The spec along another gravity, keeping its records (read once)."""
+        turned["data"], turned["assembly"] = spec_data(path, spec_folder, gravity=gravity)
+        return replace(spec_from_dict(turned["data"], source=str(path)), generated=True)
+
     generated = replace(spec_from_dict(data, source=str(path)), generated=True)
-    decided = decide_generated(generated, relations, assembly)
+    decided = decide_generated(generated, relations, assembly, turn)
     spec = decided.spec
-    if spec.gravity != data["gravity"]:  # the records along the chosen gravity
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            data, assembly = spec_data(path, spec_folder, gravity=spec.gravity)
+    if turned:  # the records along the chosen gravity
+        data, assembly = turned["data"], turned["assembly"]
     if on_note is not None:
         for line in decided.notes():
             on_note(line)
