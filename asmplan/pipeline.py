@@ -428,13 +428,11 @@ def state_graph(
     asp.state_graph.StateGraph
     """
     from asp.errors import SpecError
-    from asp.orientation import orient_units
     from asp.symmetry import reduce_exact, reduced_state_graph
     from asp.units import (
         build_with_units,
-        built_in_turn,
         hierarchy_line,
-        hold_unsupported_units,
+        prepared_units,
         refuted_units,
         with_cad_units,
     )
@@ -444,10 +442,9 @@ def state_graph(
     given_up = refuted_units(spec, rel, on_unit=say) if spec.generated else set()
     first, choices = with_cad_units(spec, rel, given_up) if spec.generated else (spec, ())
     turned: list[str] = []  # said with the file's units, once the graph uses them
-    first = orient_units(first, rel, turned.append)  # as build_with_units prepares units
     try:
         graph = reduced_state_graph(
-            built_in_turn(hold_unsupported_units(first, rel)),
+            prepared_units(first, rel, turned.append),
             rel,
             progress=progress,
             max_states=max_states,

@@ -126,7 +126,6 @@ def build_with_units(
     StateGraph
         Its ``spec`` holds the units used (``spec.subassemblies``).
     """
-    from asp.orientation import orient_units
     from asp.state_graph import build_state_graph
 
     say = on_unit or (lambda _line: None)
@@ -144,8 +143,7 @@ def build_with_units(
         found: list[tuple[str, ...]] = []
         current = base
         for _ in range(MAX_ROUNDS + 1):
-            current = orient_units(current, relations, say)  # upside down where better
-            current = built_in_turn(hold_unsupported_units(current, relations))
+            current = prepared_units(current, relations, say)
             try:
                 return build_state_graph(current, relations, **kwargs)
             except ValueError as exc:
@@ -231,6 +229,17 @@ def refuted_units(
             f"complete sequence with {'it as one unit' if one else 'them as units'} "
             f"({proof.why}); planned without {'it' if one else 'them'}"
         )
+
+
+def prepared_units(spec: AssemblySpec, relations, on_unit=None) -> AssemblySpec:
+    """``spec``'s units ready to build: each in its build orientation
+    (:func:`asp.orientation.orient_units`, said through ``on_unit``), held when nothing
+    outside it can keep it from falling (:func:`hold_unsupported_units`), and built one
+    after another when their workspaces would multiply the states (:func:`built_in_turn`)."""
+    from asp.orientation import orient_units
+
+    turned = orient_units(spec, relations, on_unit or (lambda _line: None))
+    return built_in_turn(hold_unsupported_units(turned, relations))
 
 
 def hold_unsupported_units(spec: AssemblySpec, relations) -> AssemblySpec:
