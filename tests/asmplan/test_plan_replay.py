@@ -48,6 +48,16 @@ def test_held_parts_replay(tmp_path):
         "held"
     ]
     replayed(plan)
+    # unheld, the dowel loose in the through hole falls: fitted all round is not support
+    unheld = tampered(plan, _nothing_held)
+    with pytest.raises(Rejected, match=r"\['dowel'\] is not supported"):
+        Replay(unheld).line("robust_plan")
+
+
+def _nothing_held(plan):
+    for step in plan["robust_plan"]:
+        for ins in step["insertions"]:
+            ins["held"] = False
 
 
 def tampered(plan: dict, change) -> dict:
