@@ -15,6 +15,10 @@ tests each insertion with python-fcl. The rules (``geometry``):
   its normal, never moving any face plane by more than the shrink (conservative: the
   replay tolerates at most what the plan says); the inner part of a pair in ``fits`` is
   shrunk by ``extra_shrink`` more against that pair's outer part only;
+- **open parts**: ``open_parts`` must be exactly the parts whose mesh is not closed once
+  merged; a closed part has an inside (a body lying wholly in it collides with it, as a
+  body whose surface crosses it does), an open one has none (its relations are
+  approximate: only crossing surfaces count);
 - **free**: the body, moved along ``free_along`` (``-insert_along``) from its assembled pose
   to beyond everything in steps of a quarter of the thinnest part (so nothing thin is
   jumped over), never collides with the parts already in its workspace, both eroded;
@@ -117,21 +121,33 @@ def collision_object(mesh: trimesh.Trimesh) -> fcl.CollisionObject:
 
 
 class Solid:
-    """A mesh as an fcl object with its bounds; moved by a translation."""
+    """A mesh as an fcl object with its bounds; moved by a translation. A closed solid has
+    an inside: a part lying wholly in it collides with it (no surface need cross)."""
 
-    def __init__(self, mesh: trimesh.Trimesh):
+    def __init__(self, mesh: trimesh.Trimesh, closed: bool = False):
         self.bounds = np.asarray(mesh.bounds, float)
         self.obj = collision_object(mesh)
+        self.mesh = mesh
+        self.closed = closed
 
     def hits(self, other: Solid, offset: np.ndarray) -> bool:
-        """Whether this solid, moved by ``offset``, collides with ``other`` (in place)."""
+        """Whether this solid, moved by ``offset``, collides with ``other`` (in place): their
+        surfaces cross, or one lies wholly inside the other, a closed solid."""
         lo, hi = self.bounds + offset
         if np.any(lo > other.bounds[1]) or np.any(hi < other.bounds[0]):
             return False
         self.obj.setTranslation(np.asarray(offset, float))
         hit = fcl.collide(self.obj, other.obj, fcl.CollisionRequest(), fcl.CollisionResult())
         self.obj.setTranslation(np.zeros(3))
-        return bool(hit)
+        return bool(hit) or self.inside(other, offset) or other.inside(self, -offset)
+
+    def inside(self, other: Solid, offset: np.ndarray) -> bool:
+        """Whether this solid, moved by ``offset`` and clear of ``other``'s surface, lies in
+        ``other`` (only a closed solid has an inside)."""
+        lo, hi = self.bounds + offset
+        if not other.closed or np.any(lo < other.bounds[0]) or np.any(hi > other.bounds[1]):
+            return False
+        return bool(other.mesh.contains(self.mesh.vertices[:1] + offset)[0])
 
     def gap(self, other: Solid) -> float:
         """Distance to ``other`` in place (0 when they collide)."""
@@ -156,10 +172,19 @@ class Replay:
         # a unit built in another orientation (upside down) has its own gravity
         self.down = {w["id"]: vector(w.get("gravity", plan["gravity"])) for w in plan["workspaces"]}
         self.extra = {(f["inner"], f["outer"]): f["extra_shrink"] for f in geo.get("fits", [])}
-        self.plain = {p: Solid(m) for p, m in self.meshes.items()}
-        self.solid = {p: Solid(eroded(m, self.shrink[p])) for p, m in self.meshes.items()}
+        self.open = {p for p, m in self.meshes.items() if not m.is_watertight}
+        said = set(geo.get("open_parts", self.open))
+        if said != self.open:
+            raise Rejected(
+                f"geometry.open_parts says {sorted(said)}, the meshes have {sorted(self.open)} open"
+            )
+        closed = {p: p not in self.open for p in self.meshes}
+        self.plain = {p: Solid(m, closed[p]) for p, m in self.meshes.items()}
+        self.solid = {
+            p: Solid(eroded(m, self.shrink[p]), closed[p]) for p, m in self.meshes.items()
+        }
         self.fitted = {
-            pair: Solid(eroded(self.meshes[pair[0]], self.shrink[pair[0]] + extra))
+            pair: Solid(eroded(self.meshes[pair[0]], self.shrink[pair[0]] + extra), closed[pair[0]])
             for pair, extra in self.extra.items()
         }
         thinnest = min(float(np.min(m.extents)) for m in self.meshes.values())
