@@ -94,7 +94,9 @@ def test_the_checker_rejects_a_wrong_line(tower_plan, change, message):
 
 
 def _without_merging(plan):
+    """Unmerged, every face is a mesh of its own: every part is open."""
     plan["geometry"]["merge_vertices"] = False
+    plan["geometry"]["open_parts"] = [p["id"] for p in plan["parts"]]
 
 
 @pytest.mark.parametrize(
