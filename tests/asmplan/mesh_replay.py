@@ -6,7 +6,8 @@ plan file (README, "The plan file": ``workspaces``, each step's ``insertions``,
 tests each insertion with python-fcl. The rules (``geometry``):
 
 - **meshes**: each part's mesh from ``parts[].source``, times its ``scale`` (else
-  ``geometry.scale``: mm per coordinate as trimesh reads the file), its
+  ``geometry.scale``: mm per coordinate as trimesh reads the file), turned into the build
+  frame by ``geometry.build_rotation`` (``x_build = R @ x_file``; directions are its axes), its
   coincident vertices merged when ``merge_vertices`` (a STEP or 3DXML tessellation gives
   every face its own vertices; an unmerged mesh cannot be eroded: every vertex would move
   along its own face only, leaving the edges in place), a closed mesh with its normals
@@ -77,6 +78,10 @@ def load_meshes(plan: dict) -> dict[str, trimesh.Trimesh]:
             transform, geometry = scenes[path].graph[src["node"]]
             mesh = scenes[path].geometry[geometry].copy().apply_transform(transform)
         mesh = mesh.apply_scale(src.get("scale") or geo["scale"])
+        if geo.get("build_rotation") is not None:  # into the build frame: x' = R x
+            turn = np.eye(4)
+            turn[:3, :3] = np.asarray(geo["build_rotation"], float)
+            mesh = mesh.apply_transform(turn)
         if geo.get("merge_vertices", False):
             mesh.merge_vertices()
         if mesh.is_watertight and mesh.volume < 0:
