@@ -910,8 +910,10 @@ def geometry_record(spec, relations) -> dict | None:
     own vertices; eroding such a mesh leaves its edges where they were). ``erosion``: how a
     part is shrunk. ``fits``: pairs whose inner part is shrunk further for that pair only
     (:mod:`cad.fits`). ``support_travel_factor``: a part is supported if a fall of that
-    many times the pair's tolerance meets a part below (:mod:`cad.support`).
-    ``open_parts``: parts not closed after merging (their relations are approximate).
+    many times the pair's tolerance meets a part below; ``support``: the rules a part is
+    supported by (:data:`cad.support.SUPPORT_RULES`). ``open_parts``: parts not closed after
+    merging (their relations are approximate: a closed part has an inside, a part lying
+    wholly in it collides with it; an open one has none).
     ``frame``: ``"file"`` (the file's own axes) or ``"build"`` (the parts turned as the
     product is fixtured, :mod:`cad.frame`); ``build_rotation``: the 3x3 rotation ``R``, row
     by row, taking file coordinates (times ``scale``) to build coordinates, ``x_build = R @

@@ -9,7 +9,8 @@ that plans in its file's frame plans exactly as before.
 
 Rule (:func:`choose_frame`): the candidates of :func:`cad.frame.candidate_frames` (at most
 :data:`cad.frame.MAX_CANDIDATES`: a rotation turning an axis several parts share onto the
-nearest coordinate axis, the most shared first) are tried in order; in each the relations
+nearest coordinate axis, the most shared first, of the axes that a part of an interlocked
+pair has) are tried in order; in each the relations
 are computed afresh and the generated spec's decisions taken again (gravity, base part,
 ``held``). The first in which no pair is interlocked and the derived precedences do not
 refute every sequence (:func:`asp.symmetry.infeasibility`) is taken; else the first in
@@ -61,7 +62,7 @@ class FrameChoice:
                 f"the file's frame kept, though {why}: none of {self.tried} frame(s) from "
                 "the parts' own axes helped"
             )
-        return f"{frame_text(self.rotation)}: {why}; {self.reason}, now a coordinate axis"
+        return f"{frame_text(self.rotation)}: {why}; {self.reason}, now coordinate axes"
 
 
 def choose_frame(decided, geometry, in_frame: Callable) -> tuple[FrameChoice | None, object]:
@@ -92,7 +93,7 @@ def choose_frame(decided, geometry, in_frame: Callable) -> tuple[FrameChoice | N
     if not stuck:
         return None, None
     fallback = None
-    candidates = candidate_frames(geometry)
+    candidates = candidate_frames(geometry, parts={p for pair in stuck for p in pair})
     for candidate in candidates:
         framed = in_frame(candidate.rotation)
         if interlocked(framed.relations, framed.spec.base_part):

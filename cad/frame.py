@@ -16,11 +16,14 @@ Candidate frames come from the parts' own axes (:func:`candidate_frames`): each 
 principal axes of inertia that are well defined (an eigenvalue apart from the other two: a
 pin's or a disc's axis, a plate's normal), those more than :data:`ALIGNED_DEG` off every
 coordinate axis clustered (up to sign), and for the clusters shared by the most parts the
-smallest rotation that turns the cluster's direction onto the nearest coordinate axis.
+rotation that turns the cluster's direction onto the nearest coordinate axis, a shared axis
+square to it onto another (a tilted plate's edge beside its normal), then the smallest
+rotation turning the first alone.
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -35,6 +38,8 @@ CLUSTER_DEG = 3.0
 DISTINCT = 0.1
 """A principal axis is well defined when its moment differs from the other two by this
 share of the largest moment (a cylinder's axis is, its two cross axes are not)."""
+SQUARE_DEG = 10.0
+"""A second shared axis within this angle of square to the first is aligned as well."""
 MAX_CANDIDATES = 3
 """Candidate frames tried at most (each costs one computation of the relations)."""
 AXIS_DECIMALS = 4
@@ -203,17 +208,32 @@ class Candidate:
         The parts' common axis (file frame) that the rotation turns onto a coordinate axis.
     parts : tuple of str
         The parts sharing that axis.
+    across, across_parts
+        A second shared axis, across the first, that the rotation turns onto a coordinate
+        axis as well (None: the smallest rotation turning the first).
     """
 
     rotation: Rotation
     direction: tuple[float, float, float]
     parts: tuple[str, ...]
+    across: tuple[float, float, float] | None = None
+    across_parts: tuple[str, ...] = ()
 
     @property
     def reason(self) -> str:
-        d = ", ".join(f"{round(x, 3) + 0.0:g}" for x in self.direction)
-        shown = ", ".join(self.parts[:8]) + (", ..." if len(self.parts) > 8 else "")
-        return f"{len(self.parts)} part(s) share the axis ({d}) of the file ({shown})"
+        out = f"{_listed(self.parts)} share the file's axis {_vector(self.direction)}"
+        if self.across is not None:
+            out += f", and {_listed(self.across_parts)} the axis {_vector(self.across)} across it"
+        return out
+
+
+def _listed(parts: tuple[str, ...]) -> str:
+    shown = ", ".join(parts[:8]) + (", ..." if len(parts) > 8 else "")
+    return f"{len(parts)} part(s) ({shown})"
+
+
+def _vector(direction) -> str:
+    return "(" + ", ".join(f"{round(x, 3) + 0.0:g}" for x in direction) + ")"
 
 
 def part_axes(mesh) -> list[np.ndarray]:
@@ -274,19 +294,51 @@ def onto_axis(direction) -> np.ndarray:
     return rotation_matrix(cross, degrees)
 
 
-def candidate_frames(assembly, limit: int = MAX_CANDIDATES) -> list[Candidate]:
-    """At most ``limit`` frames, each turning one shared off-axis part axis onto the
-    nearest coordinate axis: the axes shared by the most parts first (module docstring)."""
+def candidate_frames(
+    assembly, limit: int = MAX_CANDIDATES, parts: Iterable[str] | None = None
+) -> list[Candidate]:
+    """At most ``limit`` frames turning a shared off-axis part axis onto the nearest
+    coordinate axis, the axes shared by the most parts first (module docstring).
+
+    For each such axis, when another shared axis lies across it (within
+    :data:`SQUARE_DEG` of a right angle: a tilted plate's edge beside its normal), the frame
+    turning that one onto a coordinate axis as well comes first, then the smallest
+    rotation. ``parts``: only the axes some of these parts have (the parts that cannot go in
+    in the file's frame).
+    """
+    found = off_axis_directions(assembly)
+    if parts is not None:
+        wanted = set(parts)
+        found = [(d, ps) for d, ps in found if wanted & set(ps)]
+    square = np.sin(np.radians(SQUARE_DEG))
     out: list[Candidate] = []
-    for direction, parts in off_axis_directions(assembly):
-        rotation = canonical(onto_axis(direction))
-        if rotation is None or any(np.allclose(rotation, c.rotation) for c in out):
-            continue
-        sign = 1.0 if direction[int(np.argmax(np.abs(direction)))] > 0 else -1.0
-        out.append(Candidate(rotation, tuple(float(x) for x in sign * direction), parts))
-        if len(out) >= limit:
-            break
+    for direction, members in found:
+        first = onto_axis(direction)
+        across = [(d, ps) for d, ps in found if abs(float(d @ direction)) <= square]
+        ways = [(first, None)]
+        if across:  # its image across the first axis, made exactly square to it
+            e1 = first @ direction
+            w = first @ across[0][0]
+            ways.insert(0, (onto_axis(w - (w @ e1) * e1) @ first, across[0]))
+        for rotation, second in ways:
+            rotation = canonical(rotation)
+            if rotation is None or any(np.allclose(rotation, c.rotation) for c in out):
+                continue
+            out.append(Candidate(rotation, _upwards(direction), members, *_second(second)))
+            if len(out) >= limit:
+                return out
     return out
+
+
+def _upwards(direction) -> tuple[float, float, float]:
+    """A direction signed so that its largest component is positive."""
+    d = np.asarray(direction, dtype=float)
+    sign = 1.0 if d[int(np.argmax(np.abs(d)))] > 0 else -1.0
+    return tuple(float(x) for x in sign * d)
+
+
+def _second(found) -> tuple:
+    return () if found is None else (_upwards(found[0]), tuple(found[1]))
 
 
 def interlocked(relations, first: str | None = None, directions=range(6)) -> list[tuple[str, str]]:

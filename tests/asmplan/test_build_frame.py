@@ -17,6 +17,7 @@ import pytest
 from typer.testing import CliRunner
 
 from asmplan.cli import app
+from asmplan.report.meshes import part_meshes
 from asp.spec import spec_from_dict
 from cad.frame import rotation_matrix
 from tests.asmplan.checked import plan_and_check
@@ -61,6 +62,17 @@ def test_a_generated_spec_turns_the_product_so_its_pins_go_in_along_an_axis(plan
     for ins in pins:
         assert ins["insert_along"] == "-z"
         assert np.allclose(ins["insert_vector_file"], -PINS, atol=1e-4)
+
+
+@pytest.mark.slow
+def test_the_pictures_show_the_product_as_fixtured(planned):
+    doc = {**planned["doc"], "source": str(planned["root"] / "cad" / "assembly.yaml")}
+    meshes = part_meshes(doc)  # files beside the spec
+    assert set(meshes) == {"base", "plate", "pin_1", "pin_2"}
+    vertices, _ = meshes["pin_1"]
+    extent = np.ptp(vertices, axis=0)
+    assert extent[2] == pytest.approx(16.0, abs=0.01)  # upright: its length along z
+    assert extent[:2].max() < 4.1
 
 
 @pytest.mark.slow

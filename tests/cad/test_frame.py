@@ -112,3 +112,16 @@ def test_an_upright_product_has_no_interlock_and_its_aligned_parts_no_candidate(
     assert interlocked(cad.compute_relations(assembly), "base") == []
     # only the base, whose underside is slanted, has axes off the coordinate axes
     assert {p for c in candidate_frames(assembly) for p in c.parts} == {"base"}
+
+
+def test_a_shared_axis_across_the_first_is_turned_onto_an_axis_as_well():
+    """Turned about (1, 0, 1), the plate's edges leave the coordinate axes as well as its
+    normal: the first candidate turns both back (the product as drawn upright, up to a
+    quarter turn), not only the pins."""
+    turn = rotation_matrix((1.0, 0.0, 1.0), 40.0)
+    assembly = Assembly.from_meshes(tilted_pins((1.0, 0.0, 1.0), 40.0))
+    first = candidate_frames(assembly)[0]
+    assert first.across is not None and "plate" in first.across_parts
+    back = np.asarray(first.rotation) @ turn
+    assert np.allclose(np.abs(back).max(axis=1), 1.0, atol=1e-4)  # a signed permutation
+    assert np.allclose(back[:, 2], [0.0, 0.0, 1.0], atol=1e-4)  # the pins upright
