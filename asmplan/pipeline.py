@@ -569,11 +569,12 @@ def played_game(graph: StateGraph, game: Game, solution: Solution) -> PlayedGame
     from asp.solve import play
 
     dag = game.dag
-    describe = alternate_states(graph, dag)
+    every_state = alternate_states(graph, dag)
+    policy = played_policy(dag, solution, every_state)
+    describe = every_state.only(policy.table.node)  # the plan file names no other state
+    del every_state
     path, _ = play(dag, solution.robot_policy, solution.human_policy)
-    return PlayedGame(
-        played_policy(dag, solution, describe), describe, dag_figure(dag, path_edges(dag, path))
-    )
+    return PlayedGame(policy, describe, dag_figure(dag, path_edges(dag, path)))
 
 
 def robust_plan(game: Game, solution: Solution) -> tuple[PlanStep, ...]:
@@ -687,9 +688,10 @@ def plan(
     AssemblyPlan
         ``to_dict()`` is the ``plan.json`` object.
     """
-    from asp.memory import release_memory
+    from asp.memory import map_large_blocks, release_memory
     from asp.plan import relations_summary
 
+    map_large_blocks()  # a freed array of a few MB goes back to the system at once
     say = on_step or (lambda _message: None)
     say("[1/5] reading the assembly and computing part relations ...")
     assembly = (
