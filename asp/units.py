@@ -509,8 +509,10 @@ def cad_units(
     - each of its parts is placed by an operation of its own, placing no other part;
     - it can be built on its own: its parts go into its workspace one by one, each free
       along a direction the gripper approaches from, touching and supported (unless held)
-      by the parts already there (a search over the orders, at most
-      :data:`BUILD_SEARCH_LIMIT` partial workspaces; undecided counts as buildable);
+      by the parts already there, right side up or upside down (gravity reversed: a lid
+      with flanged pegs pressed in from below, :mod:`asp.orientation` then picks the way
+      up) (a search over the orders, at most :data:`BUILD_SEARCH_LIMIT` partial
+      workspaces; undecided counts as buildable);
     - it can be inserted as one rigid body: free from the base part along such a
       direction and touching a part outside it (one that rests on nothing outside it is
       held while it goes in, :func:`hold_unsupported_units`).
@@ -533,10 +535,22 @@ def cad_units(
     op_of = {p: op for op in spec.operations for p in op.parts}
     taken_ids = set(spec.op_ids) | set(spec.part_ids) | {u for u, _ in spec.subassemblies}
     in_unit: dict[str, str] = {m: u for u, ms in spec.subassemblies for m in ms}
+    flipped = []  # the oracle with gravity reversed, made when first needed
+
+    def upside_down():
+        if not flipped:
+            from dataclasses import replace
+
+            from asp.orientation import opposite
+
+            turned = replace(spec, gravity=opposite(spec.gravity))
+            flipped.append(insertion_oracle(turned, relations))
+        return flipped[0]
+
     out = []
     for gid, members in groups:
         uid = gid if gid not in taken_ids else f"{gid}_unit"
-        reason = _unit_problem(spec, oracle, index, op_of, in_unit, members)
+        reason = _unit_problem(spec, oracle, index, op_of, in_unit, members, upside_down)
         if uid in exclude and not reason:
             reason = GIVEN_UP
         out.append(HierarchyUnit(uid, members, not reason, reason))
@@ -546,8 +560,9 @@ def cad_units(
     return tuple(out)
 
 
-def _unit_problem(spec, oracle, index, op_of, in_unit, members) -> str:
-    """Why a group cannot be a unit ("" when it can)."""
+def _unit_problem(spec, oracle, index, op_of, in_unit, members, upside_down=None) -> str:
+    """Why a group cannot be a unit ("" when it can); ``upside_down()`` gives the oracle
+    with gravity reversed (a group built upside down)."""
     inside = {in_unit[m] for m in members if m in in_unit}
     if inside:
         return f"its parts are in the unit {sorted(inside)[0]} (one level of units)"
@@ -562,6 +577,8 @@ def _unit_problem(spec, oracle, index, op_of, in_unit, members) -> str:
     idx = [index[m] for m in members]
     held = {index[m]: op_of[m].held for m in members}
     why = _build_problem(oracle, idx, held)
+    if why and upside_down is not None and not _build_problem(upside_down(), idx, held):
+        why = ""
     if why:
         return f"it cannot be built on its own: {why}"
     return _insert_problem(spec, oracle, idx)
