@@ -339,7 +339,7 @@ def load(
             on_step(f"computing part relations of {len(spec.parts)} parts ...")
         geometry = spec_geometry(spec)
         rel = load_relations(spec, progress=progress, geometry=geometry)
-        decided = decide_generated(spec, rel, geometry)
+        decided = decide_generated(spec, rel, geometry, say=on_step, progress=progress)
         spec, rel = decided.spec, decided.relations
         for line in decided.notes():
             note(line)
