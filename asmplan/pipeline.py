@@ -406,12 +406,12 @@ def state_graph(
     in milliseconds, said on ``on_step``). The spec, with those units, is first
     reduced (:func:`asp.symmetry.reduced_state_graph`: the precedences every complete
     sequence keeps, interchangeable parts in a fixed order or, for blocks of parts that
-    cannot be, only the first of equal blocks moving; same TCT and W*, far fewer states).
-    (a unit is one body of the main assembly there, its workspace left alone). When that
-    has nothing to reduce or no complete sequence, exactly alike parts are placed in a
-    fixed order (:func:`asp.symmetry.reduce_exact`) and, when a part can never be inserted
-    alone, subassemblies are added automatically
-    (:func:`asp.units.build_with_units`); the graph's ``spec`` holds all of it.
+    cannot be, only the first of equal blocks moving; same TCT and W*, far fewer states;
+    a unit is one body of the main assembly there, and the alike parts of its workspace
+    are reduced in it). When that has no complete sequence and a part can never be
+    inserted alone, subassemblies are added automatically
+    (:func:`asp.units.build_with_units`, each round reduced alike); the graph's ``spec``
+    holds all of it.
 
     Parameters
     ----------
@@ -428,7 +428,7 @@ def state_graph(
     asp.state_graph.StateGraph
     """
     from asp.errors import SpecError
-    from asp.symmetry import reduce_exact, reduced_state_graph
+    from asp.symmetry import reduced_state_graph
     from asp.units import (
         build_with_units,
         hierarchy_line,
@@ -460,7 +460,7 @@ def state_graph(
         spec,
         rel,
         hierarchy=spec.generated,
-        prepare=lambda with_units: reduce_exact(with_units, rel),
+        reduce=True,
         on_unit=on_step,
         given_up=given_up,
         progress=progress,

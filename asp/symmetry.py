@@ -68,6 +68,12 @@ class ReducedModel:
         :data:`TRUE` when a predecessor's part guarantees it.
     family : tuple of frozenset of int
         Per operation, the minimal blocker sets of its allowed directions in valid states.
+    raw_near : tuple of int
+        Per operation, the operations placing what it may touch or rest on (bitset).
+    workspace : tuple of int
+        Per operation, the members of the unit whose workspace it builds in (bitset; 0: the
+        main assembly). Its tests look at those members only and hold in the empty
+        workspace; in the main assembly's tests a unit's part stands for its members.
     """
 
     part_of: tuple[int, ...]
@@ -77,6 +83,7 @@ class ReducedModel:
     support: tuple[int, ...]
     family: tuple[frozenset[int], ...]
     raw_near: tuple[int, ...] = ()
+    workspace: tuple[int, ...] = ()
 
 
 def _bits(mask: int):
@@ -149,40 +156,48 @@ def _derive(spec: AssemblySpec, relations) -> tuple[ReducedModel | None, str, Re
     oracle = insertion_oracle(spec, relations)
     n_ops = len(spec.operations)
     pidx = {p: k for k, p in enumerate(oracle.parts)}
-    # a unit is one body of the main assembly (its oracle row ORs its members'); the
-    # placements in its workspace are left alone (tested against the unit's members only)
-    members = {u: [pidx[m] for m in ms] for u, ms in spec.subassemblies}
-    in_unit = {m for ms in members.values() for m in ms}
+    # a unit is one body of the main assembly (its oracle row ORs its members'): the main
+    # assembly sees its members only once it is inserted, so in the tests of the main
+    # assembly a member stands for its unit (:func:`_as_units`); a placement in a unit's
+    # workspace is tested against the unit's members placed there only (any member may
+    # go first into the empty workspace)
+    units = [(pidx[u], sum(1 << pidx[m] for m in ms)) for u, ms in spec.subassemblies]
+    room = {m: mask for _, mask in units for m in _bits(mask)}
     part_of = tuple(
-        pidx[op.unit]
-        if op.unit
-        else (pidx[op.parts[0]] if op.parts and pidx[op.parts[0]] not in in_unit else -1)
+        pidx[op.unit] if op.unit else (pidx[op.parts[0]] if op.parts else -1)
         for op in spec.operations
+    )
+    workspace = tuple(
+        room.get(p, 0) if not op.unit else 0 for p, op in zip(part_of, spec.operations, strict=True)
     )
     op_of = {p: i for i, p in enumerate(part_of) if p >= 0}
     bits_of = {p: 1 << p for p in op_of}
-    for i, op in enumerate(spec.operations):
-        if op.unit:
-            for m in members[op.unit]:
-                op_of[m] = i
-                bits_of[part_of[i]] |= 1 << m
     base = oracle.base
     initial = 0 if base in op_of or base < 0 else 1 << base
     absent = ((1 << len(oracle.parts)) - 1) & ~initial & ~sum(1 << p for p in op_of)
-    contact = [unpack_words(oracle.contact[p]) if p >= 0 else 0 for p in part_of]
-    support = [unpack_words(oracle.support[p]) if p >= 0 else 0 for p in part_of]
-    blocked = [
+    raw_contact = [unpack_words(oracle.contact[p]) if p >= 0 else 0 for p in part_of]
+    raw_support = [unpack_words(oracle.support[p]) if p >= 0 else 0 for p in part_of]
+    raw_blocked = [
         [unpack_words(oracle.blocked[p, d]) for d in range(6) if oracle.directions[d]]
         if p >= 0
         else []
         for p in part_of
     ]
+
+    def seen(i: int, mask: int) -> int:
+        """``mask`` as operation ``i``'s test sees it: its workspace's members, or the
+        main assembly's parts with the units for their members."""
+        return mask & workspace[i] if workspace[i] else _as_units(mask, units)
+
+    contact = [seen(i, m) for i, m in enumerate(raw_contact)]
+    support = [seen(i, m) for i, m in enumerate(raw_support)]
+    blocked = [[seen(i, m) for m in masks] for i, masks in enumerate(raw_blocked)]
     index = {op.id: i for i, op in enumerate(spec.operations)}
     must = [sum(1 << index[a] for a in op.after) for op in spec.operations]
     if base in op_of:
         b = op_of[base]
         for i in range(n_ops):
-            if i != b and part_of[i] >= 0:
+            if i != b and part_of[i] >= 0 and not workspace[i]:
                 must[i] |= 1 << b
     held = [op.held or not oracle.stability for op in spec.operations]
 
@@ -230,6 +245,10 @@ def _derive(spec: AssemblySpec, relations) -> tuple[ReducedModel | None, str, Re
                 red_s.append(TRUE)
                 fams.append(frozenset({0}))
                 continue
+            if workspace[i]:
+                # in a unit's workspace: only its members count, and nothing is proved
+                # impossible or needed first (any member may go first into it)
+                there, never = there & workspace[i], never & workspace[i]
             tests = []
             for mask in (contact[i], TRUE if held[i] else support[i]):
                 tests.append(TRUE if mask == TRUE or mask & there else mask & ~never)
@@ -239,24 +258,27 @@ def _derive(spec: AssemblySpec, relations) -> tuple[ReducedModel | None, str, Re
             # a set holding an ancestor (or itself) of every part it may touch or rest on is
             # never free; a set holding an ancestor of every part of another set is free only
             # when that one is (valid states hold the ancestors of what they hold)
-            need = [t for t in tests if t != TRUE]
             sets = {b & ~never for b in blocked[i] if not b & there}
-            sets = {b for b in sets if not any(covers(b, t) for t in need)}
-            family = frozenset(
-                b for b in sets if not any(covers(b, t) and not covers(t, b) for t in sets)
-            )
-            why, test = _never(spec, i, tests, family)
-            if why:
-                looked = (contact[i], support[i], _union(blocked[i]))[test]
-                return None, why, _refuted(spec, oracle, why, i, looked)
+            if workspace[i]:  # a set holding another is free only when that one is
+                family = frozenset(b for b in sets if not any(t != b and t & b == t for t in sets))
+            else:
+                need = [t for t in tests if t != TRUE]
+                sets = {b for b in sets if not any(covers(b, t) for t in need)}
+                family = frozenset(
+                    b for b in sets if not any(covers(b, t) and not covers(t, b) for t in sets)
+                )
+                why, test = _never(spec, i, tests, family)
+                if why:
+                    looked = (raw_contact[i], raw_support[i], _union(raw_blocked[i]))[test]
+                    return None, why, _refuted(spec, oracle, why, i, looked)
+                # the only part it can touch or rest on comes first
+                for mask in tests:
+                    if mask not in (TRUE, 0) and mask & (mask - 1) == 0:
+                        q = ops_of(mask)
+                        if q and not must[i] & q:
+                            must[i] |= q
+                            changed = True
             fams.append(family)
-            # the only part it can touch or rest on comes first
-            for mask in tests:
-                if mask not in (TRUE, 0) and mask & (mask - 1) == 0:
-                    q = ops_of(mask)
-                    if q and not must[i] & q:
-                        must[i] |= q
-                        changed = True
             # a part blocking it along every direction left comes after it
             common = ~0
             for s in family:
@@ -274,6 +296,7 @@ def _derive(spec: AssemblySpec, relations) -> tuple[ReducedModel | None, str, Re
                 support=tuple(red_s),
                 family=tuple(fams),
                 raw_near=tuple(ops_of(contact[i] | support[i]) for i in range(n_ops)),
+                workspace=workspace,
             )
             return model, "", None
 
@@ -302,6 +325,15 @@ def _refuted(spec: AssemblySpec, oracle, why: str, i: int, looked: int) -> Refut
         name = oracle.parts[p]
         parts.extend(members.get(name, (name,)))
     return Refutation(why, spec.operations[i].id, tuple(dict.fromkeys(parts)))
+
+
+def _as_units(mask: int, units: list[tuple[int, int]]) -> int:
+    """``mask`` with the members of each unit ``(unit part, members mask)`` replaced by the
+    unit's part: the main assembly holds a unit's members exactly when it holds the unit."""
+    for unit, members in units:
+        if mask & members:
+            mask = mask & ~members | 1 << unit
+    return mask
 
 
 def _union(masks) -> int:
@@ -359,6 +391,7 @@ class _Symmetry:
                 -1 if m.contact[i] == TRUE else bin(m.contact[i]).count("1"),
                 -1 if m.support[i] == TRUE else bin(m.support[i]).count("1"),
                 tuple(sorted(bin(s).count("1") for s in m.family[i])),
+                m.workspace[i] if m.workspace else 0,
             )
             for i in range(n)
         ]
@@ -373,12 +406,10 @@ class _Symmetry:
             for a in _bits(m.must[i]):
                 after[a] |= 1 << i
         self.relations = (near, list(m.must), after)
-        # a unit's insertion and its members' placements are never moved: the reduced model
-        # leaves the placements in a workspace untested, so it cannot tell two units alike
-        members = {p for _, ms in spec.subassemblies for p in ms}
-        self.fixed = sum(
-            1 << i for i, op in enumerate(spec.operations) if op.unit or set(op.parts) & members
-        )
+        # a unit's insertion is never moved (its members' placements are, within its
+        # workspace)
+        self.fixed = sum(1 << i for i, op in enumerate(spec.operations) if op.unit)
+        self.workspace = m.workspace or (0,) * n
 
     def _map_ops(self, perm: dict[int, int], mask: int) -> int:
         out = 0
@@ -400,7 +431,10 @@ class _Symmetry:
         """The operations whose reduced tests ``perm`` (identity elsewhere) does not map onto
         their image's: none for a symmetry."""
         m = self.m
-        if any(self.sig[i] != self.sig[j] for i, j in perm.items()):
+        if any(
+            self.sig[i] != self.sig[j] or self.workspace[i] != self.workspace[j]
+            for i, j in perm.items()
+        ):  # the units stay in place, so a placement stays in its workspace
             return list(perm)
         # only operations whose tests mention a moved one can change
         moved_parts = sum(1 << m.part_of[i] for i in perm if m.part_of[i] >= 0)
