@@ -728,7 +728,14 @@ def plan_report(result: AssemblyPlan, doc: dict, dag_png: bytes | None = None) -
     curve and Gantt charts (solved for the report when the plan has none and is small)."""
     from asmplan.report.html import report_figures, report_html
 
-    figures = report_figures(doc, result.concurrent, spec=result.assembly.spec, graph=result.graph)
+    sched = result.schedule
+    figures = report_figures(
+        doc,
+        result.concurrent,
+        spec=result.assembly.spec,
+        graph=result.graph,
+        schedule=None if sched is None else (sched.result, sched.lower_bound),
+    )
     if dag_png:
         figures["dag"] = dag_png
     return report_html(doc, figures)

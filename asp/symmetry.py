@@ -36,6 +36,28 @@ of the blocks are done in block order: chains of precedences (:func:`with_fixed_
 sorted state every move is mapped by a transposition of two blocks with the same prefix onto a
 move of the sorted graph with the same cost and an isomorphic future, so TCT and W* are the
 same (tested against the full graph), with far fewer states.
+
+**Units.** A unit is one body of the main assembly: the main assembly sees its members only
+once it is inserted, so in the main assembly's tests a member stands for the unit's part (a
+guide pin touching one bushing of the upper half of a die set touches that half). A
+placement in a unit's workspace is tested against the members placed there only, and any
+member may go first into the empty workspace: its reduced test keeps only the members (with
+the predecessors' parts there and the successors' not, and dominated blocker sets dropped),
+derives only that a member blocking it along every direction left comes after it, and
+proves nothing impossible. The insertions stay in place, so a symmetry maps each workspace
+onto itself: alike bushings or screws of one workspace are interchangeable like alike parts
+of the main assembly, and are ordered the same way.
+
+**The concurrent game** runs two operations at once only if both orders are transitions, so
+a fixed order of alike parts would forbid placing two of them together and change its W*.
+A class of single operations that ``w`` workers may do keeps a *loose* order instead
+(:func:`symmetry_reduction`): the ``j``-th may be done while at most ``w - 1`` of those
+before it are not. Starting the first one neither done nor running is then always a move
+(the others before it are running, at most ``w - 1``), it is the move any other start is
+mapped onto by a symmetry fixing the state (done and running), and the count only falls as
+operations are done, so a running one stays a transition whichever finishes first: both
+games keep their values. Classes of blocks of several operations (a dowel with its roller)
+stay chained (the alternating game's values; tested against the full graph).
 """
 
 from __future__ import annotations
@@ -659,7 +681,8 @@ def with_fixed_order(spec: AssemblySpec, classes: list[list[str]]) -> AssemblySp
 
 
 def reduce_interchangeable(spec: AssemblySpec, relations) -> AssemblySpec:
-    """``spec`` reduced for the state graph, with the full graph's TCT and W*.
+    """``spec`` reduced for the state graph, with the full graph's TCT and W* (the
+    alternating game).
 
     With the reduced model (:func:`reduced_model`): its derived precedences become ``after``
     (:func:`with_derived_precedences`; only dead ends go) and, for every class of
@@ -667,40 +690,79 @@ def reduce_interchangeable(spec: AssemblySpec, relations) -> AssemblySpec:
     order. Otherwise the classes of an exact swap are chained. A spec the derived precedences
     prove infeasible is returned as it is (the state graph names the cause).
     """
+    return _reduced(spec, relations, concurrent=False)[0]
+
+
+def _reduced(spec: AssemblySpec, relations, concurrent: bool):
+    """:func:`reduce_interchangeable` and, with ``concurrent``, the classes of single
+    interchangeable operations left out of the fixed order with their slack (``(m, ids)``
+    for :func:`asp.feasibility.operation_model`'s ``loose``; :func:`class_slack`)."""
     model, why, _ = _derive(spec, relations)
     if model is None:
-        return spec if why else with_fixed_order(spec, _exact_classes(spec, relations))
-    chains = []
-    for cls in interchangeable_blocks(spec, relations):
+        if why:
+            return spec, []
+        base, classes = spec, [[[o] for o in cls] for cls in _exact_classes(spec, relations)]
+    else:
+        base = with_derived_precedences(spec, relations)
+        classes = interchangeable_blocks(spec, relations)
+    chains, loose = [], []
+    for cls in classes:
+        slack = class_slack(spec, [b[0] for b in cls]) if concurrent else 0
+        if slack and all(len(b) == 1 for b in cls):
+            loose.append((slack, [b[0] for b in cls]))
+            continue
         for position in range(len(cls[0])):
             chains.append([block[position] for block in cls])
-    return with_fixed_order(with_derived_precedences(spec, relations), chains)
+    return with_fixed_order(base, chains), loose
 
 
-def symmetry_reduction(spec: AssemblySpec, relations) -> tuple[AssemblySpec, list[list[list[str]]]]:
-    """:func:`reduce_interchangeable`, and the classes whose blocks are not chains.
+def class_slack(spec: AssemblySpec, ids: list[str]) -> int:
+    """How many of the interchangeable operations ``ids`` may run besides one starting: one
+    less than the workers who may do them (an agent of side ``any`` is a robot and a person
+    in the concurrent game), at most ``len(ids) - 1``."""
+    sides = {a.name: a.side for a in spec.agents}
+    agents = {a for o in ids for a, _ in spec.operation(o).durations}
+    workers = sum(2 if sides.get(a) == "any" else 1 for a in agents)
+    return max(0, min(workers, len(ids)) - 1)
 
-    Such a class (a shaft with its two bearings and a collar, three times around a drive)
+
+def symmetry_reduction(
+    spec: AssemblySpec, relations
+) -> tuple[AssemblySpec, list[list[list[str]]], list[tuple[int, list[str]]]]:
+    """The reduction of interchangeable parts for a state graph that serves both games.
+
+    Returns the reduced spec, the classes whose blocks are not chains and the classes of
+    single operations in a loose order.
+
+    Classes of single operations that several workers may do are kept in a *loose* order
+    (``(m, ids)``, :meth:`asp.feasibility.OperationModel._loose_order`): an operation may be
+    done while at most ``m`` of those before it are not, ``m`` one less than those workers
+    (:func:`class_slack`), so that in the concurrent game two of them may still run at once
+    (a fixed order would forbid it and change its W*). Other classes of chains are chained
+    position by position (:func:`reduce_interchangeable`). A class whose blocks are not
+    chains (a shaft with its two bearings and a collar, three times around a drive)
     cannot be put in a fixed order by precedences; its first operations are chained when a
     block has one operation every other of it needs, and the state graph moves only the
     first of equal blocks (:meth:`asp.feasibility.OperationModel.enabled`, pass the classes
-    as ``operation_model(..., symmetric=...)``).
+    as ``operation_model(..., symmetric=...)``). Those classes of blocks of several
+    operations keep the alternating game's values; the concurrent game's only with classes
+    of single operations.
     """
     model, why, _ = _derive(spec, relations)
-    reduced = reduce_interchangeable(spec, relations)
+    reduced, loose = _reduced(spec, relations, concurrent=True)
     if model is None:
-        return reduced, []
+        return reduced, [], loose
     index = {op.id: i for i, op in enumerate(spec.operations)}
     chains, others = [], []
     for cls in interchangeable_blocks(spec, relations, chains_only=False):
         block = sum(1 << index[o] for o in cls[0])
         if all(bin(model.must[index[o]] & block).count("1") == k for k, o in enumerate(cls[0])):
-            continue  # a chain: reduce_interchangeable ordered it
+            continue  # a chain: _reduced ordered it
         others.append(cls)
         root = index[cls[0][0]]
         if all(model.must[index[o]] >> root & 1 for o in cls[0][1:]):
             chains.append([b[0] for b in cls])
-    return with_fixed_order(reduced, chains), others
+    return with_fixed_order(reduced, chains), others, loose
 
 
 def reduced_state_graph(spec: AssemblySpec, relations, **kwargs):
@@ -713,10 +775,10 @@ def reduced_state_graph(spec: AssemblySpec, relations, **kwargs):
     from asp.feasibility import operation_model
     from asp.state_graph import build_state_graph
 
-    reduced, others = symmetry_reduction(spec, relations)
-    if reduced is spec and not others:
+    reduced, others, loose = symmetry_reduction(spec, relations)
+    if reduced is spec and not others and not loose:
         return None
-    model = operation_model(reduced, relations, symmetric=others)
+    model = operation_model(reduced, relations, symmetric=others, loose=loose)
     return build_state_graph(reduced, relations, model=model, drop_stuck=True, **kwargs)
 
 

@@ -87,13 +87,16 @@ def assembly_steps(plan: dict, *, max_pictures: int = 40) -> list[tuple[dict, st
 # --------------------------------------------------------------------------- figures
 
 
-def report_figures(doc: dict, concurrent_plan=None, *, spec=None, graph=None) -> dict[str, bytes]:
+def report_figures(
+    doc: dict, concurrent_plan=None, *, spec=None, graph=None, schedule=None
+) -> dict[str, bytes]:
     """The curve and Gantt PNGs of the report (:mod:`asmplan.report.gantt`), by name.
 
     ``concurrent_plan`` (:class:`asp.concurrent_plan.ConcurrentPlan`) gives the curve and
     the two timelines; without it they are computed here from ``spec`` and ``graph`` when
     the state graph has at most :data:`REPORT_MAX_STATES` states (else ``"why"`` says why
-    they are missing). The CP-SAT schedule's Gantt chart comes from ``doc["schedule"]``.
+    they are missing; ``schedule``, the plan's CP-SAT schedule and its lower bound, spares
+    solving it again). The CP-SAT schedule's Gantt chart comes from ``doc["schedule"]``.
     """
     import tempfile
 
@@ -108,7 +111,9 @@ def report_figures(doc: dict, concurrent_plan=None, *, spec=None, graph=None) ->
                 try:
                     from asp.concurrent_plan import plan_concurrent
 
-                    concurrent_plan = plan_concurrent(spec, graph, max_nodes=200_000)
+                    concurrent_plan = plan_concurrent(
+                        spec, graph, max_nodes=200_000, schedule=schedule
+                    )
                 except (ValueError, MemoryError) as exc:
                     out["why"] = str(exc).splitlines()[0].encode()
             else:
