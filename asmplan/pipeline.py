@@ -270,8 +270,8 @@ def load(
 
     A generated spec (no ``assembly.yaml``) is announced through ``on_step``, else as a
     warning; the decisions that need its relations (:func:`asp.generate.decide_generated`:
-    gravity, base part, ``held`` placements of parts nothing can keep from falling) are
-    each said in a note. ``contact_tol`` and
+    build frame, gravity, base part, ``held`` placements of parts nothing can keep from
+    falling) are each said in a note. ``contact_tol`` and
     ``penetration_tol`` (mm) replace the spec's tolerances when given.
     """
     from asp.feasibility import load_relations
@@ -300,7 +300,7 @@ def load(
         geometry = spec_geometry(spec)
         rel = load_relations(spec, progress=progress, geometry=geometry)
         decided = decide_generated(spec, rel, geometry)
-        spec = decided.spec
+        spec, rel = decided.spec, decided.relations
         for line in decided.notes():
             note(line)
     return Assembly(spec=spec, relations=rel)

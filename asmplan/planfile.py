@@ -718,13 +718,15 @@ def operation_records(spec) -> dict[str, dict]:
 def add_insertions(steps: list[dict], spec, relations, operations: dict) -> str | None:
     """Give each step ``insertions``: the bodies it puts in, in order, each with its way in.
 
-    An insertion is ``{operation, parts, workspace, unit, held, free_along, insert_along}``:
-    one per part an operation places in turn, one for a unit (all its members together).
-    ``free_along`` is a direction ``d`` with ``TT_d`` from everything already in the
-    workspace (the body can leave along ``d``), ``insert_along`` is ``-d``: the body moves
-    along it to go in. Both are null for the first body of a workspace and without
-    geometry. The line is replayed by :func:`asp.checker.check_line`; returns None when it
-    accepts the line, else its error (the insertions then carry no directions).
+    An insertion is ``{operation, parts, workspace, unit, held, free_along, insert_along,
+    insert_vector_file}``: one per part an operation places in turn, one for a unit (all its
+    members together). ``free_along`` is a direction ``d`` of the build frame with ``TT_d``
+    from everything already in the workspace (the body can leave along ``d``),
+    ``insert_along`` is ``-d``: the body moves along it to go in; ``insert_vector_file`` is
+    that direction as a unit vector in the file's coordinates. They are null for the first
+    body of a workspace and without geometry. The line is replayed by
+    :func:`asp.checker.check_line`; returns None when it accepts the line, else its error
+    (the insertions then carry no directions).
     """
     from asp.checker import check_line
 
@@ -755,6 +757,7 @@ def add_insertions(steps: list[dict], spec, relations, operations: dict) -> str 
                         "held": info.get("held", False),
                         "free_along": free,
                         "insert_along": _opposite(free) if free else None,
+                        "insert_vector_file": file_vector(spec, _opposite(free)) if free else None,
                     }
                 )
     return error
@@ -764,14 +767,30 @@ def _opposite(direction: str) -> str:
     return ("-" if direction[0] == "+" else "+") + direction[1:]
 
 
+def build_rotation(spec) -> tuple[tuple[float, ...], ...]:
+    """The spec's build frame as a 3x3 rotation ``R`` (``x_build = R @ x_file``; the
+    identity for the file's own frame)."""
+    identity = ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
+    return identity if getattr(spec, "frame", None) is None else spec.frame
+
+
+def file_vector(spec, direction: str) -> list[float]:
+    """A build-frame axis direction (``"-z"``) as a unit vector in the file's coordinates
+    (``R^T`` times the axis vector), rounded to 1e-9."""
+    k = "xyz".index(direction[1])
+    sign = 1.0 if direction[0] == "+" else -1.0
+    return [round(sign * x, 9) + 0.0 for x in build_rotation(spec)[k]]
+
+
 def geometry_record(spec, relations) -> dict | None:
     """The length unit, scale, frame, tolerances and mesh rules of the geometry (None
     without it): what a checker replaying a line from the meshes alone needs.
 
-    Coordinates are the source file's own frame (its node transforms applied, no axis
+    Coordinates: the source file's own frame (its node transforms applied, no axis
     changed) times ``scale`` (millimetres per coordinate as trimesh reads the files, a
     file's millimetre numbers under a wrong unit label included; null when the files
-    differ, each part's ``source.scale`` then says); tolerances are in millimetres; a
+    differ, each part's ``source.scale`` then says), turned by ``build_rotation`` into the
+    build frame (below); tolerances are in millimetres; a
     pair ``(i, j)`` tolerates an overlap of ``part_shrink[i] + part_shrink[j]``
     (:mod:`cad.tolerances`), and counts a gap of ``min(contact_reach[i],
     contact_reach[j])`` as touching (``contact_tol`` for every pair when ``contact_reach``
@@ -780,8 +799,15 @@ def geometry_record(spec, relations) -> dict | None:
     own vertices; eroding such a mesh leaves its edges where they were). ``erosion``: how a
     part is shrunk. ``fits``: pairs whose inner part is shrunk further for that pair only
     (:mod:`cad.fits`). ``support_travel_factor``: a part is supported if a fall of that
-    many times the pair's tolerance meets a part below (:mod:`cad.support`).
-    ``open_parts``: parts not closed after merging (their relations are approximate).
+    many times the pair's tolerance meets a part below; ``support``: the rules a part is
+    supported by (:data:`cad.support.SUPPORT_RULES`). ``open_parts``: parts not closed after
+    merging (their relations are approximate: a closed part has an inside, a part lying
+    wholly in it collides with it; an open one has none).
+    ``frame``: ``"file"`` (the file's own axes) or ``"build"`` (the parts turned as the
+    product is fixtured, :mod:`cad.frame`); ``build_rotation``: the 3x3 rotation ``R``, row
+    by row, taking file coordinates (times ``scale``) to build coordinates, ``x_build = R @
+    x_file`` (the identity for ``"file"``). Directions, gravity and every tolerance are in
+    the build frame.
     """
     if relations is None:
         return None
@@ -804,7 +830,8 @@ def geometry_record(spec, relations) -> dict | None:
         "unit": "mm",
         "file_unit": file_unit,
         "scale": scale,
-        "frame": "file",
+        "frame": "file" if spec.frame is None else "build",
+        "build_rotation": [list(row) for row in build_rotation(spec)],
         "contact_tol": float(relations.contact_tol),
         "penetration_tol": float(relations.penetration_tol),
         "part_shrink": dict(zip(map(str, relations.parts), map(float, shrink), strict=True)),

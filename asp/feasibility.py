@@ -785,8 +785,9 @@ def operation_model(
 def load_relations(spec: AssemblySpec, *, progress: bool = False, geometry=None):
     """Compute the cad relations of ``spec``'s parts (``None`` when it has no geometry).
 
-    Reads the meshes of the spec's parts (:func:`asp.generate.spec_geometry`) unless
-    ``geometry`` (that ``cad.Assembly``, already read) is given, with the spec's
+    Reads the meshes of the spec's parts (:func:`asp.generate.spec_geometry`: in the
+    spec's build frame) unless ``geometry`` (that ``cad.Assembly``, already read) is given,
+    with the spec's
     ``contact_tol`` and ``penetration_tol`` (None: the per-part rule).
     """
     if not spec.has_geometry:
@@ -795,7 +796,9 @@ def load_relations(spec: AssemblySpec, *, progress: bool = False, geometry=None)
     from cad.loading import load_parts
 
     return cad.compute_relations(
-        load_parts(spec.parts, spec.folder, spec.units) if geometry is None else geometry,
+        load_parts(spec.parts, spec.folder, spec.units, frame=spec.frame)
+        if geometry is None
+        else geometry,
         contact_tol=spec.contact_tol,
         penetration_tol=spec.penetration_tol,
         progress=progress,

@@ -8,6 +8,11 @@ rule, fixed so that a generated spec plans the same as the file it writes:
 - parts: one per mesh node of the file (ids and names from the file, :mod:`cad.scene`),
   or per mesh file of the folder (a ``bom.csv``/``bom.yaml`` in the folder still names
   them); ``shape`` is the shape class (identical parts share it, :mod:`cad.identical`);
+- frame: the file's own, unless some pair of parts can never be assembled in it (each
+  blocks the other along every axis direction, :func:`cad.frame.interlocked`: the Fabrica
+  duct's pins lie 30 degrees off ``z``); then a few frames turning a part axis the parts
+  share onto a coordinate axis are tried (:mod:`asp.framing`), the first that leaves every
+  part a way in taken; ``frame:`` in the spec, said on stderr;
 - gravity: the format's own down (``-y`` for glTF/GLB, whose specification makes ``+y``
   up; ``-z`` for the others) unless another axis direction is clearly better for the
   parts' relations (:mod:`asp.gravity`: a Y-up STEP export gets ``-y``);
@@ -171,7 +176,7 @@ def spec_geometry(spec: AssemblySpec):
 
     if not spec.parts:
         raise SpecError(f"{spec.source}: the spec names no parts (a 'parts:' list with files)")
-    return load_parts(spec.parts, spec.folder, spec.units)
+    return load_parts(spec.parts, spec.folder, spec.units, frame=spec.frame)
 
 
 def spec_hierarchy(spec: AssemblySpec) -> tuple[tuple[str, tuple[str, ...]], ...]:
@@ -218,25 +223,31 @@ def cad_assembly(path: str | Path):
 
 
 def spec_data(
-    path: str | Path, spec_folder: str | Path | None = None, gravity: str | None = None
+    path: str | Path,
+    spec_folder: str | Path | None = None,
+    gravity: str | None = None,
+    frame=None,
 ) -> tuple[dict, object]:
     """The generated spec of a CAD file or folder, as the YAML mapping, and its geometry.
 
     Part files are written relative to ``spec_folder`` (default: the CAD file's folder,
     or the folder of meshes itself); ``gravity`` defaults to the format's own down
-    (:func:`asp.gravity.default_down`).
+    (:func:`asp.gravity.default_down`); ``frame`` (a rotation, :mod:`cad.frame`; None: the
+    file's own) is the build frame the parts are turned into, and written as ``frame:``.
 
     Returns
     -------
     (dict, cad.Assembly)
-        The mapping :func:`asp.spec.spec_from_dict` reads, and the parts it was made from.
+        The mapping :func:`asp.spec.spec_from_dict` reads, and the parts it was made from
+        (in the build frame).
     """
     from asp.gravity import base_index, default_down
+    from cad.frame import frame_record, rotated
     from cad.identical import shape_classes
 
     path = Path(path)
     gravity = gravity or default_down(path)
-    assembly = cad_assembly(path)
+    assembly = rotated(cad_assembly(path), frame)
     shapes = shape_classes(assembly.parts)
     counts = Counter(shapes)
     if spec_folder is None:
@@ -286,6 +297,7 @@ def spec_data(
         },
         "base_part": assembly.parts[base].id,
         "gravity": gravity,
+        **({"frame": frame_record(frame)} if frame is not None else {}),
         "gripper_approach": ["+x", "-x", "+y", "-y", "+z", "-z"],
         "constraints": {"topological": True, "stability": True, "functional": True},
         "turn_model": "alternate",
@@ -313,14 +325,15 @@ def load_any(path: str | os.PathLike[str]) -> AssemblySpec:
     return generated_spec(path) if is_cad_input(path) else load_spec(path)
 
 
-def generated_spec(path: str | Path, gravity: str | None = None) -> AssemblySpec:
+def generated_spec(path: str | Path, gravity: str | None = None, frame=None) -> AssemblySpec:
     """The spec generated from a CAD file or a folder of part meshes (``generated=True``).
 
     Its ``source`` is the spec file it stands for (``assembly.yaml`` beside the CAD file,
-    which need not exist), so that part files resolve as in the written spec.
+    which need not exist), so that part files resolve as in the written spec. ``gravity``
+    and ``frame``: as :func:`spec_data` takes them.
     """
     path = Path(path)
-    data, _ = spec_data(path, gravity=gravity)
+    data, _ = spec_data(path, gravity=gravity, frame=frame)
     folder = path if path.is_dir() else path.parent
     spec = spec_from_dict(data, source=str(folder / SPEC_FILE))
     return replace(spec, generated=True, source=str(path))
@@ -340,8 +353,9 @@ def orient_generated(spec: AssemblySpec, relations, geometry, turn=None):
 
     When the choice differs from the spec's (the format's own down), the spec is
     generated again along it (base part and operation order follow gravity) by
-    ``turn(gravity)`` (default: :func:`generated_spec` of the spec's source). A user's
-    spec, or one without relations, is returned unchanged with None.
+    ``turn(gravity, frame)`` (default: :func:`generated_spec` of the spec's source), in the
+    spec's build frame. A user's spec, or one without relations, is returned unchanged
+    with None.
     """
     import warnings
 
@@ -352,9 +366,15 @@ def orient_generated(spec: AssemblySpec, relations, geometry, turn=None):
         return spec, choice
     with warnings.catch_warnings():  # the same files again: their warnings were given
         warnings.simplefilter("ignore")
-        turned = (turn or (lambda g: generated_spec(spec.source, gravity=g)))(choice.gravity)
+        turned = (turn or _regenerate(spec))(choice.gravity, spec.frame)
     tolerances = {"contact_tol": spec.contact_tol, "penetration_tol": spec.penetration_tol}
     return replace(turned, **tolerances), choice
+
+
+def _regenerate(spec: AssemblySpec):
+    """``turn(gravity, frame)``: ``spec``'s source generated again along another gravity
+    or in another build frame (tolerances are kept by the callers)."""
+    return lambda gravity, frame: generated_spec(spec.source, gravity=gravity, frame=frame)
 
 
 @dataclass(frozen=True)
@@ -364,16 +384,28 @@ class Decisions:
     Attributes
     ----------
     spec : AssemblySpec
-        The spec along the chosen gravity, on a workable base, ``held`` applied.
+        The spec in the chosen build frame, along the chosen gravity, on a workable base,
+        ``held`` applied.
     gravity : asp.gravity.GravityChoice or None
         The gravity choice and its reason (None: a user's spec, or no support table).
     rebased : str
         Why another base part was taken ("" when the lowest large part was kept).
+    relations : cad.relations.Relations or None
+        The part relations in the spec's build frame (those given, unless another frame
+        was chosen).
+    geometry : cad.Assembly or None
+        The parts in the spec's build frame.
+    frame : asp.framing.FrameChoice or None
+        Why another build frame was taken, or why none helped (None: the file's frame
+        leaves every pair of parts a way in, or a user's spec).
     """
 
     spec: AssemblySpec
     gravity: object | None
     rebased: str
+    relations: object | None = None
+    geometry: object | None = None
+    frame: object | None = None
 
     @property
     def held(self) -> tuple[str, ...]:
@@ -383,6 +415,8 @@ class Decisions:
     def notes(self) -> list[str]:
         """One line per decision, as a person reads them."""
         out = []
+        if self.frame is not None:
+            out.append(f"generated spec: frame: {self.frame.text}")
         if self.gravity is not None:
             out.append(f"generated spec: gravity {self.gravity.gravity}: {self.gravity.reason}")
         if self.rebased:
@@ -393,16 +427,44 @@ class Decisions:
 
 
 def decide_generated(spec: AssemblySpec, relations, geometry, turn=None) -> Decisions:
-    """The decisions of a generated spec that need its relations, in this order: gravity
-    (:func:`orient_generated`), then the base part and ``held`` (:func:`workable_base`).
+    """The decisions of a generated spec that need its relations, in this order: the build
+    frame (:func:`asp.framing.choose_frame`: only when some pair of parts can never be
+    assembled in the file's frame), gravity (:func:`orient_generated`), then the base part
+    and ``held`` (:func:`workable_base`).
 
     ``asmplan plan`` (:func:`asmplan.pipeline.load`) and ``asmplan init``
     (:func:`spec_text`) both take them here, so the file written plans as the file read.
-    A user's spec comes back unchanged. ``turn``: as :func:`orient_generated` takes it.
+    A user's spec comes back unchanged. ``turn(gravity, frame)``: the spec generated again
+    along another gravity or in another frame (default: from the spec's source). Use the
+    returned ``relations`` (in the chosen frame) from then on.
     """
+    from asp.framing import choose_frame
+
+    turn = turn or _regenerate(spec)
+    decided = _decide_in_frame(spec, relations, geometry, turn)
+
+    def in_frame(rotation) -> Decisions:
+        """The decisions in another build frame (its relations computed afresh)."""
+        import cad
+        from cad.frame import rotated
+
+        geo = rotated(geometry, rotation)
+        rel = cad.compute_relations(
+            geo, contact_tol=spec.contact_tol, penetration_tol=spec.penetration_tol
+        )
+        tolerances = {"contact_tol": spec.contact_tol, "penetration_tol": spec.penetration_tol}
+        framed = replace(turn(None, rotation), **tolerances)
+        return _decide_in_frame(framed, rel, geo, turn)
+
+    choice, chosen = choose_frame(decided, geometry, in_frame)
+    return replace(chosen or decided, frame=choice)
+
+
+def _decide_in_frame(spec: AssemblySpec, relations, geometry, turn) -> Decisions:
+    """Gravity, base part and ``held`` of a generated spec, its frame as given."""
     oriented, choice = orient_generated(spec, relations, geometry, turn)
     decided, rebased = workable_base(oriented, relations)
-    return Decisions(decided, choice, rebased)
+    return Decisions(decided, choice, rebased, relations, geometry)
 
 
 def spec_text(
@@ -419,8 +481,8 @@ def spec_text(
     Part files are relative to ``spec_folder``, where the file will be written. Tolerances
     given (mm) are written as the spec's ``contact_tol`` / ``penetration_tol`` and used for
     the ``held`` marks; else both keys are written commented out. ``on_note`` (optional) is
-    called with a line for each decision of :func:`decide_generated` (gravity, base part,
-    ``held``). ``decide_units(spec,
+    called with a line for each decision of :func:`decide_generated` (build frame,
+    gravity, base part, ``held``). ``decide_units(spec,
     relations)`` (:func:`asp.units.cad_units`, given by the caller: it sits above this
     module) decides which of the file's sub-assemblies are written as ``subassemblies:``;
     without it they are all written commented.
@@ -433,18 +495,20 @@ def spec_text(
     relations = cad.compute_relations(
         assembly, contact_tol=contact_tol, penetration_tol=penetration_tol
     )
-    turned: dict = {}
+    turned: dict = {(data["gravity"], None): (data, assembly)}
 
-    def turn(gravity: str) -> AssemblySpec:
-        """The spec along another gravity, keeping its records (read once)."""
-        turned["data"], turned["assembly"] = spec_data(path, spec_folder, gravity=gravity)
-        return replace(spec_from_dict(turned["data"], source=str(path)), generated=True)
+    def turn(gravity: str | None, frame) -> AssemblySpec:
+        """The spec along another gravity or in another frame, keeping its records."""
+        records = spec_data(path, spec_folder, gravity=gravity, frame=frame)
+        turned[(records[0]["gravity"], frame)] = records
+        return replace(spec_from_dict(records[0], source=str(path)), generated=True)
 
-    generated = replace(spec_from_dict(data, source=str(path)), generated=True)
+    tolerances = {"contact_tol": contact_tol, "penetration_tol": penetration_tol}
+    generated = replace(spec_from_dict(data, source=str(path)), generated=True, **tolerances)
     decided = decide_generated(generated, relations, assembly, turn)
-    spec = decided.spec
-    if turned:  # the records along the chosen gravity
-        data, assembly = turned["data"], turned["assembly"]
+    spec, relations = decided.spec, decided.relations
+    # the records along the chosen gravity, in the chosen frame
+    data, assembly = turned.get((spec.gravity, spec.frame), (data, assembly))
     if on_note is not None:
         for line in decided.notes():
             on_note(line)
@@ -493,7 +557,8 @@ def spec_text(
             if decided.rebased
             else "the lowest of the large parts"
         ),
-        f"gravity: {data['gravity']}                # direction of gravity in the file's frame:",
+        *_frame_lines(decided),
+        f"gravity: {data['gravity']}                # direction of gravity in the build frame:",
         f"#   {reason} (asp/gravity.py)",
         "gripper_approach: [+x, -x, +y, -y, +z, -z]   # directions a part may be inserted from",
         "constraints: {topological: true, stability: true, functional: true}",
@@ -576,6 +641,27 @@ def _unit_ways(spec, relations, used) -> tuple[dict[str, str], set[str]]:
         if o.upside_down:
             turned[u.id] = o.gravity
     return turned, loose_units(with_units, relations)
+
+
+def _frame_lines(decided: Decisions) -> list[str]:
+    """The ``frame:`` of a written spec (commented out when it is the file's own)."""
+    from cad.frame import frame_record
+
+    record = frame_record(decided.spec.frame)
+    if record is None:
+        lines = [
+            "# frame: file   # the build frame (the product as fixtured): the file's own, or",
+            "#   {axis: [x, y, z], degrees: a} turns it (cad/frame.py)",
+        ]
+        if decided.frame is not None:
+            lines.append(f"#   {decided.frame.text}")
+        return lines
+    axis = ", ".join(str(json_number(x)) for x in record["axis"])
+    return [
+        f"frame: {{axis: [{axis}], degrees: {json_number(record['degrees'])}}}"
+        "   # the build frame: the product as fixtured (cad/frame.py)",
+        f"#   {decided.frame.text} (asp/framing.py)",
+    ]
 
 
 def _tolerance_line(key: str, value: float | None, meaning: str) -> str:

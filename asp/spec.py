@@ -14,6 +14,10 @@ An ``assembly.yaml`` names everything the planner needs besides the part geometr
       R1.bit: {initial: hex, change_time: 0}
     base_part: BD                      # placed first (or there from the start)
     gravity: -z                        # one of +x -x +y -y +z -z
+    frame: {axis: [0, -1, 0], degrees: 30}   # the build frame: the product as fixtured,
+                                       # the file's frame turned so (or a 3x3 matrix R,
+                                       # x_build = R x_file; default: the file's own);
+                                       # directions and gravity are its axes (cad/frame.py)
     gripper_approach: [+z, -z]         # directions d a part may leave along (inserted along -d)
     constraints: {topological: true, stability: true, functional: true}
     turn_model: alternate              # or concurrent (asp/concurrent.py)
@@ -71,6 +75,7 @@ from asp.dag import MAX_COST
 from asp.rules import COST_MODELS
 from cad.bom import PartRecord, part_records, refuse_unknown_keys
 from cad.directions import DIRECTIONS
+from cad.frame import parse_frame
 from cad.tolerances import checked_tolerance
 from cad.units import unit_scale
 from cad.yamlfile import read_yaml
@@ -82,7 +87,7 @@ SPEC_FILE = "assembly.yaml"
 TOP_KEYS = (
     "name", "units", "parts", "agents", "tools", "base_part", "gravity", "gripper_approach",
     "constraints", "turn_model", "cost", "operations", "credit", "max_states", "subassemblies",
-    "contact_tol", "penetration_tol",
+    "contact_tol", "penetration_tol", "frame",
 )  # fmt: skip
 """The top-level keys of ``assembly.yaml``; any other is refused."""
 OPERATION_KEYS = (
@@ -210,6 +215,10 @@ class AssemblySpec:
     """Contact tolerance (mm) for every pair; None: the per-part rule of cad.tolerances."""
     penetration_tol: float | None = None
     """Penetration tolerance (mm) for every pair; None: the per-part rule of cad.tolerances."""
+    frame: tuple[tuple[float, float, float], ...] | None = None
+    """The build frame (``frame:``, :mod:`cad.frame`): the rotation ``R`` (row by row) with
+    ``x_build = R @ x_file``, applied to every part where it is loaded; directions and
+    gravity are axes of the build frame. None: the file's own frame."""
 
     @property
     def op_ids(self) -> tuple[str, ...]:
@@ -408,6 +417,10 @@ class _Parser:
                 tols[key] = checked_tolerance(data.get(key), key)
             except ValueError as exc:
                 raise ValueError(f"{self.source}: {exc}") from None
+        try:
+            frame = parse_frame(data.get("frame"))
+        except ValueError as exc:
+            raise self.fail("frame", str(exc)) from None
         spec = AssemblySpec(
             name=str(data.get("name") or Path(self.source).parent.name or "assembly"),
             operations=ops,
@@ -424,6 +437,7 @@ class _Parser:
             units=None if units is None else str(units),
             credit=str(data.get("credit", "")),
             max_states=max_states,
+            frame=frame,
             **tols,
         )
         raw_units = self.mapping(data.get("subassemblies"), "subassemblies")

@@ -35,7 +35,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # run from a checkout
 
 FABRICA = ROOT.parent / "shared" / "data" / "cad" / "fabrica"
-BUILT = ("rod_tower", "bolted_bracket", "finger_box", "gear_pair", "bearing_stack")
+BUILT = ("rod_tower", "bolted_bracket", "finger_box", "gear_pair", "bearing_stack", "tilted_pins")
 SCENES = {".step", ".stp", ".3dxml", ".glb", ".gltf", ".3mf"}
 MESHES = {".obj", ".stl", ".ply", ".off"}
 COLUMNS = (

@@ -63,12 +63,16 @@ class Assembly:
     groups : tuple of (str, tuple of str)
         The hierarchy the file gives (a STEP sub-assembly, a glTF parent node): group id
         -> ids of the parts below it, outermost first. Empty when the source has none.
+    frame : tuple of tuple of float, or None
+        The build frame the meshes are in (:mod:`cad.frame`): the rotation ``R`` with
+        ``x_build = R @ x_file``, row by row; None: the file's own frame.
     """
 
     parts: tuple[Part, ...]
     units: str = "mm"
     source: str = ""
     groups: tuple[tuple[str, tuple[str, ...]], ...] = ()
+    frame: tuple[tuple[float, float, float], ...] | None = None
 
     def __post_init__(self) -> None:
         seen: set[str] = set()

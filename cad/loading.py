@@ -16,6 +16,9 @@ the base folder, or ``scene.step#node`` for one part of a scene file.
 Units: a format that declares its unit wins (glTF/GLB and STEP are metres; 3MF states its
 unit), else ``units`` passed in, else millimetres. Meshes are converted to millimetres on
 load.
+
+Frame: ``frame`` (a rotation, :mod:`cad.frame`; a spec's ``frame:``) turns every part into
+the build frame once, here, after the unit conversion; None keeps the file's own frame.
 """
 
 from __future__ import annotations
@@ -30,6 +33,7 @@ import trimesh
 from cad.assembly import Assembly, prepare_part
 from cad.bom import PartRecord, read_bom
 from cad.errors import GeometryError
+from cad.frame import Rotation, rotated
 from cad.scene import SCENE_SUFFIXES, empty_scene_error, read_scene
 from cad.unit_hints import part_scale_hint
 from cad.units import unit_scale
@@ -41,7 +45,11 @@ METRES_ONLY = ((1000.0, "metres"),)
 
 
 def load_assembly(
-    path: str | Path, units: str | None = None, *, bom: str | Path | None = None
+    path: str | Path,
+    units: str | None = None,
+    *,
+    bom: str | Path | None = None,
+    frame: Rotation | None = None,
 ) -> Assembly:
     """Read an assembly from a folder of part meshes or a scene file.
 
@@ -54,6 +62,8 @@ def load_assembly(
     bom : str or Path, optional
         Explicit BOM file (CSV or YAML); in a folder ``bom.csv``/``bom.yaml`` is found
         automatically.
+    frame : 3x3 rotation, optional
+        The build frame (:mod:`cad.frame`): every mesh is turned by it (None: the file's).
 
     Returns
     -------
@@ -79,18 +89,18 @@ def load_assembly(
         if bom is None:
             bom = next((path / n for n in BOM_NAMES if (path / n).is_file()), None)
         records = read_bom(bom) if bom is not None else folder_records(path)
-        return load_parts(records, path, units)
+        return load_parts(records, path, units, frame=frame)
     if path.suffix.lower() in (".yaml", ".yml"):
         raise GeometryError(
             f"{path}: an assembly spec is read by asp.spec.load_spec (cad.load_parts takes "
             "its parts)"
         )
     if bom is None:
-        return _scene_assembly(path, units)
+        return rotated(_scene_assembly(path, units), frame)
     records = [
         PartRecord(**{**r.__dict__, "file": f"{path.name}#{r.file or r.id}"}) for r in read_bom(bom)
     ]
-    return load_parts(records, path.parent, units)
+    return load_parts(records, path.parent, units, frame=frame)
 
 
 def folder_records(folder: Path) -> tuple[PartRecord, ...]:
@@ -102,7 +112,11 @@ def folder_records(folder: Path) -> tuple[PartRecord, ...]:
 
 
 def load_parts(
-    records: Sequence[PartRecord], base: str | Path, units: str | None = None
+    records: Sequence[PartRecord],
+    base: str | Path,
+    units: str | None = None,
+    *,
+    frame: Rotation | None = None,
 ) -> Assembly:
     """The geometry of part records: each record's mesh, in millimetres.
 
@@ -115,6 +129,8 @@ def load_parts(
         Folder the files are relative to.
     units : str, optional
         Unit of files that do not declare one (default ``"mm"``).
+    frame : 3x3 rotation, optional
+        The build frame (:mod:`cad.frame`): every mesh is turned by it (None: the file's).
 
     Returns
     -------
@@ -148,7 +164,7 @@ def load_parts(
         hint = part_scale_hint(assembly, k, factors=METRES_ONLY)
         if hint:
             warnings.warn(hint, stacklevel=2)
-    return assembly
+    return rotated(assembly, frame)
 
 
 def _record_mesh(row: PartRecord, base: Path, units: str | None):
@@ -219,7 +235,7 @@ def apply_bom(assembly: Assembly, records: Sequence[PartRecord], base: Path) -> 
             shape=row.shape or old.shape,
         )
     if added:
-        parts += load_parts(added, base).parts
+        parts += load_parts(added, base, frame=assembly.frame).parts
     _check_unique([p.id for p in parts], base)
     groups = tuple(
         (gid, tuple(renamed.get(m, m) for m in members)) for gid, members in assembly.groups

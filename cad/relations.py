@@ -14,7 +14,7 @@ from cad.errors import GeometryError
 from cad.fits import find_fits
 from cad.freedom import eroded_meshes
 from cad.freedom import translational_freedom as _freedom
-from cad.support import SUPPORT_TRAVEL_FACTOR, support_relation
+from cad.support import SUPPORT_RULES, SUPPORT_TRAVEL_FACTOR, support_relation
 from cad.tolerances import resolve_tolerances
 
 
@@ -176,7 +176,8 @@ def replay_rules(relations: Relations) -> dict:
         ``merge_vertices`` (true: coincident vertices of each mesh are merged first),
         ``erosion`` (how a part is shrunk by its ``part_shrink``), ``contact_reach``
         (part -> mm, or None when ``contact_tol`` holds for every pair),
-        ``support_travel_factor``, ``fits`` (``inner, outer, extra_shrink`` mm: the inner
+        ``support_travel_factor``, ``support`` (the rules a part is supported by,
+        :data:`cad.support.SUPPORT_RULES`), ``fits`` (``inner, outer, extra_shrink`` mm: the inner
         part is shrunk by that much more against the outer one only) and ``open_parts``.
     """
     ids = [str(p) for p in relations.parts]
@@ -186,6 +187,7 @@ def replay_rules(relations: Relations) -> dict:
         "erosion": "face_planes",
         "contact_reach": dict(zip(ids, map(float, reach), strict=True)) if reach else None,
         "support_travel_factor": SUPPORT_TRAVEL_FACTOR,
+        "support": list(SUPPORT_RULES),
         "fits": [
             {"inner": str(i), "outer": str(o), "extra_shrink": float(e)}
             for i, o, e in getattr(relations, "fits", ())

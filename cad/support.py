@@ -52,6 +52,9 @@ from cad.freedom import facing_pairs, sweep_blocked
 
 SUPPORT_TRAVEL_FACTOR = 3.0
 """Support travel of a pair, in multiples of its penetration tolerance."""
+SUPPORT_RULES = ("rests", "captured", "threaded")
+"""The rules of the module docstring (drop test, captured in a hole, threaded on), as
+``plan.json``'s ``geometry.support`` names them for a checker replaying a plan."""
 _INSIDE_MARGIN = 1e-6
 """Relative slack of the cross-section containment test."""
 

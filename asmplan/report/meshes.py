@@ -12,12 +12,15 @@ import numpy as np
 
 
 def part_meshes(plan: dict) -> dict[str, tuple[np.ndarray, np.ndarray]]:
-    """Part id -> ``(vertices (V, 3) float64, faces (F, 3) int64)`` for every readable mesh."""
+    """Part id -> ``(vertices (V, 3) float64, faces (F, 3) int64)`` for every readable mesh,
+    turned into the plan's build frame (``geometry.build_rotation``: gravity is down)."""
     import trimesh
 
     source = plan.get("source") or ""
     folder = Path(source).parent if source else None
     out: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+    turn = (plan.get("geometry") or {}).get("build_rotation")
+    rotation = np.eye(3) if turn is None else np.asarray(turn, dtype=np.float64)
     for part in plan.get("parts", []):
         file = part.get("file")
         if not file or folder is None or not (folder / file).is_file():
@@ -27,7 +30,7 @@ def part_meshes(plan: dict) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         except (ValueError, OSError):
             continue
         out[part["id"]] = (
-            np.asarray(mesh.vertices, dtype=np.float64),
+            np.asarray(mesh.vertices, dtype=np.float64) @ rotation.T,
             np.asarray(mesh.faces, dtype=np.int64),
         )
     return out

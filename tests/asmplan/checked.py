@@ -6,10 +6,12 @@ import json
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 from typer.testing import CliRunner
 
 from asmplan import pipeline
 from asmplan.cli import app
+from asmplan.planfile import build_rotation
 from asp.checker import check_line, plan_operations
 from asp.spec import with_subassemblies
 from tests.asmplan.mesh_replay import replayed
@@ -45,6 +47,8 @@ def plan_and_check(source: Path, out: Path, *options: str, stderr: list[str] | N
         spec, operations=tuple(replace(op, held=held.get(op.id, op.held)) for op in spec.operations)
     )
     assert sorted(ops) == sorted(spec.op_ids)
+    if doc.get("geometry"):  # the relations below are in the frame the plan was made in
+        assert np.allclose(build_rotation(spec), doc["geometry"]["build_rotation"])
     down = {w["id"]: w["gravity"] for w in doc["workspaces"] if w["id"] != "main"}
     check_line(spec, assembly.relations, ops, units=doc["subassemblies"], gravity=down)
     replayed(doc)

@@ -6,7 +6,8 @@ plan file (README, "The plan file": ``workspaces``, each step's ``insertions``,
 tests each insertion with python-fcl. The rules (``geometry``):
 
 - **meshes**: each part's mesh from ``parts[].source``, times its ``scale`` (else
-  ``geometry.scale``: mm per coordinate as trimesh reads the file), its
+  ``geometry.scale``: mm per coordinate as trimesh reads the file), turned into the build
+  frame by ``geometry.build_rotation`` (``x_build = R @ x_file``; directions are its axes), its
   coincident vertices merged when ``merge_vertices`` (a STEP or 3DXML tessellation gives
   every face its own vertices; an unmerged mesh cannot be eroded: every vertex would move
   along its own face only, leaving the edges in place), a closed mesh with its normals
@@ -15,6 +16,10 @@ tests each insertion with python-fcl. The rules (``geometry``):
   its normal, never moving any face plane by more than the shrink (conservative: the
   replay tolerates at most what the plan says); the inner part of a pair in ``fits`` is
   shrunk by ``extra_shrink`` more against that pair's outer part only;
+- **open parts**: ``open_parts`` must be exactly the parts whose mesh is not closed once
+  merged; a closed part has an inside (a body lying wholly in it collides with it, as a
+  body whose surface crosses it does), an open one has none (its relations are
+  approximate: only crossing surfaces count);
 - **free**: the body, moved along ``free_along`` (``-insert_along``) from its assembled pose
   to beyond everything in steps of a quarter of the thinnest part (so nothing thin is
   jumped over), never collides with the parts already in its workspace, both eroded;
@@ -22,12 +27,17 @@ tests each insertion with python-fcl. The rules (``geometry``):
   (``min(contact_reach[i], contact_reach[j])``, else ``contact_tol``), or they overlap, or
   the body comes to rest on one of them (the fall of the support test below meets it: a
   clip hanging on a barrel across its clearance touches it once settled);
-- **supported** (unless ``held``): moved along ``gravity`` (the workspace's own, for a
-  unit built in another orientation) by ``support_travel_factor``
-  times the pair's tolerance, the eroded body collides with them (it rests on something),
-  or it is fitted: the same move in each of the four directions across gravity collides (a
-  bearing pressed in a holder, a nut on its bolt). The fit rule is more lenient than the
-  planner's.
+- **supported** (unless ``held``), along ``gravity`` (the workspace's own, for a unit
+  built in another orientation), by the rules ``geometry.support`` lists (DESIGN.md,
+  "Support"; ``cad/support.py``), for some part of the body and some part already there:
+  ``rests``: moved along gravity by the support travel (``support_travel_factor`` times
+  the pair's tolerance) the eroded body meets the part; ``captured``: the part holds the
+  body all round across gravity (a move of the pair's contact tolerance plus its
+  tolerance in each of the four directions across gravity meets it, and a move on to
+  beyond everything never gets clear) and a fall of the shorter of the two extents along
+  gravity meets it (a dowel in a blind hole); ``threaded``: held all round likewise and
+  the part's cross-section at the body's mid-height lies inside the body's (a nut on its
+  bolt). A pin merely fitted in a through hole is not supported.
 
 The first body of a workspace stands on the fixture and is not tested; after a unit's
 insertion its members are in ``main``. A rejection names the step, the pair, the
@@ -46,6 +56,8 @@ import trimesh
 AXES = {"x": 0, "y": 1, "z": 2}
 SUPPORT_FACTOR = 3.0
 """Support travel in pair tolerances when the plan does not say."""
+SUPPORT_RULES = ("rests", "captured", "threaded")
+"""The ways a part is held up when the plan does not say (``geometry.support``)."""
 
 
 class Rejected(AssertionError):
@@ -77,6 +89,10 @@ def load_meshes(plan: dict) -> dict[str, trimesh.Trimesh]:
             transform, geometry = scenes[path].graph[src["node"]]
             mesh = scenes[path].geometry[geometry].copy().apply_transform(transform)
         mesh = mesh.apply_scale(src.get("scale") or geo["scale"])
+        if geo.get("build_rotation") is not None:  # into the build frame: x' = R x
+            turn = np.eye(4)
+            turn[:3, :3] = np.asarray(geo["build_rotation"], float)
+            mesh = mesh.apply_transform(turn)
         if geo.get("merge_vertices", False):
             mesh.merge_vertices()
         if mesh.is_watertight and mesh.volume < 0:
@@ -110,21 +126,33 @@ def collision_object(mesh: trimesh.Trimesh) -> fcl.CollisionObject:
 
 
 class Solid:
-    """A mesh as an fcl object with its bounds; moved by a translation."""
+    """A mesh as an fcl object with its bounds; moved by a translation. A closed solid has
+    an inside: a part lying wholly in it collides with it (no surface need cross)."""
 
-    def __init__(self, mesh: trimesh.Trimesh):
+    def __init__(self, mesh: trimesh.Trimesh, closed: bool = False):
         self.bounds = np.asarray(mesh.bounds, float)
         self.obj = collision_object(mesh)
+        self.mesh = mesh
+        self.closed = closed
 
     def hits(self, other: Solid, offset: np.ndarray) -> bool:
-        """Whether this solid, moved by ``offset``, collides with ``other`` (in place)."""
+        """Whether this solid, moved by ``offset``, collides with ``other`` (in place): their
+        surfaces cross, or one lies wholly inside the other, a closed solid."""
         lo, hi = self.bounds + offset
         if np.any(lo > other.bounds[1]) or np.any(hi < other.bounds[0]):
             return False
         self.obj.setTranslation(np.asarray(offset, float))
         hit = fcl.collide(self.obj, other.obj, fcl.CollisionRequest(), fcl.CollisionResult())
         self.obj.setTranslation(np.zeros(3))
-        return bool(hit)
+        return bool(hit) or self.inside(other, offset) or other.inside(self, -offset)
+
+    def inside(self, other: Solid, offset: np.ndarray) -> bool:
+        """Whether this solid, moved by ``offset`` and clear of ``other``'s surface, lies in
+        ``other`` (only a closed solid has an inside)."""
+        lo, hi = self.bounds + offset
+        if not other.closed or np.any(lo < other.bounds[0]) or np.any(hi > other.bounds[1]):
+            return False
+        return bool(other.mesh.contains(self.mesh.vertices[:1] + offset)[0])
 
     def gap(self, other: Solid) -> float:
         """Distance to ``other`` in place (0 when they collide)."""
@@ -144,14 +172,24 @@ class Replay:
         self.contact_tol = float(geo["contact_tol"])
         self.reach = geo.get("contact_reach")
         self.factor = float(geo.get("support_travel_factor", SUPPORT_FACTOR))
+        self.rules = set(geo.get("support", SUPPORT_RULES))
         self.gravity = vector(plan["gravity"])
         # a unit built in another orientation (upside down) has its own gravity
         self.down = {w["id"]: vector(w.get("gravity", plan["gravity"])) for w in plan["workspaces"]}
         self.extra = {(f["inner"], f["outer"]): f["extra_shrink"] for f in geo.get("fits", [])}
-        self.plain = {p: Solid(m) for p, m in self.meshes.items()}
-        self.solid = {p: Solid(eroded(m, self.shrink[p])) for p, m in self.meshes.items()}
+        self.open = {p for p, m in self.meshes.items() if not m.is_watertight}
+        said = set(geo.get("open_parts", self.open))
+        if said != self.open:
+            raise Rejected(
+                f"geometry.open_parts says {sorted(said)}, the meshes have {sorted(self.open)} open"
+            )
+        closed = {p: p not in self.open for p in self.meshes}
+        self.plain = {p: Solid(m, closed[p]) for p, m in self.meshes.items()}
+        self.solid = {
+            p: Solid(eroded(m, self.shrink[p]), closed[p]) for p, m in self.meshes.items()
+        }
         self.fitted = {
-            pair: Solid(eroded(self.meshes[pair[0]], self.shrink[pair[0]] + extra))
+            pair: Solid(eroded(self.meshes[pair[0]], self.shrink[pair[0]] + extra), closed[pair[0]])
             for pair, extra in self.extra.items()
         }
         thinnest = min(float(np.min(m.extents)) for m in self.meshes.values())
@@ -231,18 +269,96 @@ class Replay:
             raise Rejected(f"{where}: {body} touches none of {there} ({p}-{j} gap {gap:.3f} mm)")
         if ins["held"]:
             return "held"
-        if rests:
+        how = self.support(body, there, down)
+        if how is None:
+            raise Rejected(f"{where}: {body} is not supported (it would fall along gravity)")
+        return how
+
+    # ------------------------------------------------------------------ support
+    def support(self, body: list[str], there: list[str], down: np.ndarray) -> str | None:
+        """How some part of ``body`` is held up by some part of ``there`` when it falls along
+        ``down`` (``geometry.support``): ``rests`` (a fall of the support travel meets it),
+        ``captured`` (fitted across gravity in a part that a fall of the shorter extent
+        along gravity meets: a dowel in a blind hole), ``threaded`` (fitted across gravity
+        around a part passing through it: a nut on its bolt); None when it would fall."""
+        if self.falls_into(body, there, down):
             return "rests"
-        across = [vector(s + a) for a in "xyz" for s in "+-"]
-        if all(self.falls_into(body, there, v) for v in across if abs(v @ down) < 0.5):
-            return "fitted"  # a bearing pressed in its holder, a nut on its bolt
-        raise Rejected(f"{where}: {body} is not supported (it would fall along gravity)")
+        axis = int(np.argmax(np.abs(down)))
+        for p in body:
+            for j in there:
+                if not self.fitted_across(p, j, axis):
+                    continue
+                if "captured" in self.rules:
+                    travel = min(
+                        np.ptp(self.plain[p].bounds[:, axis]), np.ptp(self.plain[j].bounds[:, axis])
+                    )
+                    travel = max(travel, self.travel(p, j))
+                    if self.first_hit(p, j, down, self.fall(travel, p, j)) is not None:
+                        return "captured"
+                if "threaded" in self.rules and self.passes_through(j, p, axis):
+                    return "threaded"
+        return None
+
+    def travel(self, p: str, j: str) -> float:
+        """Support travel of a pair (mm): ``support_travel_factor`` pair tolerances."""
+        return self.factor * self.tolerance(p, j)
+
+    def fall(self, travel: float, p: str, j: str) -> np.ndarray:
+        """Offsets (mm) of a move of ``travel``: eighths of the pair's support travel, then
+        steps of a quarter of the thinnest part (nothing thin is jumped over)."""
+        t = self.travel(p, j)
+        near = np.linspace(t / 8, t, 8)
+        return np.unique(
+            np.concatenate([near[near < travel], np.arange(t, travel, self.step), [travel]])
+        )
+
+    def fitted_across(self, p: str, j: str, axis: int) -> bool:
+        """Whether ``j`` holds ``p`` all round across ``axis``: a move of the pair's contact
+        tolerance plus its tolerance (the gap erosion opens) in each of the four directions
+        across it meets ``j``, and a move on to beyond everything never gets clear (a pin in
+        a hole, a nut on a bolt: ``TC`` and not ``TT`` in each)."""
+        near = self.contact(p, j) + self.tolerance(p, j)
+        for a in range(3):
+            if a == axis:
+                continue
+            for sign in (1.0, -1.0):
+                v = np.zeros(3)
+                v[a] = sign
+                if self.first_hit(p, j, v, self.fall(max(near, self.travel(p, j)), p, j)) is None:
+                    return False
+                if not self.blocked(p, j, v):
+                    return False
+        return True
+
+    def blocked(self, p: str, j: str, v: np.ndarray) -> bool:
+        """Whether ``p`` moved along ``v`` to beyond everything meets ``j``."""
+        return self.first_hit(p, j, v, self.path(p, j, v)) is not None
+
+    def passes_through(self, inner: str, outer: str, axis: int) -> bool:
+        """Whether ``inner``'s cross-section at ``outer``'s mid-height (a plane across
+        ``axis``) lies inside ``outer``'s and is smaller (a bolt through its nut; a plate a
+        bolt passes through does not pass through the bolt)."""
+        lo, hi = self.plain[outer].bounds[:, axis]
+        normal = np.zeros(3)
+        normal[axis] = 1.0
+        origin = normal * 0.5 * (lo + hi)
+        cuts = [
+            self.meshes[k].section(plane_origin=origin, plane_normal=normal) for k in (inner, outer)
+        ]
+        if cuts[0] is None or cuts[1] is None:
+            return False
+        others = [k for k in range(3) if k != axis]
+        b_in, b_out = (np.asarray(c.bounds)[:, others] for c in cuts)
+        slack = 1e-6 * float(np.ptp(b_out, axis=0).max())
+        inside = np.all(b_in[0] >= b_out[0] - slack) and np.all(b_in[1] <= b_out[1] + slack)
+        smaller = np.any(np.ptp(b_in, axis=0) < np.ptp(b_out, axis=0) - slack)
+        return bool(inside and smaller)
 
     def falls_into(self, body: list[str], there: list[str], v: np.ndarray) -> bool:
         """Whether a short move along ``v`` (the support travel of each pair) meets a part."""
         for p in body:
             for j in there:
-                travel = self.factor * self.tolerance(p, j)
+                travel = self.travel(p, j)
                 if self.first_hit(p, j, v, np.linspace(travel / 8, travel, 8)) is not None:
                     return True
         return False

@@ -4,11 +4,12 @@ from __future__ import annotations
 
 import copy
 
+import numpy as np
 import pytest
 import trimesh
 
 from asmplan import pipeline
-from tests.asmplan.mesh_replay import Rejected, Replay, replayed
+from tests.asmplan.mesh_replay import Rejected, Replay, Solid, replayed
 from tests.asmplan.test_generated_held import plate_with_dowel
 from tests.cad.real_shapes import box, finger_box, unmerged
 from tests.cad.test_subassemblies import TOWER_TREE, rod_tower, write_glb
@@ -48,6 +49,16 @@ def test_held_parts_replay(tmp_path):
         "held"
     ]
     replayed(plan)
+    # unheld, the dowel loose in the through hole falls: fitted all round is not support
+    unheld = tampered(plan, _nothing_held)
+    with pytest.raises(Rejected, match=r"\['dowel'\] is not supported"):
+        Replay(unheld).line("robust_plan")
+
+
+def _nothing_held(plan):
+    for step in plan["robust_plan"]:
+        for ins in step["insertions"]:
+            ins["held"] = False
 
 
 def tampered(plan: dict, change) -> dict:
@@ -83,7 +94,9 @@ def test_the_checker_rejects_a_wrong_line(tower_plan, change, message):
 
 
 def _without_merging(plan):
+    """Unmerged, every face is a mesh of its own: every part is open."""
     plan["geometry"]["merge_vertices"] = False
+    plan["geometry"]["open_parts"] = [p["id"] for p in plan["parts"]]
 
 
 @pytest.mark.parametrize(
@@ -143,3 +156,25 @@ def test_an_inside_out_part_replays(tmp_path):
     (ins,) = [i for s in plan["robust_plan"] for i in s["insertions"] if i["parts"] == ["cap"]]
     assert ins["free_along"][1] != plan["gravity"][1]  # it leaves sliding on the block
     replayed(plan)
+
+
+def test_a_part_inside_a_closed_part_collides_not_inside_an_open_one():
+    """A closed solid has an inside (the planner's interpenetration test,
+    ``cad.freedom._intersect``): a cube wholly in a block collides with it though no
+    surfaces cross; a block with a face missing (``geometry.open_parts``) has no inside."""
+    cube = Solid(box((4, 4, 4), (6, 6, 6)), closed=True)
+    block = box((0, 0, 0), (10, 10, 10))
+    assert cube.hits(Solid(block, closed=True), np.zeros(3))
+    assert not cube.hits(Solid(block, closed=True), np.array([0.0, 0.0, 20.0]))
+    opened = block.copy()
+    opened.update_faces(np.arange(len(opened.faces)) > 1)
+    assert not opened.is_watertight
+    assert not cube.hits(Solid(opened, closed=False), np.zeros(3))
+
+
+def test_the_open_parts_must_be_the_open_meshes(tmp_path):
+    plan = pipeline.plan(plate_with_dowel(tmp_path / "meshes"), time_limit=5).to_dict()
+    assert plan["geometry"]["open_parts"] == []
+    Replay(plan)
+    with pytest.raises(Rejected, match="open_parts says"):
+        Replay(tampered(plan, lambda p: p["geometry"].update(open_parts=["plate"])))

@@ -362,3 +362,38 @@ def die_set(
                 cylinder(3, 58, 128, 24 * n, xy), cylinder(5, 54, 58, 36 * n, xy)
             )
     return parts
+
+
+def tilted_pins(
+    axis=(1.0, 1.0, 0.0), degrees: float = 25.0, detail: float = 1.0, upright: bool = False
+) -> dict[str, trimesh.Trimesh]:
+    """A plate pinned onto the slanted face of a base, drawn with the base level (mm).
+
+    Built upright first: a base block whose top face carries two blind holes, a plate
+    lying on it with two through holes, and two pins (0.05 mm clearance) through the
+    plate standing on the holes' bottoms. The base's underside is cut level with the
+    file's ``xy`` plane, and everything is turned by ``degrees`` about ``axis`` (as a
+    product fixtured in its own orientation is drawn): the plate then lies on a slanted
+    face and the pins stand at ``degrees`` off ``z``, along ``R @ (0, 0, 1)``. ``upright``:
+    the same product before that turn (pins along ``z``, the base's underside slanted).
+    """
+    from cad.frame import rotation_matrix
+
+    n = max(1, round(detail))
+    turn = np.eye(4)
+    turn[:3, :3] = rotation_matrix(axis, degrees)
+    level = np.linalg.inv(turn)  # the file's level underside, seen upright
+    holes = [(-12.0, 0.0), (12.0, 0.0)]
+    block = difference(
+        box((-60, -60, -80), (60, 60, 0)), *(cylinder(2.05, -8, 1, 32 * n, xy) for xy in holes)
+    )
+    underside = box((-25, -25, -30), (25, 25, 200)).apply_transform(level)
+    parts = {
+        "base": trimesh.boolean.intersection([block, underside], engine="manifold"),
+        "plate": difference(
+            box((-20, -15, 0), (20, 15, 5)), *(cylinder(2.05, -1, 6, 32 * n, xy) for xy in holes)
+        ),
+    }
+    for k, xy in enumerate(holes, 1):
+        parts[f"pin_{k}"] = cylinder(2.0, -8, 8, 24 * n, xy)
+    return parts if upright else {pid: m.apply_transform(turn) for pid, m in parts.items()}
