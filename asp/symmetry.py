@@ -56,8 +56,10 @@ before it are not. Starting the first one neither done nor running is then alway
 (the others before it are running, at most ``w - 1``), it is the move any other start is
 mapped onto by a symmetry fixing the state (done and running), and the count only falls as
 operations are done, so a running one stays a transition whichever finishes first: both
-games keep their values. Classes of blocks of several operations (a dowel with its roller)
-stay chained (the alternating game's values; tested against the full graph).
+games keep their values. Blocks of several operations (a dowel with its roller) are ordered
+position by position, each position with the slack of the one before it plus its own (a
+block may be behind lower ones by what the position before allowed). The classes of blocks
+that are not chains (moved first of equals) keep the alternating game's values only.
 """
 
 from __future__ import annotations
@@ -694,9 +696,15 @@ def reduce_interchangeable(spec: AssemblySpec, relations) -> AssemblySpec:
 
 
 def _reduced(spec: AssemblySpec, relations, concurrent: bool):
-    """:func:`reduce_interchangeable` and, with ``concurrent``, the classes of single
-    interchangeable operations left out of the fixed order with their slack (``(m, ids)``
-    for :func:`asp.feasibility.operation_model`'s ``loose``; :func:`class_slack`)."""
+    """:func:`reduce_interchangeable` and, with ``concurrent``, the chains of the classes
+    of blocks kept in a loose order instead, with their slack (``(m, ids)`` for
+    :func:`asp.feasibility.operation_model`'s ``loose``).
+
+    The slack of position ``p`` of a class's blocks is ``s(p) = s(p - 1) + m(p)``, ``m(p)``
+    the :func:`class_slack` of the operations at ``p`` (``s(-1) = 0``): the block to move,
+    the first of those neither ahead nor running, has below it only blocks running
+    their operation ``p`` (at most ``m(p)``) or still before ``p`` (at most ``s(p - 1)``:
+    the rule held when it did its operation ``p - 1``, and the count only falls)."""
     model, why, _ = _derive(spec, relations)
     if model is None:
         if why:
@@ -707,12 +715,15 @@ def _reduced(spec: AssemblySpec, relations, concurrent: bool):
         classes = interchangeable_blocks(spec, relations)
     chains, loose = [], []
     for cls in classes:
-        slack = class_slack(spec, [b[0] for b in cls]) if concurrent else 0
-        if slack and all(len(b) == 1 for b in cls):
-            loose.append((slack, [b[0] for b in cls]))
-            continue
+        slack = 0
         for position in range(len(cls[0])):
-            chains.append([block[position] for block in cls])
+            chain = [block[position] for block in cls]
+            if concurrent:  # lower blocks behind it at the position before, or running
+                slack = min(slack + class_slack(spec, chain), len(chain) - 1)
+            if slack:
+                loose.append((slack, chain))
+            else:
+                chains.append(chain)
     return with_fixed_order(base, chains), loose
 
 

@@ -81,8 +81,9 @@ def test_alike_members_of_a_workspace_keep_the_concurrent_game(copies):
     grouping=st.sampled_from([None, *sorted(GROUPINGS)]),
 )
 def test_random_tables_keep_the_concurrent_game(data, copies, singles, grouping):
-    """Random tables, with or without units: whenever every class of interchangeable
-    operations is of single operations, the reduced graph has the full graph's W*(k)."""
+    """Random tables, with or without units: whenever the blocks of interchangeable
+    operations are chains (single operations, or a pin with its roller), the reduced graph
+    has the full graph's W*(k)."""
     rel = alike_copies(_random_tables(data.draw, copies, singles), copies, singles)
     held = data.draw(st.sets(st.sampled_from("psr")))
     spec = _random_spec(rel.parts, held)
@@ -93,10 +94,29 @@ def test_random_tables_keep_the_concurrent_game(data, copies, singles, grouping)
         full = build_state_graph(spec, rel)
     except SpecError:
         return  # no complete sequence
-    blocks = interchangeable_blocks(spec, rel, chains_only=False)
-    if any(len(b) > 1 for cls in blocks for b in cls):
-        return  # blocks of several operations: the alternating game's values only
+    if interchangeable_blocks(spec, rel, chains_only=False) != interchangeable_blocks(spec, rel):
+        return  # blocks that are not chains (first of equals): the alternating game's only
     reduced = reduced_state_graph(spec, rel)
     if reduced is None:
         return
+    assert curve(reduced) == curve(full)
+
+
+@pytest.fixture(scope="module", params=[False, True], ids=["ring", "ring+hub"])
+def ring(request):
+    from cad import Assembly, compute_relations
+    from tests.asp.test_symmetry_ring import ring_meshes, ring_spec
+
+    meshes = ring_meshes(hub=request.param)
+    return ring_spec(list(meshes)), compute_relations(Assembly.from_meshes(meshes))
+
+
+def test_pins_with_their_rollers_keep_the_concurrent_game(ring):
+    """Blocks of two operations (a pin and the roller threaded on it), ordered position by
+    position with the slack of the pins added to the rollers'."""
+    spec, rel = ring
+    assert interchangeable_blocks(spec, rel) == [[[f"pin{k}", f"roller{k}"] for k in range(4)]]
+    full = build_state_graph(spec, rel)
+    reduced = reduced_state_graph(spec, rel)
+    assert reduced.n_states < full.n_states
     assert curve(reduced) == curve(full)
