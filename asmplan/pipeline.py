@@ -397,6 +397,7 @@ def state_graph(
     progress: bool = False,
     max_states: int | None = None,
     on_step: Progress | None = None,
+    concurrent: bool = False,
 ) -> StateGraph:
     """The assembly state graph: every feasible partial assembly and operation.
 
@@ -422,6 +423,10 @@ def state_graph(
         State limit (default: the spec's ``max_states``, else 20,000,000).
     on_step : callable, optional
         Called with a line for each round of automatic subassemblies.
+    concurrent : bool
+        Reduce so that the concurrent game (and the CP-SAT schedule) keep their values too:
+        alike parts in a loose order, not a fixed one (more states;
+        :func:`asp.symmetry.symmetry_reduction`).
 
     Returns
     -------
@@ -446,6 +451,7 @@ def state_graph(
         graph = reduced_state_graph(
             prepared_units(first, rel, turned.append),
             rel,
+            concurrent=concurrent,
             progress=progress,
             max_states=max_states,
         )
@@ -461,6 +467,7 @@ def state_graph(
         rel,
         hierarchy=spec.generated,
         reduce=True,
+        concurrent=concurrent,
         on_unit=on_step,
         given_up=given_up,
         progress=progress,
@@ -644,7 +651,20 @@ def plan(
     )
     summary = relations_summary(assembly.relations) if assembly.relations is not None else []
     say("[2/5] building the assembly state graph ...")
-    graph = state_graph(assembly, progress=True, max_states=max_states, on_step=on_step)
+    turn = assembly.spec.turn_model if turn_model is None else turn_model
+    from asp.spec import TURN_MODELS
+
+    if turn not in TURN_MODELS:
+        from asp.errors import GraphError
+
+        raise GraphError(f"--turn-model: expected alternate or concurrent, got {turn!r}")
+    graph = state_graph(
+        assembly,
+        progress=True,
+        max_states=max_states,
+        on_step=on_step,
+        concurrent=turn == "concurrent",
+    )
     from asp.units import units_report
 
     units = units_report(assembly.spec, assembly.relations, graph.spec.subassemblies)
@@ -658,14 +678,7 @@ def plan(
     say("[4/5] CP-SAT minimum-makespan schedule ...")
     line = [step.operation for step in steps if step.operation]
     sched = schedule(assembly, graph, time_limit=time_limit, seed=seed, sequence=line)
-    turn = assembly.spec.turn_model if turn_model is None else turn_model
     concurrent = None
-    from asp.spec import TURN_MODELS
-
-    if turn not in TURN_MODELS:
-        from asp.errors import GraphError
-
-        raise GraphError(f"--turn-model: expected alternate or concurrent, got {turn!r}")
     if turn == "concurrent":
         from asp.concurrent import DEFAULT_MAX_K
         from asp.concurrent_plan import plan_concurrent

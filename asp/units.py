@@ -83,6 +83,7 @@ def build_with_units(
     *,
     hierarchy: bool = False,
     reduce: bool = False,
+    concurrent: bool = False,
     on_unit: Callable[[str], None] | None = None,
     given_up: Iterable[str] | None = None,
     **kwargs,
@@ -114,7 +115,8 @@ def build_with_units(
         Build each graph with the symmetry reduction
         (:func:`asp.symmetry.reduced_state_graph`: interchangeable parts in the main
         assembly and in each unit's workspace in a fixed order; the full graph when there
-        is nothing to reduce), for the spec with every unit of that round.
+        is nothing to reduce), for the spec with every unit of that round; with
+        ``concurrent``, the reduction that keeps the concurrent game's values too.
     on_unit : callable, optional
         Called with a line for each unit decision (a person reads it on stderr).
     given_up : iterable of str, optional
@@ -136,7 +138,7 @@ def build_with_units(
         if reduce:
             from asp.symmetry import reduced_state_graph
 
-            graph = reduced_state_graph(with_units, relations, **kwargs)
+            graph = reduced_state_graph(with_units, relations, concurrent=concurrent, **kwargs)
             if graph is not None:
                 return graph
         return build_state_graph(with_units, relations, **kwargs)
