@@ -36,6 +36,8 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # pragma: no cover - types only
+    from asmplan.planfile import AlternateStates, PlayedPolicy
+    from asmplan.report.plot import DagFigure
     from asp.baseline import BaselineResult
     from asp.concurrent_plan import ConcurrentPlan
     from asp.dag import GameDAG
@@ -125,6 +127,31 @@ class Schedule:
 
 
 @dataclass(frozen=True, eq=False)
+class PlayedGame:
+    """What a plan's outputs take from its solved game (turn model ``alternate``):
+    ``plan.json``'s policy, lines and values, and ``dag.png``'s figure (:func:`played_game`).
+
+    Its size is the robust policy's, not the game's: ``plan(keep_game=False)`` (what
+    ``asmplan plan`` runs) makes it and lets the game and its solution go before CP-SAT and
+    the outputs, so the game's edge arrays, the state graph and CP-SAT are never all held
+    at once.
+
+    Attributes
+    ----------
+    policy : asmplan.planfile.PlayedPolicy
+        The robust policy's table, named, with the game's sizes, TCT and W*.
+    describe : asmplan.planfile.AlternateStates
+        Names the game's states (done operations and tools).
+    figure : asmplan.report.plot.DagFigure
+        The game DAG (or its layers) with the robust plan's path.
+    """
+
+    policy: PlayedPolicy
+    describe: AlternateStates
+    figure: DagFigure
+
+
+@dataclass(frozen=True, eq=False)
 class AssemblyPlan:
     """Everything ``asmplan plan`` computes for one assembly.
 
@@ -134,9 +161,11 @@ class AssemblyPlan:
     graph : asp.state_graph.StateGraph
     sequences : int
         Number of feasible complete assembly sequences.
-    game : Game
-    solution : asp.solve.Solution
-        Exact solution: TCT, W* and both sides' policies.
+    game : Game or None
+        None when :func:`plan` let it go (``keep_game=False``; ``played`` has what the
+        outputs need of it).
+    solution : asp.solve.Solution or None
+        Exact solution: TCT, W* and both sides' policies (None with ``game``).
     steps : tuple of asp.plan.PlanStep
         The robust plan, turn by turn (robust robot against a maximising human).
     relations_summary : list of dict
@@ -149,22 +178,33 @@ class AssemblyPlan:
     units : list of dict
         Every unit used and every sub-assembly of the CAD file, used or why not
         (:func:`asp.units.units_report`; ``plan.json``'s ``units``).
+    played : PlayedGame or None
+        What the outputs take from the game, made by :func:`plan` (else from ``game`` and
+        ``solution`` when first needed: :attr:`played_game`).
     """
 
     assembly: Assembly
     graph: StateGraph
     sequences: int
-    game: Game
-    solution: Solution
+    game: Game | None
+    solution: Solution | None
     steps: tuple[PlanStep, ...]
     relations_summary: list[dict]
     schedule: Schedule
     concurrent: ConcurrentPlan | None = None
     units: list[dict] = field(default_factory=list)
+    played: PlayedGame | None = None
 
     @property
     def dag(self) -> GameDAG:
         return self.game.dag
+
+    @functools.cached_property
+    def played_game(self) -> PlayedGame:
+        """``played``, or made from ``game`` and ``solution`` (once)."""
+        if self.played is not None:
+            return self.played
+        return played_game(self.graph, self.game, self.solution)
 
     def to_dict(self) -> dict[str, Any]:
         """The ``asmplan-plan/2`` object written as ``plan.json`` (:mod:`asmplan.planfile`;
@@ -173,7 +213,7 @@ class AssemblyPlan:
 
     @functools.cached_property
     def _document(self) -> dict[str, Any]:
-        from asmplan.planfile import alternate_states, plan_document
+        from asmplan.planfile import plan_document, played_document
 
         extra = {
             "relations": self.relations_summary,
@@ -184,11 +224,11 @@ class AssemblyPlan:
             "units": self.units,
         }
         if self.concurrent is None:
-            return plan_document(
-                spec=self.assembly.spec,
-                dag=self.game.dag,
-                solution=self.solution,
-                describe=alternate_states(self.graph, self.game.dag),
+            played = self.played_game
+            return played_document(
+                self.assembly.spec,
+                played.policy,
+                played.describe,
                 extra=extra,
                 relations=self.assembly.relations,
             )
@@ -299,7 +339,7 @@ def load(
             on_step(f"computing part relations of {len(spec.parts)} parts ...")
         geometry = spec_geometry(spec)
         rel = load_relations(spec, progress=progress, geometry=geometry)
-        decided = decide_generated(spec, rel, geometry)
+        decided = decide_generated(spec, rel, geometry, say=on_step, progress=progress)
         spec, rel = decided.spec, decided.relations
         for line in decided.notes():
             note(line)
@@ -529,6 +569,21 @@ def solve_game(dag: GameDAG) -> Solution:
     return solve(dag)
 
 
+def played_game(graph: StateGraph, game: Game, solution: Solution) -> PlayedGame:
+    """What the outputs of a plan take from its solved game (:class:`PlayedGame`)."""
+    from asmplan.planfile import alternate_states, played_policy
+    from asmplan.report.plot import dag_figure
+    from asp.solve import play
+
+    dag = game.dag
+    every_state = alternate_states(graph, dag)
+    policy = played_policy(dag, solution, every_state)
+    describe = every_state.only(policy.table.node)  # the plan file names no other state
+    del every_state
+    path, _ = play(dag, solution.robot_policy, solution.human_policy)
+    return PlayedGame(policy, describe, dag_figure(dag, path_edges(dag, path)))
+
+
 def robust_plan(game: Game, solution: Solution) -> tuple[PlanStep, ...]:
     """The robust robot policy against the maximising human, turn by turn."""
     from asp.plan import robust_plan as steps
@@ -600,6 +655,7 @@ def plan(
     max_states: int | None = None,
     contact_tol: float | None = None,
     penetration_tol: float | None = None,
+    keep_game: bool = True,
 ) -> AssemblyPlan:
     """Plan an assembly end to end, as ``asmplan plan`` does.
 
@@ -628,14 +684,21 @@ def plan(
     contact_tol, penetration_tol : float, optional
         Tolerances in mm for every pair (default: the spec's, else the per-part rule of
         :mod:`cad.tolerances`); ignored when ``source`` is an :class:`Assembly`.
+    keep_game : bool
+        Keep the game DAG and its solution in the result. ``False`` (``asmplan plan``):
+        once solved, what the outputs need of them is taken (:class:`PlayedGame`) and they
+        are let go before CP-SAT, so a game of tens of millions of edges is not held with
+        the state graph and CP-SAT's model; the result's ``game`` and ``solution`` are None.
 
     Returns
     -------
     AssemblyPlan
         ``to_dict()`` is the ``plan.json`` object.
     """
+    from asp.memory import map_large_blocks, release_memory
     from asp.plan import relations_summary
 
+    map_large_blocks()  # a freed array of a few MB goes back to the system at once
     say = on_step or (lambda _message: None)
     say("[1/5] reading the assembly and computing part relations ...")
     assembly = (
@@ -650,6 +713,7 @@ def plan(
         )
     )
     summary = relations_summary(assembly.relations) if assembly.relations is not None else []
+    release_memory()  # the meshes and collision objects of the relations
     say("[2/5] building the assembly state graph ...")
     turn = assembly.spec.turn_model if turn_model is None else turn_model
     from asp.spec import TURN_MODELS
@@ -671,13 +735,21 @@ def plan(
     if graph.spec is not assembly.spec:  # subassemblies found: their insertions are operations
         assembly = Assembly(graph.spec, assembly.relations)
     sequences = graph.count_sequences()
+    release_memory()  # the layers and tables of the build
     say("[3/5] solving the robot-vs-human game ...")
     the_game = Game(game(graph, cost=cost), assembly.descriptions)
+    release_memory()  # the game's per-edge temporaries
     solution = solve_game(the_game.dag)
     steps = robust_plan(the_game, solution)
+    played = None
+    if not keep_game:
+        played = played_game(graph, the_game, solution)
+        the_game = solution = None
+    release_memory()  # the game, unless kept
     say("[4/5] CP-SAT minimum-makespan schedule ...")
     line = [step.operation for step in steps if step.operation]
     sched = schedule(assembly, graph, time_limit=time_limit, seed=seed, sequence=line)
+    release_memory()  # CP-SAT's model and the replay tables
     concurrent = None
     if turn == "concurrent":
         from asp.concurrent import DEFAULT_MAX_K
@@ -692,7 +764,17 @@ def plan(
             schedule=(sched.result, sched.lower_bound),
         )
     return AssemblyPlan(
-        assembly, graph, sequences, the_game, solution, steps, summary, sched, concurrent, units
+        assembly,
+        graph,
+        sequences,
+        the_game,
+        solution,
+        steps,
+        summary,
+        sched,
+        concurrent,
+        units,
+        played,
     )
 
 
@@ -710,21 +792,19 @@ def write_plan(
     tuple of Path
         The files written (the manifest last).
     """
-    from asmplan.report.plot import plot_dag
+    from asmplan.report.plot import draw_dag
     from asp.atomic import OutputSet
-    from asp.solve import play
 
-    dag, solution = result.game.dag, result.solution
+    played = result.played_game
     with OutputSet(output, owns=PLAN_FILES + CONCURRENT_FILES) as out:
         doc = result.to_dict()
         out.write_text("plan.json", json.dumps(doc, separators=(",", ":"), allow_nan=False) + "\n")
-        path, _ = play(dag, solution.robot_policy, solution.human_policy)
-        plot_dag(
-            dag,
+        game = played.policy
+        draw_dag(
+            played.figure,
             out.path("dag.png"),
-            highlight=path_edges(dag, path),
-            title=f"{result.assembly.spec.name}: game DAG ({dag.cost_model}), robust plan "
-            f"in red, TCT {solution.tct:g}, W* {solution.minimax:g}",
+            title=f"{result.assembly.spec.name}: game DAG ({game.cost_model}), robust plan "
+            f"in red, TCT {game.tct:g}, W* {game.minimax:g}",
         )
         if result.concurrent is not None:
             from asmplan.report.gantt import write_figures

@@ -65,15 +65,23 @@ def alternate_states(graph, dag: GameDAG) -> AlternateStates:
     """
     alive = graph.coreachable()
     complete = graph.complete
-    inner = np.flatnonzero(alive & ~complete)
     ends = np.flatnonzero(alive & complete)
-    del alive, complete
-    if inner.size + 1 != dag.n_nodes:
+    alive &= ~complete  # the inner states
+    del complete
+    n_inner = int(np.count_nonzero(alive))
+    if n_inner + 1 != dag.n_nodes:
         raise ValueError(
             f"state names: the game has {dag.n_nodes} nodes, the state graph "
-            f"{inner.size + 1} (was the game built from this graph?)"
+            f"{n_inner + 1} (was the game built from this graph?)"
         )
-    return AlternateStates(graph, np.append(inner, ends[:1]))
+    # Complete states come after every inner one (they are the last layer): the inner
+    # states and the first complete one, in order, without a second copy of the array.
+    alive[ends[:1]] = True
+    state_of = np.flatnonzero(alive)
+    if ends.size and state_of[-1] != ends[0]:  # pragma: no cover - another layout
+        alive[ends[:1]] = False
+        state_of = np.append(np.flatnonzero(alive), ends[:1])
+    return AlternateStates(graph, state_of)
 
 
 class AlternateStates:
@@ -84,16 +92,34 @@ class AlternateStates:
     ----------
     graph : asp.state_graph.StateGraph
     state_of : (n,) int64
-        The state graph state of each game node.
+        The state graph state of each game node (of each of ``nodes``, when given).
+    nodes : (k,) int64 or None
+        The game nodes named, sorted (:meth:`only`); None: every node.
     """
 
-    def __init__(self, graph, state_of: np.ndarray):
+    def __init__(self, graph, state_of: np.ndarray, nodes: np.ndarray | None = None):
         self.graph = graph
         self.state_of = state_of
+        self.nodes = nodes
+
+    def states(self, nodes) -> np.ndarray:
+        """The state graph states of the game nodes ``nodes`` (an int or an index array)."""
+        if self.nodes is None:
+            return self.state_of[nodes]
+        at = np.searchsorted(self.nodes, nodes)
+        if not np.all(self.nodes[np.minimum(at, self.nodes.size - 1)] == nodes):
+            raise KeyError(f"state names: game node(s) {nodes} not among those kept")
+        return self.state_of[at]
+
+    def only(self, nodes: np.ndarray) -> AlternateStates:
+        """The same names for the game nodes ``nodes`` alone: a table of their size, not
+        the game's."""
+        nodes = np.unique(np.asarray(nodes, dtype=np.int64))
+        return AlternateStates(self.graph, self.states(nodes), nodes)
 
     def __call__(self, v: int) -> dict:
         model = self.graph.model
-        key = self.graph.keys[int(self.state_of[v])]
+        key = self.graph.keys[int(self.states(v))]
         return {"done": model.done_ops(key), "tools": model.tool_state(key), "running": []}
 
     @property
@@ -107,7 +133,7 @@ class AlternateStates:
 
     def done_matrix(self, nodes: np.ndarray) -> np.ndarray:
         """(k, n_ops) bool: the operations done at each of the game nodes ``nodes``."""
-        return self.graph.model.done_matrix(self.graph.keys[self.state_of[nodes]])
+        return self.graph.model.done_matrix(self.graph.keys[self.states(nodes)])
 
 
 # --------------------------------------------------------------------------- policy table
@@ -239,6 +265,87 @@ def _moves_kernel(
     return ptr, edge, nxt, instruction
 
 
+@dataclass(frozen=True, eq=False)
+class PlayedPolicy:
+    """What the plan file takes from a solved game (turn model ``alternate``): the robust
+    policy's table with each move named, the game's sizes and its values.
+
+    Its size is the policy's (the states the robust robot reaches against any human), not
+    the game's: once it is made (:func:`played_policy`), the game DAG and its solution can be
+    let go, and :func:`played_document` writes the plan file from it.
+
+    Attributes
+    ----------
+    table : PolicyTable
+    operation, agent : (M,) int64
+        Each move's operation and agent, indices into ``operations`` and ``agents`` (-1: a
+        pass).
+    cost : (M,) float64
+        Each move's cost (0 for a pass).
+    operations, agents : list of str
+        The plan file's operation and agent names (``policy.operations``, ``policy.agents``).
+    node_ids : list
+        The game node id of each state of the table (JSON scalars).
+    turn_model, cost_model : str
+    n_nodes, n_edges : int
+        Size of the game DAG.
+    tct, minimax, avg_random : float
+        Cooperative cost, W* and the expected cost against a random person, from the start.
+    """
+
+    table: PolicyTable
+    operation: np.ndarray
+    agent: np.ndarray
+    cost: np.ndarray
+    operations: list[str]
+    agents: list[str]
+    node_ids: list
+    turn_model: str
+    cost_model: str
+    n_nodes: int
+    n_edges: int
+    tct: float
+    minimax: float
+    avg_random: float
+
+
+def played_policy(
+    dag: GameDAG, solution: Solution, describe: StateDescriber | None = None
+) -> PlayedPolicy:
+    """The :class:`PlayedPolicy` of a solved ``alternate`` game; ``describe`` names its
+    states (its end node's done operations join the operation names)."""
+    table = policy_table(dag, solution)
+    op_names = _operation_names(dag, describe)
+    op_index = {op: k for k, op in enumerate(op_names)}
+    agent_names = sorted(_labels_used(dag.agents))
+    agent_index = {a: k for k, a in enumerate(agent_names)}
+    moves = table.edge >= 0
+    move_op = np.full(table.edge.shape, -1, dtype=np.int64)
+    move_agent = np.full(table.edge.shape, -1, dtype=np.int64)
+    move_cost = np.zeros(table.edge.shape)
+    if dag.operations is not None and len(dag.operations):
+        move_op[moves] = _label_indices(dag.operations, table.edge[moves], op_index)
+        if dag.agents is not None:
+            move_agent[moves] = _label_indices(dag.agents, table.edge[moves], agent_index)
+    move_cost[moves] = rules.move_costs(dag, table.edge[moves])
+    return PlayedPolicy(
+        table=table,
+        operation=move_op,
+        agent=move_agent,
+        cost=move_cost,
+        operations=op_names,
+        agents=agent_names,
+        node_ids=_node_ids(dag, table.node),
+        turn_model=dag.turn_model,
+        cost_model=dag.cost_model,
+        n_nodes=dag.n_nodes,
+        n_edges=dag.n_edges,
+        tct=solution.tct,
+        minimax=solution.minimax,
+        avg_random=float(solution.expected[dag.start, ROBOT]),
+    )
+
+
 def policy_document(
     dag: GameDAG,
     solution: Solution,
@@ -256,23 +363,18 @@ def policy_document(
     """
     if game is not None:
         return _concurrent_policy(game, solution, table)
-    op_names = _operation_names(dag, describe)
-    op_index = {op: k for k, op in enumerate(op_names)}
-    agent_names = sorted(_labels_used(dag.agents))
-    agent_index = {a: k for k, a in enumerate(agent_names)}
-    moves = table.edge >= 0
-    move_op = np.full(table.edge.shape, -1, dtype=np.int64)
-    move_agent = np.full(table.edge.shape, -1, dtype=np.int64)
-    move_cost = np.zeros(table.edge.shape)
-    if dag.operations is not None and len(dag.operations):
-        move_op[moves] = _label_indices(dag.operations, table.edge[moves], op_index)
-        if dag.agents is not None:
-            move_agent[moves] = _label_indices(dag.agents, table.edge[moves], agent_index)
-    move_cost[moves] = rules.move_costs(dag, table.edge[moves])
+    return played_policy_object(played_policy(dag, solution, describe), describe)
+
+
+def played_policy_object(played: PlayedPolicy, describe: StateDescriber | None) -> dict:
+    """The ``policy`` object of the plan file from a :class:`PlayedPolicy`."""
+    table = played.table
+    op_index = {op: k for k, op in enumerate(played.operations)}
+    agent_index = {a: k for k, a in enumerate(played.agents)}
     states = _state_columns(table, describe or _anonymous, op_index, agent_index)
 
     ptr, turns = table.ptr.tolist(), table.turn.tolist()
-    ops, agents = move_op.tolist(), move_agent.tolist()
+    ops, agents = played.operation.tolist(), played.agent.tolist()
     robots: list[list] = []
     instruction: list = []
     for i, j in enumerate(table.instruction.tolist()):
@@ -283,23 +385,26 @@ def policy_document(
             robots.append([])
         instruction.append(None if j < 0 else [ops[j], agents[j]])
     states.update(robots=robots, instruction=instruction)
+    tools = states.pop("_tools")
     return {
-        **_policy_head(dag, table, op_names, agent_names, states.pop("_tools")),
-        "states": {"node": _node_ids(dag, table.node), **states},
+        **_policy_head(
+            played.turn_model, played.cost_model, table, played.operations, played.agents, tools
+        ),
+        "states": {"node": played.node_ids, **states},
         "moves": {
             "ptr": ptr,
             "operation": ops,
             "agent": agents,
-            "cost": _numbers(move_cost),
+            "cost": _numbers(played.cost),
             "next": table.next.tolist(),
         },
     }
 
 
-def _policy_head(dag, table, op_names, agent_names, tools, turn_model=None) -> dict:
+def _policy_head(turn_model, cost_model, table, op_names, agent_names, tools) -> dict:
     return {
-        "turn_model": turn_model or dag.turn_model,
-        "cost": dag.cost_model,
+        "turn_model": turn_model,
+        "cost": cost_model,
         "operations": op_names,
         "agents": agent_names,
         "tools": tools,
@@ -451,7 +556,9 @@ def _concurrent_policy(game, solution: Solution, table: PolicyTable) -> dict:
             instruction.append(told(state.get("instructions", {})))
     states.update(robots=robots, instruction=instruction, budget=budget)
     return {
-        **_policy_head(dag, table, op_names, agent_names, states.pop("_tools"), "concurrent"),
+        **_policy_head(
+            "concurrent", dag.cost_model, table, op_names, agent_names, states.pop("_tools")
+        ),
         "states": {"node": table.node.tolist(), **states},
         "moves": {
             "ptr": table.ptr.tolist(),
@@ -622,8 +729,38 @@ def plan_document(
     ``Relations``, None without geometry): each line step's ``insertions`` then name the
     direction each body goes in along, and ``geometry`` the unit, scale and tolerances.
     """
-    table = policy_table(dag, solution)
-    policy = policy_document(dag, solution, describe, table, game=game)
+    if game is None:
+        played = played_policy(dag, solution, describe)
+        return played_document(spec, played, describe, extra=extra, relations=relations)
+    policy = _concurrent_policy(game, solution, policy_table(dag, solution))
+    sizes = (dag.cost_model, dag.n_nodes, dag.n_edges)
+    values = (solution.tct, solution.minimax, float(solution.expected[dag.start, ROBOT]))
+    return _document(spec, policy, sizes, values, extra, relations)
+
+
+def played_document(
+    spec,
+    played: PlayedPolicy,
+    describe: StateDescriber | None = None,
+    *,
+    extra: dict | None = None,
+    relations=None,
+) -> dict:
+    """The whole plan file of a solved ``alternate`` game from its :class:`PlayedPolicy`
+    (the game itself no longer needed; arguments as :func:`plan_document`'s)."""
+    policy = played_policy_object(played, describe)
+    sizes = (played.cost_model, played.n_nodes, played.n_edges)
+    values = (played.tct, played.minimax, played.avg_random)
+    return _document(spec, policy, sizes, values, extra, relations)
+
+
+def _document(spec, policy: dict, sizes: tuple, values: tuple, extra, relations) -> dict:
+    """The plan file around its ``policy``: lines, metrics, operations, parts, ``extra``.
+
+    ``sizes``: the game's cost model, node and edge counts; ``values``: TCT, W* and the
+    expected cost against a random person, from the start."""
+    cost_model, n_nodes, n_edges = sizes
+    tct, minimax, avg_random = values
     operations = operation_records(spec)
     principal = line_steps(policy, "plan", operations)
     worst = line_steps(policy, "worst", operations)
@@ -637,18 +774,18 @@ def plan_document(
         "assembly": spec.name,
         "source": spec.source,
         "turn_model": policy["turn_model"],
-        "cost": dag.cost_model,
-        "game_nodes": dag.n_nodes,
-        "game_edges": dag.n_edges,
-        "tct": solution.tct,
-        "minimax": solution.minimax,
+        "cost": cost_model,
+        "game_nodes": n_nodes,
+        "game_edges": n_edges,
+        "tct": tct,
+        "minimax": minimax,
         "metrics": {
-            "tct": solution.tct,
-            "minimax": solution.minimax,
+            "tct": tct,
+            "minimax": minimax,
             "w0": w0,
             "worst_line": worst[-1]["elapsed"] if worst else 0.0,
-            "adversarial_tax": adversarial_tax(solution.tct, solution.minimax),
-            "avg_random": float(solution.expected[dag.start, ROBOT]),
+            "adversarial_tax": adversarial_tax(tct, minimax),
+            "avg_random": avg_random,
             "policy_states": policy["n_states"],
             "policy_moves": policy["n_moves"],
         },

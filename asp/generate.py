@@ -426,7 +426,9 @@ class Decisions:
         return out
 
 
-def decide_generated(spec: AssemblySpec, relations, geometry, turn=None) -> Decisions:
+def decide_generated(
+    spec: AssemblySpec, relations, geometry, turn=None, *, say=None, progress: bool = False
+) -> Decisions:
     """The decisions of a generated spec that need its relations, in this order: the build
     frame (:func:`asp.framing.choose_frame`: only when some pair of parts can never be
     assembled in the file's frame), gravity (:func:`orient_generated`), then the base part
@@ -436,7 +438,8 @@ def decide_generated(spec: AssemblySpec, relations, geometry, turn=None) -> Deci
     (:func:`spec_text`) both take them here, so the file written plans as the file read.
     A user's spec comes back unchanged. ``turn(gravity, frame)``: the spec generated again
     along another gravity or in another frame (default: from the spec's source). Use the
-    returned ``relations`` (in the chosen frame) from then on.
+    returned ``relations`` (in the chosen frame) from then on. ``say`` is called with a line
+    before each candidate frame's relations are computed (``progress``: their bars).
     """
     from asp.framing import choose_frame
 
@@ -446,11 +449,16 @@ def decide_generated(spec: AssemblySpec, relations, geometry, turn=None) -> Deci
     def in_frame(rotation) -> Decisions:
         """The decisions in another build frame (its relations computed afresh)."""
         import cad
-        from cad.frame import rotated
+        from cad.frame import frame_text, rotated
 
         geo = rotated(geometry, rotation)
+        if say is not None:
+            say(f"trying another build frame ({frame_text(rotation)}): part relations ...")
         rel = cad.compute_relations(
-            geo, contact_tol=spec.contact_tol, penetration_tol=spec.penetration_tol
+            geo,
+            contact_tol=spec.contact_tol,
+            penetration_tol=spec.penetration_tol,
+            progress=progress,
         )
         tolerances = {"contact_tol": spec.contact_tol, "penetration_tol": spec.penetration_tol}
         framed = replace(turn(None, rotation), **tolerances)

@@ -9,11 +9,12 @@ Target: under 60 s and under 2 GB on the 2-core machine.
 
 With a path (a CAD file, a folder of meshes or an ``assembly.yaml``), that assembly instead,
 e.g. trimesh's public ``models/cycloidal.3DXML`` (72 parts; not in the repository: skipped
-when the file is absent). The stages are those of ``asmplan plan``: relations (reading the
-file, the geometry, the generated spec), the state graph (with the symmetry reduction of
-:mod:`asp.symmetry`), counting sequences, the game DAG, the exact solve, the CP-SAT schedule,
-and writing plan.json, dag.png and report.html; the plan's principal line goes through the
-independent checker.
+when the file is absent). The plan is made by ``pipeline.plan(keep_game=False)`` and
+``pipeline.write_plan``, the calls of ``asmplan plan``, with each of their steps timed
+(:data:`STAGES`: relations, state graph, game DAG, solve, robust plan, what the outputs take
+from the game before it is let go, CP-SAT, the plan document and files): wall and CPU
+seconds, resident memory at the step's end and the highest during it. The plan's principal
+line goes through the independent checker.
 
 Run: ``.venv/bin/python benchmarks/plan_70_parts.py [PATH]``
 """
@@ -23,6 +24,7 @@ from __future__ import annotations
 import resource
 import sys
 import tempfile
+import threading
 import time
 from pathlib import Path
 
@@ -81,65 +83,108 @@ def drive() -> dict:
     return parts
 
 
+STAGES = (
+    ("load", "relations (file, geometry, generated spec)"),
+    ("state_graph", "state graph (+ units, counting sequences)"),
+    ("game", "game DAG"),
+    ("solve_game", "exact solve"),
+    ("robust_plan", "robust plan"),
+    ("played_game", "policy, lines, figure taken from the game"),
+    ("schedule", "CP-SAT schedule (automatic budget)"),
+    ("write_plan", "plan document, plan.json, dag.png, report"),
+)
+"""The steps of :func:`asmplan.pipeline.plan` and ``write_plan`` timed, as ``asmplan plan``
+calls them."""
+BETWEEN = "between the steps (imports, units, count, free)"
+
+
+class Meter:
+    """Wall and CPU seconds and resident memory per stage: the memory at the stage's end and
+    the highest during it (sampled every 5 ms from ``/proc/self/statm``; elsewhere only the
+    process's peak so far)."""
+
+    def __init__(self) -> None:
+        self.rows: list[tuple[str, float, float, float, float]] = []
+        self.peak = self.rss()
+        self.wall, self.cpu = time.perf_counter(), time.process_time()
+        threading.Thread(target=self._sample, daemon=True).start()
+
+    @staticmethod
+    def rss() -> float:
+        """Resident memory now (MB); the process's peak where /proc is missing."""
+        try:
+            with open("/proc/self/statm") as f:
+                return int(f.read().split()[1]) * resource.getpagesize() / 2**20
+        except OSError:
+            return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+    def _sample(self) -> None:
+        while True:
+            self.peak = max(self.peak, self.rss())
+            time.sleep(0.005)
+
+    def lap(self, name: str) -> None:
+        wall, cpu, now = time.perf_counter(), time.process_time(), self.rss()
+        self.rows.append((name, wall - self.wall, cpu - self.cpu, now, max(self.peak, now)))
+        self.peak, self.wall, self.cpu = now, time.perf_counter(), time.process_time()
+
+
 def stages(source) -> None:
-    """Plan ``source`` (a path, or an ``Assembly`` already loaded) stage by stage, printing
-    seconds and the peak memory after each stage."""
+    """Plan ``source`` (a path, or an ``Assembly`` already loaded) as ``asmplan plan`` does,
+    printing the seconds and memory of each step of :data:`STAGES`."""
     from asmplan import pipeline
     from asp.checker import check_line, plan_operations
-    from asp.plan import relations_summary
 
-    times: list[tuple[str, float, float]] = []
-    clock = [time.perf_counter()]
+    meter = Meter()
+    t0, names = time.perf_counter(), dict(STAGES)
 
-    def lap(name: str) -> None:
-        now = time.perf_counter()
-        peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
-        times.append((name, now - clock[0], peak))
-        clock[0] = now
+    def timed(name: str):
+        step = getattr(pipeline, name)
 
-    t0 = clock[0]
-    assembly = source if isinstance(source, pipeline.Assembly) else pipeline.load(source)
-    lap("relations (load + cad)")
-    graph = pipeline.state_graph(assembly)
-    lap("state graph")
-    sequences = graph.count_sequences()
-    lap("count sequences")
-    plan = pipeline.Assembly(graph.spec, assembly.relations)
-    game = pipeline.Game(pipeline.game(graph), plan.descriptions)
-    lap("game DAG")
-    solution = pipeline.solve_game(game.dag)
-    steps = pipeline.robust_plan(game, solution)
-    lap("solve + robust plan")
-    line = [step.operation for step in steps if step.operation]
-    sched = pipeline.schedule(plan, graph, seed=0, sequence=line)  # asmplan plan's default
-    lap("CP-SAT (default budget)")
-    summary = relations_summary(assembly.relations) if assembly.relations is not None else []
-    result = pipeline.AssemblyPlan(
-        plan, graph, sequences, game, solution, steps, summary, sched, None
-    )
-    with tempfile.TemporaryDirectory() as out:
-        pipeline.write_plan(result, out)
-        lap("outputs (plan.json, dag.png, report.html)")
-    check_line(graph.spec, assembly.relations, plan_operations(result.to_dict()))
-    lap("checker")
-    spec = graph.spec
-    alive = int(graph.coreachable().sum())
+        def run(*args, **kwargs):
+            meter.lap(BETWEEN)
+            out = step(*args, **kwargs)
+            meter.lap(names[name])
+            return out
+
+        return run
+
+    saved = {name: getattr(pipeline, name) for name in names}
+    for name in names:
+        setattr(pipeline, name, timed(name))
+    try:
+        result = pipeline.plan(source, keep_game=False)  # asmplan plan's call
+        with tempfile.TemporaryDirectory() as out:
+            pipeline.write_plan(result, out)
+    finally:
+        for name, step in saved.items():
+            setattr(pipeline, name, step)
+    doc = result.to_dict()
+    check_line(result.graph.spec, result.assembly.relations, plan_operations(doc))
+    graph, spec = result.graph, result.graph.spec
     print(
         f"{len(spec.part_ids)} parts, {len(spec.operations)} operations, "
         f"{len(spec.subassemblies)} subassemblies, base {spec.base_part}, "
-        f"{sum(op.held for op in spec.operations)} held; {graph.n_states:,} states "
-        f"({alive:,} can complete), {graph.n_transitions:,} transitions, game "
-        f"{game.dag.n_nodes:,} nodes, {sequences:.3g} sequences"
+        f"{sum(op.held for op in spec.operations)} held; {graph.n_states:,} states, "
+        f"{graph.n_transitions:,} transitions, game {doc['game_nodes']:,} nodes and "
+        f"{doc['game_edges']:,} edges, {result.sequences:.3g} sequences"
     )
     print(
-        f"TCT {solution.tct:g}, W* {solution.minimax:g}, CP-SAT {sched.result.objective} "
-        f"({sched.result.status}); checker ok"
+        f"TCT {doc['tct']:g}, W* {doc['minimax']:g}, CP-SAT {doc['schedule']['objective']} "
+        f"({doc['schedule']['status']}); checker ok"
     )
-    for name, dt, peak in times:
-        print(f"  {name:42s} {dt:7.2f} s   peak {peak:7,.0f} MB")
-    peak = times[-1][2]
+    print(f"  {'stage':44s} {'wall s':>7s} {'cpu s':>7s} {'MB after':>9s} {'MB peak':>8s}")
+    between = [0.0, 0.0, 0.0]  # wall, cpu, peak MB
+    for name, wall, cpu, now, peak in meter.rows:
+        if name == BETWEEN:
+            between = [between[0] + wall, between[1] + cpu, max(between[2], peak)]
+        else:
+            print(f"  {name:44s} {wall:7.2f} {cpu:7.2f} {now:9,.0f} {peak:8,.0f}")
+    wall, cpu, peak = between
+    print(f"  {BETWEEN:44s} {wall:7.2f} {cpu:7.2f} {'':9s} {peak:8,.0f}")
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     print(
-        f"  {'end to end':42s} {time.perf_counter() - t0:7.2f} s (target < 60 s); peak memory "
+        f"  {'end to end':44s} {time.perf_counter() - t0:7.2f} s (target < 60 s); peak memory "
         f"{peak:,.0f} MB (target < 2048 MB)"
     )
 

@@ -39,7 +39,7 @@ def plan_summary(result) -> list[str]:
     from asmplan.report.plan import plan_text, relations_summary_text
     from asp.numbers import cost_unit
 
-    spec, graph, dag, solution = result.assembly.spec, result.graph, result.dag, result.solution
+    spec, graph = result.assembly.spec, result.graph
     lines = [
         f"{spec.name}: {len(spec.parts)} parts, {len(spec.operations)} operations, "
         f"agents {', '.join(f'{a.name} ({a.side})' for a in spec.agents)}"
@@ -63,14 +63,15 @@ def plan_summary(result) -> list[str]:
         lines.append(f"worst line: the robust plan (k = {plan.curve.k}) against the worst person:")
         lines.append(timeline_text(*plan.worst))
         return lines
-    unit = cost_unit(dag.cost_model)
+    game = result.played_game.policy  # the game's sizes and values (the game may be gone)
+    unit = cost_unit(game.cost_model)
     doc = result.to_dict()
     lines += [
-        f"game DAG ({dag.cost_model}): {dag.n_nodes} nodes, {dag.n_edges} edges",
-        f"TCT (cooperative) {solution.tct:g}{unit}, W* (robust) {solution.minimax:g}{unit}",
+        f"game DAG ({game.cost_model}): {game.n_nodes} nodes, {game.n_edges} edges",
+        f"TCT (cooperative) {game.tct:g}{unit}, W* (robust) {game.minimax:g}{unit}",
         f"robust plan (the person following it; {doc['metrics']['w0']:g}{unit}):",
         plan_text(doc["robust_plan"]),
-        f"worst line (the robust plan against a delaying person; {solution.minimax:g}{unit}):",
+        f"worst line (the robust plan against a delaying person; {game.minimax:g}{unit}):",
         plan_text(doc["worst_line"]),
     ]
     sched = result.schedule
@@ -165,6 +166,7 @@ def plan_command(
         max_states=max_states,
         contact_tol=contact_tol,
         penetration_tol=penetration_tol,
+        keep_game=False,  # let the game go once solved: less memory for CP-SAT and the files
     )
     for line in plan_summary(result):
         typer.echo(line)

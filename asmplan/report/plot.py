@@ -3,7 +3,8 @@
 Up to :data:`MAX_PLOT_NODES` nodes every node and edge is drawn; above, the graph is drawn
 by layers (longest path from the start) with the number of nodes and edges of each layer,
 and the highlighted path as the layers it crosses, so a large graph is never silently left
-undrawn. matplotlib is imported lazily and used without pyplot (no global backend is set, no figure
+undrawn. What is drawn is a :class:`DagFigure`, small even for a game of millions of edges.
+matplotlib is imported lazily and used without pyplot (no global backend is set, no figure
 is left open); the PNG is written atomically.
 """
 
@@ -11,13 +12,14 @@ from __future__ import annotations
 
 import io
 import os
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import numba
 import numpy as np
 
 from asp.atomic import write_bytes
-from asp.dag import GameDAG
+from asp.dag import GameDAG, ids_topological
 from asp.solve import node_order
 
 AGENT_COLOURS = {"H": "#9e9e9e", "R1": "#2e9d4a", "R2": "#f28c28"}
@@ -28,18 +30,64 @@ MAX_PLOT_NODES = 5_000
 
 def node_layers(dag: GameDAG) -> np.ndarray:
     """(n,) int64: length of the longest path from the start to each node."""
-    return _layers_kernel(dag.indptr, dag.targets, node_order(dag))
+    order = np.zeros(0, np.int64)  # node ids already topological: index order, no array
+    if not ids_topological(dag):
+        order = node_order(dag)
+    return _layers_kernel(dag.indptr, dag.targets, order)
 
 
 @numba.njit(cache=True)
 def _layers_kernel(indptr, targets, order):  # pragma: no cover - compiled
-    layer = np.zeros(indptr.shape[0] - 1, np.int64)
-    for v in order:
+    n = indptr.shape[0] - 1
+    layer = np.zeros(n, np.int64)
+    for k in range(n):
+        v = order[k] if order.shape[0] else k
         for e in range(indptr[v], indptr[v + 1]):
             t = targets[e]
             if layer[t] < layer[v] + 1:
                 layer[t] = layer[v] + 1
     return layer
+
+
+@dataclass(frozen=True, eq=False)
+class DagFigure:
+    """What ``dag.png`` shows of a game DAG and a highlighted path (:func:`dag_figure`).
+
+    A DAG of at most :data:`MAX_PLOT_NODES` nodes is kept whole and drawn node by node;
+    a larger one only by its layers (longest path from the start), so the figure of a game
+    of millions of edges holds a few small arrays and the game itself can be let go.
+
+    Attributes
+    ----------
+    n_nodes, n_edges : int
+    dag : GameDAG or None
+        The DAG, when it is drawn whole.
+    highlight : (k,) int64
+        The highlighted edges (a DAG drawn whole).
+    nodes, edges : (L,) int64 or None
+        Nodes of each layer and edges leaving it (a DAG drawn by layers).
+    path_layers : (k,) int64 or None
+        The layers the highlighted edges join (a DAG drawn by layers).
+    """
+
+    n_nodes: int
+    n_edges: int
+    dag: GameDAG | None = None
+    highlight: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    nodes: np.ndarray | None = None
+    edges: np.ndarray | None = None
+    path_layers: np.ndarray | None = None
+
+
+def dag_figure(dag: GameDAG, highlight: list[int] | None = None) -> DagFigure:
+    """The :class:`DagFigure` of ``dag`` with the edges ``highlight`` marked."""
+    hl = np.asarray(highlight if highlight else [], dtype=np.int64)
+    if dag.n_nodes <= MAX_PLOT_NODES:
+        return DagFigure(dag.n_nodes, dag.n_edges, dag=dag, highlight=hl)
+    layer = node_layers(dag)
+    nodes, edges = _layer_counts(dag, layer)
+    path_layers = np.unique(np.concatenate([layer[dag.edge_sources(hl)], layer[dag.targets[hl]]]))
+    return DagFigure(dag.n_nodes, dag.n_edges, nodes=nodes, edges=edges, path_layers=path_layers)
 
 
 def plot_dag(
@@ -51,14 +99,20 @@ def plot_dag(
 ) -> Path:
     """Draw ``dag`` into the PNG ``path``; ``highlight`` is a list of edge indices.
 
-    Above :data:`MAX_PLOT_NODES` nodes the drawing is by layers (:func:`plot_layers`).
+    Above :data:`MAX_PLOT_NODES` nodes the drawing is by layers (:class:`DagFigure`).
     """
-    if dag.n_nodes > MAX_PLOT_NODES:
-        return plot_layers(dag, path, highlight=highlight, title=title)
+    return draw_dag(dag_figure(dag, highlight), path, title=title)
+
+
+def draw_dag(figure: DagFigure, path: str | os.PathLike[str], *, title: str = "") -> Path:
+    """Draw a :class:`DagFigure` into the PNG ``path``."""
+    if figure.dag is None:
+        return _draw_layers(figure, path, title)
     from matplotlib.collections import LineCollection
     from matplotlib.figure import Figure
     from matplotlib.lines import Line2D
 
+    dag = figure.dag
     layer = node_layers(dag)
     y = np.zeros(dag.n_nodes)
     for k in np.unique(layer):
@@ -81,10 +135,11 @@ def plot_dag(
     )
     colours = [palette[a] for a in agents]
     ax.add_collection(LineCollection(segments, colors=colours, linewidths=0.8, alpha=0.6))
-    if highlight:
-        hl = np.asarray(highlight, dtype=np.int64)
+    if figure.highlight.size:
         ax.add_collection(
-            LineCollection(segments[hl], colors="#d62728", linewidths=3.0, alpha=0.9, zorder=3)
+            LineCollection(
+                segments[figure.highlight], colors="#d62728", linewidths=3.0, alpha=0.9, zorder=3
+            )
         )
     ax.scatter(x, y, s=14, c="white", edgecolors="black", linewidths=0.6, zorder=4)
     ax.scatter(x[[dag.start, dag.end]], y[[dag.start, dag.end]], s=50, c="black", zorder=5)
@@ -103,23 +158,26 @@ def plot_dag(
 
 def layer_counts(dag: GameDAG) -> tuple[np.ndarray, np.ndarray]:
     """Nodes per layer and edges leaving each layer: two ``(L,)`` int64 arrays."""
-    layer = node_layers(dag)
-    n_layers = int(layer.max()) + 1
-    nodes = np.bincount(layer, minlength=n_layers)
-    # Edges leaving a layer: the out-degrees of its nodes (no per-edge array).
-    degree = np.diff(dag.indptr)
-    edges = np.bincount(layer, weights=degree, minlength=n_layers).round().astype(np.int64)
-    return nodes.astype(np.int64), edges.astype(np.int64)
+    return _layer_counts(dag, node_layers(dag))
 
 
-def plot_layers(
-    dag: GameDAG,
-    path: str | os.PathLike[str],
-    *,
-    highlight: list[int] | None = None,
-    title: str = "",
-) -> Path:
-    """Draw a large ``dag`` by layers: node and edge counts per layer, the path's layers.
+def _layer_counts(dag: GameDAG, layer: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    return _counts_kernel(dag.indptr, layer, int(layer.max()) + 1)
+
+
+@numba.njit(cache=True)
+def _counts_kernel(indptr, layer, n_layers):  # pragma: no cover - compiled
+    """Nodes of each layer and edges leaving it (the out-degrees of its nodes)."""
+    nodes = np.zeros(n_layers, np.int64)
+    edges = np.zeros(n_layers, np.int64)
+    for v in range(layer.shape[0]):
+        nodes[layer[v]] += 1
+        edges[layer[v]] += indptr[v + 1] - indptr[v]
+    return nodes, edges
+
+
+def _draw_layers(figure: DagFigure, path: str | os.PathLike[str], title: str) -> Path:
+    """Draw a large DAG by layers: node and edge counts per layer, the path's layers.
 
     Each layer (longest path from the start) is a bar as high as its node count (log
     scale), labelled with its node and out-edge counts; the highlighted edges mark the
@@ -127,8 +185,7 @@ def plot_layers(
     """
     from matplotlib.figure import Figure
 
-    layer = node_layers(dag)
-    nodes, edges = layer_counts(dag)
+    nodes, edges = figure.nodes, figure.edges
     x = np.arange(nodes.size)
     fig = Figure(figsize=(min(max(8.0, 0.4 * nodes.size), 40), 5), dpi=110)
     ax = fig.subplots()
@@ -145,15 +202,14 @@ def plot_layers(
             xytext=(0, 2),
             textcoords="offset points",
         )
-    if highlight:
-        hl = np.asarray(highlight, dtype=np.int64)
-        layers = np.unique(np.concatenate([layer[dag.edge_sources(hl)], layer[dag.targets[hl]]]))
+    layers = figure.path_layers
+    if layers is not None and layers.size:
         ax.scatter(layers, nodes[layers], s=30, c="#d62728", zorder=4, label="robust plan")
     ax.set_xlabel("layer (longest path from the start)")
     ax.set_ylabel("count (log)")
     ax.set_title(
         (title + "\n" if title else "")
-        + f"{dag.n_nodes:,} nodes, {dag.n_edges:,} edges, drawn by layers "
+        + f"{figure.n_nodes:,} nodes, {figure.n_edges:,} edges, drawn by layers "
         f"(more than {MAX_PLOT_NODES:,} nodes)",
         fontsize=10,
     )

@@ -57,7 +57,7 @@ def test_a_failure_mid_write_leaves_no_mixed_folder(pump_plan, tmp_path, monkeyp
         assert (tmp_path / "plan.json").is_file()  # the new plan.json is written by now
         raise OSError(28, "No space left on device")
 
-    monkeypatch.setattr(plot, "plot_dag", killed)
+    monkeypatch.setattr(plot, "draw_dag", killed)
     with pytest.raises(OSError, match="No space"):
         pipeline.write_plan(pump_plan, tmp_path)
     names = sorted(p.name for p in tmp_path.iterdir())
@@ -127,3 +127,19 @@ def test_make_demo_path(tmp_path):
     assert result.exit_code == 0, result.output
     assert f"wrote {tmp_path / 'pump' / 'plan.json'} and" in result.output
     assert (tmp_path / "pump" / MANIFEST).is_file()
+
+
+def test_a_plan_that_lets_its_game_go_writes_the_same_files(pump_plan, tmp_path):
+    """``asmplan plan`` lets the game and its solution go once solved (``keep_game=False``,
+    less memory for CP-SAT and the files): the same plan.json and dag.png as with them kept."""
+    lean = pipeline.plan(PUMP, time_limit=20, keep_game=False)
+    assert lean.game is None and lean.solution is None and pump_plan.game is not None
+    kept, let_go = pump_plan.to_dict(), lean.to_dict()
+    assert {k: v for k, v in kept.items() if k != "schedule"} == {
+        k: v for k, v in let_go.items() if k != "schedule"
+    }
+    assert kept["schedule"]["objective"] == let_go["schedule"]["objective"]
+    pipeline.write_plan(pump_plan, tmp_path / "kept")
+    pipeline.write_plan(lean, tmp_path / "lean")
+    png = [(tmp_path / name / "dag.png").read_bytes() for name in ("kept", "lean")]
+    assert png[0] == png[1]
