@@ -154,6 +154,7 @@ def build_with_units(
             say(hierarchy_line(u))
         found: list[tuple[str, ...]] = []
         current = base
+        plain = None  # the units without the parts hung on them, if those fail
         for _ in range(MAX_ROUNDS + 1):
             current = prepared_units(current, relations, say)
             try:
@@ -162,6 +163,10 @@ def build_with_units(
                 if relations is None or "infeasible assembly" not in str(exc):
                     raise
                 first_error = first_error or exc
+                if plain is not None:
+                    current, plain = plain, None
+                    say("no complete sequence with the held parts in the units: without them")
+                    continue
             graph = build_state_graph(current, relations, **{**kwargs, "check": False})
             stuck = stuck_operations(graph)
             drop = _stuck_units(graph.spec, stuck, optional)
@@ -184,6 +189,18 @@ def build_with_units(
                 "no complete sequence with single parts: trying subassemblies "
                 + "; ".join(f"[{', '.join(g)}]" for g in groups)
             )
+            hung = hung_on_units(base, relations, groups)
+            if hung != groups:
+                plain = current
+                current = with_subassemblies(base, _named(base, hung))
+                say(
+                    "held parts that rest on a unit built upside down go in with it: "
+                    + "; ".join(
+                        f"{', '.join(h[len(g) :])} with {g[0]}'s unit"
+                        for h, g in zip(hung, groups, strict=True)
+                        if h != g
+                    )
+                )
         else:
             drop = set(optional)
         if not drop:
@@ -306,6 +323,52 @@ def built_in_turn(spec: AssemblySpec) -> AssemblySpec:
         for op in spec.operations
     ]
     return replace(spec, operations=tuple(ops))
+
+
+def hung_on_units(
+    spec: AssemblySpec, relations, groups: list[tuple[str, ...]]
+) -> list[tuple[str, ...]]:
+    """Automatic units with the held parts that hang on them (a spec generated from CAD).
+
+    A part an agent must hold in the product (``held``: nothing below keeps it from
+    falling along the gravity ``g``), placed alone and in no unit, *hangs on* a unit when
+    some member keeps it from falling along ``-g``: built upside down, the unit carries it
+    (the guide bushings of a die set's upper half, pressed into the top plate from below,
+    rest on it with the top plate on the bench). It joins the unit when the unit with it
+    is then built upside down (:func:`asp.orientation.unit_orientation`) without holding
+    it: a toolmaker presses the bushings in there instead of holding each on its guide pin
+    until the top plate comes down. The state graph still checks the unit
+    (:func:`build_with_units` falls back to the units without them)."""
+    if not spec.generated or not spec.constraints.stability or relations is None:
+        return groups
+    sp = getattr(relations, "sp", None)
+    if sp is None:
+        return groups
+    from asp.orientation import opposite, unit_orientation
+    from asp.spec import DIRECTIONS
+
+    index = {str(p): k for k, p in enumerate(relations.parts)}
+    up = DIRECTIONS.index(opposite(spec.gravity))
+    taken = {m for g in groups for m in g} | {m for _, ms in spec.subassemblies for m in ms}
+    loose = [
+        op.parts[0]
+        for op in spec.operations
+        if op.held and len(op.parts) == 1 and op.parts[0] not in taken and op.parts[0] in index
+    ]
+    loose = [p for p in loose if p != spec.base_part]
+    out = []
+    for group in groups:
+        rows = [index[m] for m in group if m in index]
+        hangers = [p for p in loose if np.asarray(sp)[index[p], rows, up].any()]
+        if hangers:
+            wider = (*group, *hangers)
+            trial = with_subassemblies(spec, [("_hung", wider)])
+            o = unit_orientation(trial, relations, "_hung")
+            if o.upside_down and not set(hangers) & set(o.held):
+                loose = [p for p in loose if p not in hangers]
+                group = wider
+        out.append(group)
+    return out
 
 
 def _stuck_units(spec: AssemblySpec, stuck: list[int], optional: dict[str, set[str]]) -> set[str]:
@@ -458,8 +521,10 @@ def cad_units(
     - each of its parts is placed by an operation of its own, placing no other part;
     - it can be built on its own: its parts go into its workspace one by one, each free
       along a direction the gripper approaches from, touching and supported (unless held)
-      by the parts already there (a search over the orders, at most
-      :data:`BUILD_SEARCH_LIMIT` partial workspaces; undecided counts as buildable);
+      by the parts already there, right side up or upside down (gravity reversed: a lid
+      with flanged pegs pressed in from below, :mod:`asp.orientation` then picks the way
+      up) (a search over the orders, at most :data:`BUILD_SEARCH_LIMIT` partial
+      workspaces; undecided counts as buildable);
     - it can be inserted as one rigid body: free from the base part along such a
       direction and touching a part outside it (one that rests on nothing outside it is
       held while it goes in, :func:`hold_unsupported_units`).
@@ -482,10 +547,22 @@ def cad_units(
     op_of = {p: op for op in spec.operations for p in op.parts}
     taken_ids = set(spec.op_ids) | set(spec.part_ids) | {u for u, _ in spec.subassemblies}
     in_unit: dict[str, str] = {m: u for u, ms in spec.subassemblies for m in ms}
+    flipped = []  # the oracle with gravity reversed, made when first needed
+
+    def upside_down():
+        if not flipped:
+            from dataclasses import replace
+
+            from asp.orientation import opposite
+
+            turned = replace(spec, gravity=opposite(spec.gravity))
+            flipped.append(insertion_oracle(turned, relations))
+        return flipped[0]
+
     out = []
     for gid, members in groups:
         uid = gid if gid not in taken_ids else f"{gid}_unit"
-        reason = _unit_problem(spec, oracle, index, op_of, in_unit, members)
+        reason = _unit_problem(spec, oracle, index, op_of, in_unit, members, upside_down)
         if uid in exclude and not reason:
             reason = GIVEN_UP
         out.append(HierarchyUnit(uid, members, not reason, reason))
@@ -495,8 +572,9 @@ def cad_units(
     return tuple(out)
 
 
-def _unit_problem(spec, oracle, index, op_of, in_unit, members) -> str:
-    """Why a group cannot be a unit ("" when it can)."""
+def _unit_problem(spec, oracle, index, op_of, in_unit, members, upside_down=None) -> str:
+    """Why a group cannot be a unit ("" when it can); ``upside_down()`` gives the oracle
+    with gravity reversed (a group built upside down)."""
     inside = {in_unit[m] for m in members if m in in_unit}
     if inside:
         return f"its parts are in the unit {sorted(inside)[0]} (one level of units)"
@@ -511,6 +589,8 @@ def _unit_problem(spec, oracle, index, op_of, in_unit, members) -> str:
     idx = [index[m] for m in members]
     held = {index[m]: op_of[m].held for m in members}
     why = _build_problem(oracle, idx, held)
+    if why and upside_down is not None and not _build_problem(upside_down(), idx, held):
+        why = ""
     if why:
         return f"it cannot be built on its own: {why}"
     return _insert_problem(spec, oracle, idx)

@@ -178,3 +178,14 @@ def test_the_open_parts_must_be_the_open_meshes(tmp_path):
     Replay(plan)
     with pytest.raises(Rejected, match="open_parts says"):
         Replay(tampered(plan, lambda p: p["geometry"].update(open_parts=["plate"])))
+
+
+def test_support_follows_the_rules_the_plan_names(tower_plan):
+    """The tower's flanged bearings are held up by what passes through them (``threaded``,
+    :mod:`cad.support`); a plan whose ``geometry.support`` named the drop test alone would
+    leave them unsupported."""
+    assert tower_plan["geometry"]["support"] == ["rests", "captured", "threaded"]
+    assert "threaded" in Replay(tower_plan).line("robust_plan")
+    rests_only = tampered(tower_plan, lambda p: p["geometry"].update(support=["rests"]))
+    with pytest.raises(Rejected, match="is not supported"):
+        Replay(rests_only).line("robust_plan")

@@ -136,7 +136,10 @@ def test_a_die_set_without_product_tree_finds_its_upper_half(tmp_path):
     """From a folder of STL parts (no hierarchy) the upper half is found automatically: its
     parts can never go in one by one (the screws driven up into the top plate would have
     to pass through the die block); the groups of the stuck parts that span both first
-    guesses merge into one unit, which is built upside down."""
+    guesses merge into one unit, which is built upside down. The guide bushings, pressed
+    into the top plate from below, join it (:func:`asp.units.hung_on_units`): upside down
+    they rest on the top plate, where otherwise each would be held on its guide pin until
+    the upper half comes down."""
     from cad import Assembly
     from tests.cad.test_loading import write_folder
 
@@ -145,6 +148,9 @@ def test_a_die_set_without_product_tree_finds_its_upper_half(tmp_path):
     (uid, members), *others = plan["subassemblies"].items()
     assert not others
     assert {"top_plate", "punch_holder", "punch", "stripper_plate", "top_screw_1"} <= set(members)
+    assert {"bushing_1", "bushing_2"} <= set(members)
+    steps = [i for s in plan["robust_plan"] for i in s["insertions"]]
+    assert [i["parts"] for i in steps if i["held"]] == [list(members)]  # only the half
     spaces = {w["id"]: w for w in plan["workspaces"]}
     assert spaces[uid]["gravity"] == "+z" and spaces[uid]["parts"][0] == "top_plate"
     assert plan["line_check"] == {"robust_plan": None, "worst_line": None}

@@ -418,3 +418,47 @@ def test_a_unit_the_derived_precedences_refute_is_given_up_before_building(tmp_p
     assert units["stack"]["used"] is False and units["stack"]["reason"] == GIVEN_UP
     assert doc["subassemblies"] == {}
     check_line(result.assembly.spec, result.assembly.relations, plan_operations(doc))
+
+
+def capped_block():
+    """A block with two pockets and a lid (mm, z up) into which two flanged pegs are pressed
+    from below, their flanges under the lid standing in the block's pockets: built on its
+    own right side up, the lid's unit needs a peg held (one stands on the bench, the lid on
+    its flange, nothing under the other), upside down (lid on the bench) both pegs rest on
+    the lid."""
+    from tests.cad.real_shapes import box, cylinder, difference, union
+
+    xys = [(-15.0, 0.0), (15.0, 0.0)]
+    parts = {
+        "block": difference(
+            box((-30, -20, 0), (30, 20, 20)), *(cylinder(5.5, 12, 21, 40, xy) for xy in xys)
+        ),
+        "lid": difference(
+            box((-30, -20, 20), (30, 20, 30)), *(cylinder(3, 19, 31, 32, xy) for xy in xys)
+        ),
+    }
+    for k, xy in enumerate(xys, 1):
+        parts[f"peg_{k}"] = union(cylinder(3, 20, 30, 32, xy), cylinder(5, 12, 20, 40, xy))
+    return parts
+
+
+def test_a_files_sub_assembly_built_upside_down_passes_both_checkers(tmp_path):
+    """The file's sub-assembly [lid, peg_1, peg_2] is built upside down in its workspace
+    (:mod:`asp.orientation`), turned over and put on the block; the relations checker and
+    the mesh replay both follow the workspace's gravity from ``plan.json``."""
+    from tests.asmplan.checked import plan_and_check
+
+    write_glb(
+        tmp_path / "capped.glb",
+        capped_block(),
+        {"Product": ["block", "Cap"], "Cap": ["lid", "peg_1", "peg_2"]},
+    )
+    plan = plan_and_check(tmp_path / "capped.glb", tmp_path / "out", "--time-limit", "5")
+    assert plan["subassemblies"] == {"cap": ["lid", "peg_1", "peg_2"]}
+    spaces = {w["id"]: w for w in plan["workspaces"]}
+    assert (spaces["main"]["gravity"], spaces["cap"]["gravity"]) == ("-y", "+y")
+    assert spaces["cap"]["parts"][0] == "lid"
+    steps = [i for s in plan["robust_plan"] for i in s["insertions"]]
+    assert not any(i["held"] for i in steps)  # the lid rests on the block
+    into = next(i for i in steps if i["unit"] == "cap")
+    assert into["insert_along"] == "-y"
