@@ -45,6 +45,10 @@ def plan_summary(result) -> list[str]:
         f"agents {', '.join(f'{a.name} ({a.side})' for a in spec.agents)}"
     ]
     if result.relations_summary:
+        if spec.frame is not None:
+            from cad.frame import frame_text
+
+            lines.append(f"build frame: {frame_text(spec.frame)} (directions below are its axes)")
         lines.append("part relations (contacts with directions; free directions in the assembly):")
         lines.append(relations_summary_text(result.relations_summary))
     lines += units_text(result.units, graph.spec)

@@ -17,7 +17,13 @@ from asp.spec import with_subassemblies
 from tests.asmplan.mesh_replay import replayed
 
 
-def plan_and_check(source: Path, out: Path, *options: str, stderr: list[str] | None = None) -> dict:
+def plan_and_check(
+    source: Path,
+    out: Path,
+    *options: str,
+    stderr: list[str] | None = None,
+    stdout: list[str] | None = None,
+) -> dict:
     """Run ``asmplan plan SOURCE -o OUT [options]`` with defaults and check its line.
 
     Asserts the command succeeds, the principal line does every operation of the spec
@@ -28,12 +34,14 @@ def plan_and_check(source: Path, out: Path, *options: str, stderr: list[str] | N
     operations say: what the plan claims an agent holds), and the mesh replay
     (:mod:`tests.asmplan.mesh_replay`: ``plan.json`` and the meshes alone) accepts both of
     its lines. Returns ``plan.json`` as a dict; the command's stderr (its notes) is
-    appended to ``stderr`` when given.
+    appended to ``stderr`` when given, its stdout (the summary) to ``stdout``.
     """
     result = CliRunner().invoke(app, ["plan", str(source), "-o", str(out), *options])
     assert result.exit_code == 0, result.output
     if stderr is not None:
         stderr.append(result.stderr)
+    if stdout is not None:
+        stdout.append(result.stdout)
     doc = json.loads((out / "plan.json").read_text())
     ops = plan_operations(doc)
     assembly = pipeline.load(source, on_step=lambda _: None)

@@ -44,8 +44,9 @@ def planned(tmp_path_factory) -> dict:
     """The tilted product planned from its files with defaults, and its stderr."""
     root = tmp_path_factory.mktemp("tilted")
     stderr: list[str] = []
-    doc = plan_and_check(product(root / "cad"), root / "plan", stderr=stderr)
-    return {"doc": doc, "stderr": stderr[0], "root": root}
+    stdout: list[str] = []
+    doc = plan_and_check(product(root / "cad"), root / "plan", stderr=stderr, stdout=stdout)
+    return {"doc": doc, "stderr": stderr[0], "stdout": stdout[0], "root": root}
 
 
 @pytest.mark.slow
@@ -53,6 +54,7 @@ def test_a_generated_spec_turns_the_product_so_its_pins_go_in_along_an_axis(plan
     doc = planned["doc"]
     assert "generated spec: frame: the file's frame turned 25 degrees about" in planned["stderr"]
     assert "pin_1-base" in planned["stderr"]  # why: the pairs stuck in the file's frame
+    assert "build frame: the file's frame turned 25 degrees" in planned["stdout"]
     geometry = doc["geometry"]
     assert geometry["frame"] == "build"
     rotation = np.asarray(geometry["build_rotation"])
