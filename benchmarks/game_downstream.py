@@ -1,13 +1,14 @@
 """Everything downstream of a multi-million-state assembly state graph: time and memory.
 
 Stages (those of ``asmplan plan`` after the state graph): counting sequences, the game DAG
-(:func:`asp.game.game_dag`), the exact solve, the robust plan, the CP-SAT schedule (limit
-5 s; only with ``--cpsat``, else an empty schedule), the plan document
-(``AssemblyPlan.to_dict``: the policy table) and writing plan.json, dag.png and
-report.html. Each row gives wall seconds, CPU seconds (the machine is shared)
-and the process's peak RSS after the stage. Target (issue 12, the 4.19M-state graph of a
-72-part cycloidal drive): game DAG + solve + plan document + writing under 10 s, the peak of
-the whole downstream (graph in memory) under 1.6 GB.
+(:func:`asp.game.game_dag`), the exact solve, the robust plan, what the outputs take from the
+game (:func:`asmplan.pipeline.played_game`: the policy table, named; the figure), after
+which the game and its solution are let go, the CP-SAT schedule (limit 5 s; only with
+``--cpsat``, else an empty schedule), the plan document (``AssemblyPlan.to_dict``) and
+writing plan.json, dag.png and report.html. Each row gives wall seconds, CPU seconds (the
+machine is shared) and the process's peak RSS after the stage. Target (issue 12, the
+4.19M-state graph of a 72-part cycloidal drive): game DAG + solve + plan document + writing
+under 10 s, the peak of the whole downstream (graph in memory) under 1.6 GB.
 
 Default graph, built here: ``K`` independent chains of ``L`` operations each (every
 operation done by the person or the robot), ``(L + 1) ** K`` states: 6 chains of 12 give
@@ -111,6 +112,10 @@ def main(argv: list[str]) -> None:
     stages.lap("solve")
     steps = pipeline.robust_plan(game, solution)
     stages.lap("robust plan")
+    played = pipeline.played_game(graph, game, solution)  # then the game goes, as in
+    tct, minimax = solution.tct, solution.minimax  # asmplan plan (keep_game=False)
+    del game, solution, dag
+    stages.lap("policy, lines, figure from the game")
     if args.cpsat:
         line = [s.operation for s in steps if s.operation]
         sched = pipeline.schedule(assembly, graph, sequence=line, time_limit=5, seed=0)
@@ -121,19 +126,17 @@ def main(argv: list[str]) -> None:
         empty = BaselineResult("schedule", graph.spec.name, "UNKNOWN", None, None, 0.0)
         sched = pipeline.Schedule(empty, 0.0, 0.0, 0.0)
     result = pipeline.AssemblyPlan(
-        assembly, graph, sequences, game, solution, steps, [], sched, None, []
+        assembly, graph, sequences, None, None, steps, [], sched, None, [], played
     )
     doc = result.to_dict()
     stages.lap("plan document (to_dict)")
     with tempfile.TemporaryDirectory() as out:
         pipeline.write_plan(result, out)
         stages.lap("write plan.json, dag.png, report")
-    print(
-        f"TCT {solution.tct:g}, W* {solution.minimax:g}, "
-        f"{doc['metrics']['policy_states']:,} policy states"
-    )
+    print(f"TCT {tct:g}, W* {minimax:g}, {doc['metrics']['policy_states']:,} policy states")
     rows = {name: wall for name, wall, _, _ in stages.rows}
-    down = sum(rows[k] for k in ("game DAG", "solve", "plan document (to_dict)"))
+    taken = ("game DAG", "solve", "policy, lines, figure from the game", "plan document (to_dict)")
+    down = sum(rows[k] for k in taken)
     down += rows["write plan.json, dag.png, report"]
     print(
         f"game DAG + solve + to_dict + write: {down:.2f} s (target < {TARGET_S:g} s); "
