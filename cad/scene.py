@@ -93,6 +93,29 @@ def best_raw(candidates: list[str]) -> str | None:
     return next((raw for raw in candidates if not is_generic(clean_name(raw))), None)
 
 
+_PLAIN = re.compile(r"^(\d+(_\d+)*|(body|solid|part|component)_?\d*)$")
+"""A name that is generic but the modeller's own: an item number (``3_001``, a drawing's
+balloon) or a body word (``body_001``); better than the product's name or ``part``."""
+
+
+def plain_raw(candidates: list[str]) -> str | None:
+    """The first of ``candidates`` (raw names) that is a plain item number or body word
+    (:data:`_PLAIN`; never an OCCT label, ``NAUO7`` or ``mesh_0``), or None."""
+    for raw in candidates:
+        if _REFERENCE_LABEL.search(str(raw)):
+            continue
+        digits = re.sub(r"[^0-9a-zA-Z]+", "_", str(raw)).strip("_").lower()
+        if digits and _PLAIN.match(digits):
+            return str(raw)
+    return None
+
+
+def part_id(raw: str) -> str:
+    """The id of a part named ``raw``: :func:`clean_name`, an item number as ``part_3_001``."""
+    name = clean_name(raw)
+    return "part_" + name.removeprefix("p_") if re.fullmatch(r"(p_)?\d+(_\d+)*", name) else name
+
+
 def unique_ids(names: list[str], taken: set[str] | None = None) -> list[str]:
     """Number repeated names in order (``nut`` x2 -> ``nut_1``, ``nut_2``); keep single ones.
 
@@ -174,10 +197,11 @@ def load_scene_file(path: Path) -> trimesh.Scene:
             ) from None
     if path.stat().st_size == 0:
         raise GeometryError(f"empty mesh file {path}")
-    # an OBJ's objects (``o name``) are its parts: one file may hold a whole assembly
-    split = {"split_objects": True} if path.suffix.lower() == ".obj" else {}
     try:
-        scene = trimesh.load(str(path), force="scene", **split)
+        try:
+            scene = trimesh.load(str(path), force="scene", **load_options(path))
+        except KeyError:  # trimesh cannot merge primitives without a material
+            scene = trimesh.load(str(path), force="scene")
     except Exception as exc:  # trimesh raises many types for bad files
         if external_references(path):
             raise empty_scene_error(path) from None
@@ -185,6 +209,19 @@ def load_scene_file(path: Path) -> trimesh.Scene:
     if not isinstance(scene, trimesh.Scene):  # pragma: no cover - force="scene"
         scene = trimesh.Scene(scene)
     return scene
+
+
+def load_options(path: Path) -> dict:
+    """Keywords for ``trimesh.load`` of a scene file: an OBJ's objects (``o name``) are its
+    parts (one file may hold a whole assembly); a glTF mesh's primitives (one per material,
+    as CAD exporters write a part of several colours) are one part, under its node's own
+    name (unmerged, trimesh makes each a node named with a random suffix)."""
+    suffix = path.suffix.lower()
+    if suffix == ".obj":
+        return {"split_objects": True}
+    if suffix in (".glb", ".gltf"):
+        return {"merge_primitives": True}
+    return {}
 
 
 def empty_scene_error(path: Path) -> GeometryError:
@@ -277,23 +314,28 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
         return below
 
     walk(graph.base_frame, [])
+    # a node over every part is the product itself: its name is no part's name while a
+    # part has a plain name of its own (a pen's ``body_001``, a mold's item ``3_001``)
+    whole = {g for g, below in group_nodes if len(below) == len(part_nodes) > 1}
     if file.suffix.lower() == ".3dxml":  # trimesh flattens the tree into the node names
         group_nodes = _3dxml_groups(file, [node for node, _ in part_nodes])
     # the node holding every part (the product itself) is not a group
     group_nodes = [(g, b) for g, b in group_nodes if len(b) < len(part_nodes)]
 
     rescale = _millimetre_numbers(file, scene)
-    names, meshes = [], []
+    names, meshes, bases = [], [], []
     for node, anc in part_nodes:
         transform, geom_name = graph[node]
         mesh = scene.geometry[geom_name].copy().apply_transform(transform)
         meshes.append(mesh.apply_scale(rescale) if rescale != 1.0 else mesh)
-        raw = best_raw([original(node), str(geom_name), *[original(a) for a in anc]])
+        own = [original(node), str(geom_name)]
+        raw = (
+            best_raw(own + [original(a) for a in anc if a not in whole])
+            or plain_raw(own)
+            or best_raw([original(a) for a in anc])
+        )
         names.append(display_name(original(node) if raw is None else raw))
-    bases = [
-        best_name([original(node), str(graph[node][1]), *[original(a) for a in anc]])
-        for node, anc in part_nodes
-    ]
+        bases.append("part" if raw is None else part_id(raw))
     ids = unique_ids(bases)
     id_of = {node: pid for (node, _), pid in zip(part_nodes, ids, strict=True)}
     group_ids = unique_ids(

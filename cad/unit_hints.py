@@ -23,11 +23,12 @@ def unit_hint(assembly: Assembly, a: int, b: int) -> str:
     """A sentence naming the unit that would fit when parts ``a``, ``b`` overlap, or ``""``.
 
     Checks, in order: one of the two is about 1000, 25.4 or 10 times smaller or larger than
-    the median of the other parts (a file in another unit); the whole assembly is under 2 mm
-    across (metres or inches read as millimetres) or over 10 m (millimetres declared as
-    metres).
+    the median of the other parts (a file in another unit; not when both come from one
+    scene file, which has one unit: a clutch's spring is 8 times a bolt); the whole
+    assembly is under 2 mm across (metres or inches read as millimetres) or over 10 m
+    (millimetres declared as metres).
     """
-    for k in (a, b):
+    for k in () if one_scene_file(assembly, a, b) else (a, b):
         hint = part_scale_hint(assembly, k, other=b if k == a else a)
         if hint:
             return hint
@@ -45,6 +46,13 @@ def unit_hint(assembly: Assembly, a: int, b: int) -> str:
             "millimetres, declare mm (export STL/OBJ and set units: mm)"
         )
     return ""
+
+
+def one_scene_file(assembly: Assembly, a: int, b: int) -> bool:
+    """True when parts ``a`` and ``b`` are nodes of one scene file (``source`` ``file#node``)."""
+    sources = [assembly.parts[k].source for k in (a, b)]
+    files = {s.rsplit("#", 1)[0] for s in sources if "#" in s}
+    return len(files) == 1 and all("#" in s for s in sources)
 
 
 def part_scale_hint(

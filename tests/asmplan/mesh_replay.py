@@ -85,7 +85,11 @@ def load_meshes(plan: dict) -> dict[str, trimesh.Trimesh]:
             mesh = trimesh.load(path, force="mesh")
         else:
             if path not in scenes:
-                scenes[path] = trimesh.load(path, force="scene")
+                # a glTF mesh's primitives are one part, named as its node (not randomly)
+                merge = (
+                    {"merge_primitives": True} if path.suffix.lower() in (".glb", ".gltf") else {}
+                )
+                scenes[path] = trimesh.load(path, force="scene", **merge)
             transform, geometry = scenes[path].graph[src["node"]]
             mesh = scenes[path].geometry[geometry].copy().apply_transform(transform)
         mesh = mesh.apply_scale(src.get("scale") or geo["scale"])

@@ -6,6 +6,7 @@ import warnings
 
 import numpy as np
 import pytest
+import trimesh
 
 from cad import Assembly, compute_relations
 from cad.explain import peel_depths, why_blocked
@@ -93,3 +94,27 @@ def test_a_part_in_metres_among_millimetres_warns_on_load(tmp_path):
 
     with pytest.warns(UserWarning, match=r"part 'pin' is about \d+ times smaller .*metres"):
         load_assembly(folder)
+
+
+def test_no_unit_hint_between_parts_of_one_scene_file(tmp_path):
+    """A clutch's STEP: a disc spring 8 times the size of the others overlaps its neighbour
+    deeply; one file has one unit, so the error names no unit (it said "the others may be
+    in centimetres")."""
+    b = shapes.box_between
+    scene = trimesh.Scene()
+    meshes = {
+        "spring_1": b((0, 0, 0), (100, 100, 8)),
+        "spring_2": b((0, 0, 4), (100, 100, 12)),  # 4 mm into spring_1
+        **{f"pin_{k}": b((20 * k, 0, 12), (20 * k + 8, 8, 20)) for k in range(4)},
+    }
+    for name, mesh in meshes.items():
+        scene.add_geometry(mesh.apply_scale(0.001), node_name=name, geom_name=name)
+    path = tmp_path / "clutch.glb"
+    scene.export(path)
+    from cad import load_assembly
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with pytest.raises(ValueError, match="interpenetrate") as info:
+            compute_relations(load_assembly(path))
+    assert "may be in" not in str(info.value)

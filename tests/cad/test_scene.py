@@ -342,3 +342,60 @@ def test_a_gltf_declaring_millimetres_keeps_its_numbers(tmp_path):
     assert assembly.units == "mm"
     assert np.allclose(assembly.parts[0].mesh.extents, [400, 300, 20], atol=1e-3)
     assert coordinate_scale(path) == 1.0
+
+
+def test_plain_part_names_win_over_the_product_name(tmp_path):
+    """A FreeCAD STEP (the APLAN benchmark's pen and shear mold): parts ``body_001`` and
+    ``3_001`` (item numbers) straight under the product ``asm_pen``: ids come from the parts'
+    own names, never the product's (which named every part ``asm_pen_<n>``); a name-less
+    NAUO under a product still takes the product's name (test_gltf_names_and_hierarchy)."""
+    scene = trimesh.Scene()
+    scene.graph.update(frame_from="world", frame_to="asm_pen")
+    for k, node in enumerate(["body_001", "head_001", "3_001", "12_001"]):
+        mesh = shapes.box_between((10 * k, 0, 0), (10 * k + 5, 5, 5)).apply_scale(0.001)
+        scene.add_geometry(mesh, node_name=node, geom_name=node, parent_node_name="asm_pen")
+    path = tmp_path / "pen.glb"
+    scene.export(path)
+    parts = read_scene(path)
+    assert dict(zip(parts.ids, parts.names, strict=True)) == {
+        "body_001": "body_001", "head_001": "head_001", "part_3_001": "3_001",
+        "part_12_001": "12_001",
+    }  # fmt: skip
+
+
+def test_a_gltf_mesh_of_several_primitives_is_one_part(tmp_path):
+    """A glTF node whose mesh has two primitives (two materials, as CAD exporters write a
+    part of two colours) is one part with the node's name, read the same on every load
+    (trimesh made each primitive a node named with a random suffix: the 2-cylinder engine
+    of the Khronos samples)."""
+    import json
+
+    from trimesh.exchange.gltf import export_gltf
+
+    scene = trimesh.Scene()
+    scene.graph.update(frame_from="world", frame_to="Gearbox")
+    meshes = {
+        "Housing": shapes.box_between((0, 0, 0), (40, 40, 5)),
+        "Housing lid": shapes.box_between((0, 0, 5), (40, 40, 10)),  # a 2nd primitive
+        "Gear": shapes.box_between((10, 10, 10), (20, 20, 15)),
+    }
+    for k, (name, mesh) in enumerate(meshes.items()):
+        colour = trimesh.visual.material.PBRMaterial(baseColorFactor=[60 * k, 90, 200, 255])
+        mesh.visual = trimesh.visual.TextureVisuals(material=colour)
+        scene.add_geometry(
+            mesh.apply_scale(0.001), node_name=name, geom_name=name, parent_node_name="Gearbox"
+        )
+    files = export_gltf(scene)
+    doc = json.loads(files["model.gltf"])
+    by_name = {node["name"]: node for node in doc["nodes"]}
+    housing, lid = by_name["Housing"], by_name["Housing lid"]
+    doc["meshes"][housing["mesh"]]["primitives"] += doc["meshes"][lid["mesh"]]["primitives"]
+    lid.pop("mesh")  # an empty node now
+    files["model.gltf"] = json.dumps(doc).encode()
+    for name, data in files.items():
+        (tmp_path / name).write_bytes(data)
+    first = read_scene(tmp_path / "model.gltf")
+    assert first.ids == ("gear", "housing")
+    assert np.allclose(first.meshes[1].extents, [0.04, 0.04, 0.01])
+    (tmp_path / "again.gltf").write_bytes(files["model.gltf"])
+    assert read_scene(tmp_path / "again.gltf").nodes == first.nodes == ("Gear", "Housing")
