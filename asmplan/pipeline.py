@@ -231,6 +231,7 @@ class AssemblyPlan:
                 played.describe,
                 extra=extra,
                 relations=self.assembly.relations,
+                interchangeable=self.graph.model.interchangeable,
             )
         curve = self.concurrent.curve
         doc = plan_document(
@@ -240,6 +241,7 @@ class AssemblyPlan:
             game=curve.game,
             extra=extra,
             relations=self.assembly.relations,
+            interchangeable=self.graph.model.interchangeable,
         )
         from asp.concurrent_plan import plan_entries
 
