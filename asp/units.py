@@ -105,7 +105,8 @@ def build_with_units(
     first error is raised. With ``reduce``, a round whose derived precedences already prove
     that no complete sequence exists (:func:`asp.symmetry.refutation`, milliseconds)
     builds no graph: the operation the proof names is the stuck one (a clutch's pressure
-    plate blocked by its 13 pins: 15.7M states built twice before, none now). Every unit is checked by the state graph itself: its members
+    plate blocked by its 13 pins: 15.7M states built twice before, none now).
+    Every unit is checked by the state graph itself: its members
     must go into its own workspace one by one and the finished unit into the assembly as
     one rigid body, so units only ever give sound plans.
 
