@@ -145,9 +145,7 @@ def build_with_units(
 
             proof = refutation(with_units, relations)
             if proof is not None:  # no complete sequence: known without a graph
-                raise SpecError(
-                    f"{with_units.source}: infeasible assembly, no complete sequence: {proof.why}"
-                )
+                raise _Proved(with_units, proof.why)
             graph = reduced_state_graph(with_units, relations, concurrent=concurrent, **kwargs)
             if graph is not None:
                 return graph
@@ -229,6 +227,8 @@ def build_with_units(
         else:
             drop = set(optional)
         if not drop:
+            if isinstance(first_error, _Proved):  # the graph's report names more
+                first_error = _graph_report(first_error, relations, kwargs)
             raise first_error from None
         given_up |= drop
         say(
@@ -405,6 +405,26 @@ def _stuck_units(spec: AssemblySpec, stuck: list[int], optional: dict[str, set[s
             if op.unit == uid or set(op.parts) & members:
                 out.add(uid)
     return out
+
+
+class _Proved(SpecError):
+    """No complete sequence, proved by the derived precedences without a state graph."""
+
+    def __init__(self, spec: AssemblySpec, why: str):
+        super().__init__(f"{spec.source}: infeasible assembly, no complete sequence: {why}")
+        self.spec = spec
+
+
+def _graph_report(proof: _Proved, relations, kwargs: dict) -> SpecError:
+    """The state graph's own report of a proved failure (it names the blockers along each
+    direction and a state where the part was tried), or the proof if the graph has none."""
+    from asp.state_graph import build_state_graph
+
+    try:
+        build_state_graph(proof.spec, relations, **kwargs)
+    except SpecError as exc:
+        return exc
+    return proof
 
 
 @dataclass(frozen=True)
