@@ -15,6 +15,7 @@ import pytest
 
 from asmplan import pipeline
 from asp.game import game_dag
+from asp.generate import gravity_choice
 from asp.solve import solve
 from asp.spec import with_subassemblies
 from asp.state_graph import build_state_graph
@@ -51,6 +52,15 @@ def free(name: str, i: str, j: str) -> set[str]:
 )
 def test_meshing_teeth_block_what_they_should(name, i, j, expected):
     assert free(name, i, j) == expected
+
+
+def test_a_helical_pair_blocked_on_its_shafts_is_not_called_another_axis_up():
+    """Along -z no order exists even with every part held (the helix, not gravity): the
+    sideways plan is said as such, never as a Y-up file."""
+    assembly = Assembly.from_meshes(products.helical_pair())
+    choice = gravity_choice(relations("helical_pair"), assembly, "-z")
+    assert choice.feasible["-z"] is False and choice.blocked_anyway
+    assert "even with every part held" in choice.reason and "likely" not in choice.reason
 
 
 @pytest.mark.slow
