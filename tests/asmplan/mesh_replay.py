@@ -14,8 +14,9 @@ tests each insertion with python-fcl. The rules (``geometry``):
   inwards turned outwards;
 - **erosion**: every part shrunk by its ``part_shrink``: each vertex moved inwards along
   its normal, never moving any face plane by more than the shrink (conservative: the
-  replay tolerates at most what the plan says); the inner part of a pair in ``fits`` is
-  shrunk by ``extra_shrink`` more against that pair's outer part only;
+  replay tolerates at most what the plan says), and the free edges of an open part (edges
+  of one face) moved back in their faces by ``free_edge_pull`` shrinks; the inner part of a
+  pair in ``fits`` is shrunk by ``extra_shrink`` more against that pair's outer part only;
 - **open parts**: ``open_parts`` must be exactly the parts whose mesh is not closed once
   merged; a closed part has an inside (a body lying wholly in it collides with it, as a
   body whose surface crosses it does), an open one has none (its relations are
@@ -105,11 +106,27 @@ def load_meshes(plan: dict) -> dict[str, trimesh.Trimesh]:
     return out
 
 
-def eroded(mesh: trimesh.Trimesh, shrink: float) -> trimesh.Trimesh:
+def eroded(mesh: trimesh.Trimesh, shrink: float, pull: float = 0.0) -> trimesh.Trimesh:
     """Each vertex moved inwards along its normal so that no face plane it touches moves by
-    more than ``shrink`` (exactly ``shrink`` for the plane closest to the normal)."""
+    more than ``shrink`` (exactly ``shrink`` for the plane closest to the normal); a vertex
+    on free edges (edges of one face) also moved back in those faces, away from them, by
+    at most ``pull * shrink`` (``free_edge_pull``)."""
     if shrink <= 0:
         return mesh
+    back = np.zeros((len(mesh.vertices), 3))
+    if pull > 0 and not mesh.is_watertight:
+        counts = np.bincount(mesh.edges_unique_inverse)
+        free = counts[mesh.edges_unique_inverse] == 1
+        ends, faces = mesh.edges[free], mesh.edges_face[free]
+        start, stop = mesh.vertices[ends[:, 0]], mesh.vertices[ends[:, 1]]
+        away = np.cross(stop - start, mesh.face_normals[faces])
+        outside = (start + stop) / 2 - mesh.triangles_center[faces]
+        away *= np.sign(np.einsum("ij,ij->i", away, outside))[:, None]
+        away /= np.maximum(np.linalg.norm(away, axis=1), 1e-300)[:, None]
+        np.add.at(back, ends[:, 0], away)
+        np.add.at(back, ends[:, 1], away)
+        size = np.linalg.norm(back, axis=1)
+        back /= np.maximum(size, 1.0)[:, None]  # at most one pull, however many free edges
     normals = mesh.vertex_normals
     cos = np.zeros(len(mesh.vertices))
     for k in range(mesh.vertex_faces.shape[1]):
@@ -118,7 +135,8 @@ def eroded(mesh: trimesh.Trimesh, shrink: float) -> trimesh.Trimesh:
         dots = np.einsum("ij,ij->i", normals[has], mesh.face_normals[f[has]])
         cos[has] = np.maximum(cos[has], dots)
     move = shrink / np.clip(cos, 0.5, 1.0)
-    return trimesh.Trimesh(mesh.vertices - normals * move[:, None], mesh.faces, process=False)
+    moved = mesh.vertices - normals * move[:, None] - back * (pull * shrink)
+    return trimesh.Trimesh(moved, mesh.faces, process=False)
 
 
 def collision_object(mesh: trimesh.Trimesh) -> fcl.CollisionObject:
@@ -181,6 +199,7 @@ class Replay:
         # a unit built in another orientation (upside down) has its own gravity
         self.down = {w["id"]: vector(w.get("gravity", plan["gravity"])) for w in plan["workspaces"]}
         self.extra = {(f["inner"], f["outer"]): f["extra_shrink"] for f in geo.get("fits", [])}
+        pull = float(geo.get("free_edge_pull", 0.0))
         self.open = {p for p, m in self.meshes.items() if not m.is_watertight}
         said = set(geo.get("open_parts", self.open))
         if said != self.open:
@@ -190,10 +209,12 @@ class Replay:
         closed = {p: p not in self.open for p in self.meshes}
         self.plain = {p: Solid(m, closed[p]) for p, m in self.meshes.items()}
         self.solid = {
-            p: Solid(eroded(m, self.shrink[p]), closed[p]) for p, m in self.meshes.items()
+            p: Solid(eroded(m, self.shrink[p], pull), closed[p]) for p, m in self.meshes.items()
         }
         self.fitted = {
-            pair: Solid(eroded(self.meshes[pair[0]], self.shrink[pair[0]] + extra), closed[pair[0]])
+            pair: Solid(
+                eroded(self.meshes[pair[0]], self.shrink[pair[0]] + extra, pull), closed[pair[0]]
+            )
             for pair, extra in self.extra.items()
         }
         thinnest = min(float(np.min(m.extents)) for m in self.meshes.values())
