@@ -437,6 +437,7 @@ def state_graph(
     progress: bool = False,
     max_states: int | None = None,
     on_step: Progress | None = None,
+    concurrent: bool = False,
 ) -> StateGraph:
     """The assembly state graph: every feasible partial assembly and operation.
 
@@ -446,12 +447,12 @@ def state_graph(
     in milliseconds, said on ``on_step``). The spec, with those units, is first
     reduced (:func:`asp.symmetry.reduced_state_graph`: the precedences every complete
     sequence keeps, interchangeable parts in a fixed order or, for blocks of parts that
-    cannot be, only the first of equal blocks moving; same TCT and W*, far fewer states).
-    (a unit is one body of the main assembly there, its workspace left alone). When that
-    has nothing to reduce or no complete sequence, exactly alike parts are placed in a
-    fixed order (:func:`asp.symmetry.reduce_exact`) and, when a part can never be inserted
-    alone, subassemblies are added automatically
-    (:func:`asp.units.build_with_units`); the graph's ``spec`` holds all of it.
+    cannot be, only the first of equal blocks moving; same TCT and W*, far fewer states;
+    a unit is one body of the main assembly there, and the alike parts of its workspace
+    are reduced in it). When that has no complete sequence and a part can never be
+    inserted alone, subassemblies are added automatically
+    (:func:`asp.units.build_with_units`, each round reduced alike); the graph's ``spec``
+    holds all of it.
 
     Parameters
     ----------
@@ -462,13 +463,17 @@ def state_graph(
         State limit (default: the spec's ``max_states``, else 20,000,000).
     on_step : callable, optional
         Called with a line for each round of automatic subassemblies.
+    concurrent : bool
+        Reduce so that the concurrent game (and the CP-SAT schedule) keep their values too:
+        alike parts in a loose order, not a fixed one (more states;
+        :func:`asp.symmetry.symmetry_reduction`).
 
     Returns
     -------
     asp.state_graph.StateGraph
     """
     from asp.errors import SpecError
-    from asp.symmetry import reduce_exact, reduced_state_graph
+    from asp.symmetry import reduced_state_graph
     from asp.units import (
         build_with_units,
         hierarchy_line,
@@ -486,6 +491,7 @@ def state_graph(
         graph = reduced_state_graph(
             prepared_units(first, rel, turned.append),
             rel,
+            concurrent=concurrent,
             progress=progress,
             max_states=max_states,
         )
@@ -500,7 +506,8 @@ def state_graph(
         spec,
         rel,
         hierarchy=spec.generated,
-        prepare=lambda with_units: reduce_exact(with_units, rel),
+        reduce=True,
+        concurrent=concurrent,
         on_unit=on_step,
         given_up=given_up,
         progress=progress,
@@ -708,7 +715,20 @@ def plan(
     summary = relations_summary(assembly.relations) if assembly.relations is not None else []
     release_memory()  # the meshes and collision objects of the relations
     say("[2/5] building the assembly state graph ...")
-    graph = state_graph(assembly, progress=True, max_states=max_states, on_step=on_step)
+    turn = assembly.spec.turn_model if turn_model is None else turn_model
+    from asp.spec import TURN_MODELS
+
+    if turn not in TURN_MODELS:
+        from asp.errors import GraphError
+
+        raise GraphError(f"--turn-model: expected alternate or concurrent, got {turn!r}")
+    graph = state_graph(
+        assembly,
+        progress=True,
+        max_states=max_states,
+        on_step=on_step,
+        concurrent=turn == "concurrent",
+    )
     from asp.units import units_report
 
     units = units_report(assembly.spec, assembly.relations, graph.spec.subassemblies)
@@ -730,14 +750,7 @@ def plan(
     line = [step.operation for step in steps if step.operation]
     sched = schedule(assembly, graph, time_limit=time_limit, seed=seed, sequence=line)
     release_memory()  # CP-SAT's model and the replay tables
-    turn = assembly.spec.turn_model if turn_model is None else turn_model
     concurrent = None
-    from asp.spec import TURN_MODELS
-
-    if turn not in TURN_MODELS:
-        from asp.errors import GraphError
-
-        raise GraphError(f"--turn-model: expected alternate or concurrent, got {turn!r}")
     if turn == "concurrent":
         from asp.concurrent import DEFAULT_MAX_K
         from asp.concurrent_plan import plan_concurrent
@@ -808,7 +821,14 @@ def plan_report(result: AssemblyPlan, doc: dict, dag_png: bytes | None = None) -
     curve and Gantt charts (solved for the report when the plan has none and is small)."""
     from asmplan.report.html import report_figures, report_html
 
-    figures = report_figures(doc, result.concurrent, spec=result.assembly.spec, graph=result.graph)
+    sched = result.schedule
+    figures = report_figures(
+        doc,
+        result.concurrent,
+        spec=result.assembly.spec,
+        graph=result.graph,
+        schedule=None if sched is None else (sched.result, sched.lower_bound),
+    )
     if dag_png:
         figures["dag"] = dag_png
     return report_html(doc, figures)

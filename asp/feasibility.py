@@ -341,6 +341,10 @@ class OperationModel:
         Per subassembly, its member parts.
     symmetric : tuple of classes of blocks of operation indices
         Interchangeable blocks: of equal blocks only the first moves (:mod:`asp.symmetry`).
+    loose : tuple of (int, tuple of int)
+        Classes of interchangeable operations, each with its slack ``m``: an operation of a
+        class may be done only while at most ``m`` of the ones listed before it are not
+        (:meth:`_loose_order`; ``m = 0`` is a fixed order).
     """
 
     spec: AssemblySpec
@@ -364,6 +368,7 @@ class OperationModel:
     unit_ops: tuple[int, ...] = ()
     unit_masks: np.ndarray | None = None
     symmetric: tuple[tuple[tuple[int, ...], ...], ...] = ()
+    loose: tuple[tuple[int, tuple[int, ...]], ...] = ()
 
     @property
     def n_ops(self) -> int:
@@ -456,8 +461,7 @@ class OperationModel:
             ok = np.empty((keys.shape[0], self.n_ops), dtype=bool)
             sets = np.ascontiguousarray(self.oracle.sets(parts))
             enabled_single(np.ascontiguousarray(keys), sets, *self._kernel_args, ok)
-            if self.symmetric:
-                self._first_of_equals(keys, ok)
+            self._symmetries(keys, ok)
             return ok
         zero = np.uint64(0)
         if self.n_words == 1:  # the fast path: one broadcast test per mask
@@ -503,8 +507,7 @@ class OperationModel:
                 good &= self.oracle.feasible(p, s, held=held, workspace=workspace)
                 s = s | self.oracle.bit(p)
             column[rows] = good
-        if self.symmetric:
-            self._first_of_equals(keys, ok)
+        self._symmetries(keys, ok)
         return ok
 
     def stuck(self, keys: np.ndarray, parts: np.ndarray) -> np.ndarray:
@@ -561,6 +564,31 @@ class OperationModel:
                 else np.zeros((0, o.n_words), dtype=np.uint64)
             ),
         )
+
+    def _symmetries(self, keys: np.ndarray, ok: np.ndarray) -> None:
+        """Keep only the moves the reduction of interchangeable operations keeps."""
+        if self.symmetric:
+            self._first_of_equals(keys, ok)
+        if self.loose:
+            self._loose_order(keys, ok)
+
+    def _loose_order(self, keys: np.ndarray, ok: np.ndarray) -> None:
+        """Of each class of interchangeable operations ``(m, ops)`` (:mod:`asp.symmetry`),
+        keep ``ops[j]`` only where at most ``m`` of ``ops[:j]`` are not done.
+
+        Any of them may be done next, so doing the first one not done is the same move up to
+        a symmetry fixing the state: ``m = 0`` keeps that move alone (a fixed order). With
+        ``m`` one less than the workers who may do them, ``m`` of them may still be running
+        when another one starts, so the concurrent game keeps its moves too (the first not
+        running), and since the count only falls as operations are done, an operation kept
+        when it starts is kept whichever finishes first.
+        """
+        for slack, ops in self.loose:
+            missing = np.zeros(keys.shape[0], dtype=np.int64)
+            for j, i in enumerate(ops):
+                if j > slack:
+                    ok[:, i] &= missing <= slack
+                missing += ~self.has_op(keys, i)
 
     def _first_of_equals(self, keys: np.ndarray, ok: np.ndarray) -> None:
         """Keep, of interchangeable blocks in the same state, only the first one's moves.
@@ -657,14 +685,16 @@ def _split(value: int, n_words: int) -> list[int]:
 
 
 def operation_model(
-    spec: AssemblySpec, relations=None, *, _min_words: int = 1, symmetric=()
+    spec: AssemblySpec, relations=None, *, _min_words: int = 1, symmetric=(), loose=()
 ) -> OperationModel:
     """Compile ``spec`` (and the cad relations, if any) into an :class:`OperationModel`.
 
     The state key takes as many 64-bit words as the operations and tool fields need
     (``_min_words`` forces more, for tests of the multi-word path). ``symmetric``: classes of
     interchangeable blocks of operation ids (:func:`asp.symmetry.interchangeable_blocks`),
-    of which only the first of equal blocks moves (:meth:`OperationModel.enabled`).
+    of which only the first of equal blocks moves (:meth:`OperationModel.enabled`);
+    ``loose``: classes of interchangeable operation ids with their slack, ``(m, ids)``
+    (:attr:`OperationModel.loose`).
 
     Raises
     ------
@@ -748,6 +778,7 @@ def operation_model(
         symmetric=tuple(
             tuple(tuple(index[o] for o in block) for block in cls) for cls in symmetric
         ),
+        loose=tuple((int(m), tuple(index[o] for o in ids)) for m, ids in loose),
     )
 
 

@@ -36,6 +36,34 @@ of the blocks are done in block order: chains of precedences (:func:`with_fixed_
 sorted state every move is mapped by a transposition of two blocks with the same prefix onto a
 move of the sorted graph with the same cost and an isomorphic future, so TCT and W* are the
 same (tested against the full graph), with far fewer states.
+
+**Units.** A unit is one body of the main assembly: the main assembly sees its members only
+once it is inserted, so in the main assembly's tests a member stands for the unit's part (a
+guide pin touching one bushing of the upper half of a die set touches that half). A
+placement in a unit's workspace is tested against the members placed there only, and any
+member may go first into the empty workspace: its reduced test keeps only the members (with
+the predecessors' parts there and the successors' not, and dominated blocker sets dropped),
+derives only that a member blocking it along every direction left comes after it, and
+proves nothing impossible. The insertions stay in place, so a symmetry maps each workspace
+onto itself: alike bushings or screws of one workspace are interchangeable like alike parts
+of the main assembly, and are ordered the same way.
+
+**The concurrent game** runs two operations at once only if both orders are transitions, so
+a fixed order of alike parts would forbid placing two of them together and change its W*.
+A graph for the concurrent game (``reduced_state_graph(..., concurrent=True)``) keeps a
+*loose* order instead: of a class of single operations that ``w`` workers may do, the
+``j``-th may be done while at most ``w - 1`` of those
+before it are not. Starting the first one neither done nor running is then always a move
+(the others before it are running, at most ``w - 1``), it is the move any other start is
+mapped onto by a symmetry fixing the state (done and running), and the count only falls as
+operations are done, so a running one stays a transition whichever finishes first: both
+games keep their values. Blocks of several operations (a dowel with its roller) are ordered
+position by position, each position with the slack of the one before it plus its own (a
+block may be behind lower ones by what the position before allowed). The classes of blocks
+that are not chains (moved first of equals) keep the alternating game's values only. A loose
+order holds many more states (the 26-part shear mold stand-in: 459,182 instead of 15,019; a
+70-part drive with 20 pins and rollers over 20 million instead of 697,641), so the pipeline
+builds it for the concurrent turn model only.
 """
 
 from __future__ import annotations
@@ -68,6 +96,12 @@ class ReducedModel:
         :data:`TRUE` when a predecessor's part guarantees it.
     family : tuple of frozenset of int
         Per operation, the minimal blocker sets of its allowed directions in valid states.
+    raw_near : tuple of int
+        Per operation, the operations placing what it may touch or rest on (bitset).
+    workspace : tuple of int
+        Per operation, the members of the unit whose workspace it builds in (bitset; 0: the
+        main assembly). Its tests look at those members only and hold in the empty
+        workspace; in the main assembly's tests a unit's part stands for its members.
     """
 
     part_of: tuple[int, ...]
@@ -77,6 +111,7 @@ class ReducedModel:
     support: tuple[int, ...]
     family: tuple[frozenset[int], ...]
     raw_near: tuple[int, ...] = ()
+    workspace: tuple[int, ...] = ()
 
 
 def _bits(mask: int):
@@ -149,40 +184,48 @@ def _derive(spec: AssemblySpec, relations) -> tuple[ReducedModel | None, str, Re
     oracle = insertion_oracle(spec, relations)
     n_ops = len(spec.operations)
     pidx = {p: k for k, p in enumerate(oracle.parts)}
-    # a unit is one body of the main assembly (its oracle row ORs its members'); the
-    # placements in its workspace are left alone (tested against the unit's members only)
-    members = {u: [pidx[m] for m in ms] for u, ms in spec.subassemblies}
-    in_unit = {m for ms in members.values() for m in ms}
+    # a unit is one body of the main assembly (its oracle row ORs its members'): the main
+    # assembly sees its members only once it is inserted, so in the tests of the main
+    # assembly a member stands for its unit (:func:`_as_units`); a placement in a unit's
+    # workspace is tested against the unit's members placed there only (any member may
+    # go first into the empty workspace)
+    units = [(pidx[u], sum(1 << pidx[m] for m in ms)) for u, ms in spec.subassemblies]
+    room = {m: mask for _, mask in units for m in _bits(mask)}
     part_of = tuple(
-        pidx[op.unit]
-        if op.unit
-        else (pidx[op.parts[0]] if op.parts and pidx[op.parts[0]] not in in_unit else -1)
+        pidx[op.unit] if op.unit else (pidx[op.parts[0]] if op.parts else -1)
         for op in spec.operations
+    )
+    workspace = tuple(
+        room.get(p, 0) if not op.unit else 0 for p, op in zip(part_of, spec.operations, strict=True)
     )
     op_of = {p: i for i, p in enumerate(part_of) if p >= 0}
     bits_of = {p: 1 << p for p in op_of}
-    for i, op in enumerate(spec.operations):
-        if op.unit:
-            for m in members[op.unit]:
-                op_of[m] = i
-                bits_of[part_of[i]] |= 1 << m
     base = oracle.base
     initial = 0 if base in op_of or base < 0 else 1 << base
     absent = ((1 << len(oracle.parts)) - 1) & ~initial & ~sum(1 << p for p in op_of)
-    contact = [unpack_words(oracle.contact[p]) if p >= 0 else 0 for p in part_of]
-    support = [unpack_words(oracle.support[p]) if p >= 0 else 0 for p in part_of]
-    blocked = [
+    raw_contact = [unpack_words(oracle.contact[p]) if p >= 0 else 0 for p in part_of]
+    raw_support = [unpack_words(oracle.support[p]) if p >= 0 else 0 for p in part_of]
+    raw_blocked = [
         [unpack_words(oracle.blocked[p, d]) for d in range(6) if oracle.directions[d]]
         if p >= 0
         else []
         for p in part_of
     ]
+
+    def seen(i: int, mask: int) -> int:
+        """``mask`` as operation ``i``'s test sees it: its workspace's members, or the
+        main assembly's parts with the units for their members."""
+        return mask & workspace[i] if workspace[i] else _as_units(mask, units)
+
+    contact = [seen(i, m) for i, m in enumerate(raw_contact)]
+    support = [seen(i, m) for i, m in enumerate(raw_support)]
+    blocked = [[seen(i, m) for m in masks] for i, masks in enumerate(raw_blocked)]
     index = {op.id: i for i, op in enumerate(spec.operations)}
     must = [sum(1 << index[a] for a in op.after) for op in spec.operations]
     if base in op_of:
         b = op_of[base]
         for i in range(n_ops):
-            if i != b and part_of[i] >= 0:
+            if i != b and part_of[i] >= 0 and not workspace[i]:
                 must[i] |= 1 << b
     held = [op.held or not oracle.stability for op in spec.operations]
 
@@ -230,6 +273,10 @@ def _derive(spec: AssemblySpec, relations) -> tuple[ReducedModel | None, str, Re
                 red_s.append(TRUE)
                 fams.append(frozenset({0}))
                 continue
+            if workspace[i]:
+                # in a unit's workspace: only its members count, and nothing is proved
+                # impossible or needed first (any member may go first into it)
+                there, never = there & workspace[i], never & workspace[i]
             tests = []
             for mask in (contact[i], TRUE if held[i] else support[i]):
                 tests.append(TRUE if mask == TRUE or mask & there else mask & ~never)
@@ -239,24 +286,27 @@ def _derive(spec: AssemblySpec, relations) -> tuple[ReducedModel | None, str, Re
             # a set holding an ancestor (or itself) of every part it may touch or rest on is
             # never free; a set holding an ancestor of every part of another set is free only
             # when that one is (valid states hold the ancestors of what they hold)
-            need = [t for t in tests if t != TRUE]
             sets = {b & ~never for b in blocked[i] if not b & there}
-            sets = {b for b in sets if not any(covers(b, t) for t in need)}
-            family = frozenset(
-                b for b in sets if not any(covers(b, t) and not covers(t, b) for t in sets)
-            )
-            why, test = _never(spec, i, tests, family)
-            if why:
-                looked = (contact[i], support[i], _union(blocked[i]))[test]
-                return None, why, _refuted(spec, oracle, why, i, looked)
+            if workspace[i]:  # a set holding another is free only when that one is
+                family = frozenset(b for b in sets if not any(t != b and t & b == t for t in sets))
+            else:
+                need = [t for t in tests if t != TRUE]
+                sets = {b for b in sets if not any(covers(b, t) for t in need)}
+                family = frozenset(
+                    b for b in sets if not any(covers(b, t) and not covers(t, b) for t in sets)
+                )
+                why, test = _never(spec, i, tests, family)
+                if why:
+                    looked = (raw_contact[i], raw_support[i], _union(raw_blocked[i]))[test]
+                    return None, why, _refuted(spec, oracle, why, i, looked)
+                # the only part it can touch or rest on comes first
+                for mask in tests:
+                    if mask not in (TRUE, 0) and mask & (mask - 1) == 0:
+                        q = ops_of(mask)
+                        if q and not must[i] & q:
+                            must[i] |= q
+                            changed = True
             fams.append(family)
-            # the only part it can touch or rest on comes first
-            for mask in tests:
-                if mask not in (TRUE, 0) and mask & (mask - 1) == 0:
-                    q = ops_of(mask)
-                    if q and not must[i] & q:
-                        must[i] |= q
-                        changed = True
             # a part blocking it along every direction left comes after it
             common = ~0
             for s in family:
@@ -274,6 +324,7 @@ def _derive(spec: AssemblySpec, relations) -> tuple[ReducedModel | None, str, Re
                 support=tuple(red_s),
                 family=tuple(fams),
                 raw_near=tuple(ops_of(contact[i] | support[i]) for i in range(n_ops)),
+                workspace=workspace,
             )
             return model, "", None
 
@@ -302,6 +353,15 @@ def _refuted(spec: AssemblySpec, oracle, why: str, i: int, looked: int) -> Refut
         name = oracle.parts[p]
         parts.extend(members.get(name, (name,)))
     return Refutation(why, spec.operations[i].id, tuple(dict.fromkeys(parts)))
+
+
+def _as_units(mask: int, units: list[tuple[int, int]]) -> int:
+    """``mask`` with the members of each unit ``(unit part, members mask)`` replaced by the
+    unit's part: the main assembly holds a unit's members exactly when it holds the unit."""
+    for unit, members in units:
+        if mask & members:
+            mask = mask & ~members | 1 << unit
+    return mask
 
 
 def _union(masks) -> int:
@@ -359,6 +419,7 @@ class _Symmetry:
                 -1 if m.contact[i] == TRUE else bin(m.contact[i]).count("1"),
                 -1 if m.support[i] == TRUE else bin(m.support[i]).count("1"),
                 tuple(sorted(bin(s).count("1") for s in m.family[i])),
+                m.workspace[i] if m.workspace else 0,
             )
             for i in range(n)
         ]
@@ -373,12 +434,10 @@ class _Symmetry:
             for a in _bits(m.must[i]):
                 after[a] |= 1 << i
         self.relations = (near, list(m.must), after)
-        # a unit's insertion and its members' placements are never moved: the reduced model
-        # leaves the placements in a workspace untested, so it cannot tell two units alike
-        members = {p for _, ms in spec.subassemblies for p in ms}
-        self.fixed = sum(
-            1 << i for i, op in enumerate(spec.operations) if op.unit or set(op.parts) & members
-        )
+        # a unit's insertion is never moved (its members' placements are, within its
+        # workspace)
+        self.fixed = sum(1 << i for i, op in enumerate(spec.operations) if op.unit)
+        self.workspace = m.workspace or (0,) * n
 
     def _map_ops(self, perm: dict[int, int], mask: int) -> int:
         out = 0
@@ -400,7 +459,10 @@ class _Symmetry:
         """The operations whose reduced tests ``perm`` (identity elsewhere) does not map onto
         their image's: none for a symmetry."""
         m = self.m
-        if any(self.sig[i] != self.sig[j] for i, j in perm.items()):
+        if any(
+            self.sig[i] != self.sig[j] or self.workspace[i] != self.workspace[j]
+            for i, j in perm.items()
+        ):  # the units stay in place, so a placement stays in its workspace
             return list(perm)
         # only operations whose tests mention a moved one can change
         moved_parts = sum(1 << m.part_of[i] for i in perm if m.part_of[i] >= 0)
@@ -625,7 +687,8 @@ def with_fixed_order(spec: AssemblySpec, classes: list[list[str]]) -> AssemblySp
 
 
 def reduce_interchangeable(spec: AssemblySpec, relations) -> AssemblySpec:
-    """``spec`` reduced for the state graph, with the full graph's TCT and W*.
+    """``spec`` reduced for the state graph, with the full graph's TCT and W* (the
+    alternating game).
 
     With the reduced model (:func:`reduced_model`): its derived precedences become ``after``
     (:func:`with_derived_precedences`; only dead ends go) and, for every class of
@@ -633,45 +696,94 @@ def reduce_interchangeable(spec: AssemblySpec, relations) -> AssemblySpec:
     order. Otherwise the classes of an exact swap are chained. A spec the derived precedences
     prove infeasible is returned as it is (the state graph names the cause).
     """
+    return _reduced(spec, relations, concurrent=False)[0]
+
+
+def _reduced(spec: AssemblySpec, relations, concurrent: bool):
+    """:func:`reduce_interchangeable` and, with ``concurrent``, the chains of the classes
+    of blocks kept in a loose order instead, with their slack (``(m, ids)`` for
+    :func:`asp.feasibility.operation_model`'s ``loose``).
+
+    The slack of position ``p`` of a class's blocks is ``s(p) = s(p - 1) + m(p)``, ``m(p)``
+    the :func:`class_slack` of the operations at ``p`` (``s(-1) = 0``): the block to move,
+    the first of those neither ahead nor running, has below it only blocks running
+    their operation ``p`` (at most ``m(p)``) or still before ``p`` (at most ``s(p - 1)``:
+    the rule held when it did its operation ``p - 1``, and the count only falls)."""
     model, why, _ = _derive(spec, relations)
     if model is None:
-        return spec if why else with_fixed_order(spec, _exact_classes(spec, relations))
-    chains = []
-    for cls in interchangeable_blocks(spec, relations):
+        if why:
+            return spec, []
+        base, classes = spec, [[[o] for o in cls] for cls in _exact_classes(spec, relations)]
+    else:
+        base = with_derived_precedences(spec, relations)
+        classes = interchangeable_blocks(spec, relations)
+    chains, loose = [], []
+    for cls in classes:
+        slack = 0
         for position in range(len(cls[0])):
-            chains.append([block[position] for block in cls])
-    return with_fixed_order(with_derived_precedences(spec, relations), chains)
+            chain = [block[position] for block in cls]
+            if concurrent:  # lower blocks behind it at the position before, or running
+                slack = min(slack + class_slack(spec, chain), len(chain) - 1)
+            if slack:
+                loose.append((slack, chain))
+            else:
+                chains.append(chain)
+    return with_fixed_order(base, chains), loose
 
 
-def symmetry_reduction(spec: AssemblySpec, relations) -> tuple[AssemblySpec, list[list[list[str]]]]:
-    """:func:`reduce_interchangeable`, and the classes whose blocks are not chains.
+def class_slack(spec: AssemblySpec, ids: list[str]) -> int:
+    """How many of the interchangeable operations ``ids`` may run besides one starting: one
+    less than the workers who may do them (an agent of side ``any`` is a robot and a person
+    in the concurrent game), at most ``len(ids) - 1``."""
+    sides = {a.name: a.side for a in spec.agents}
+    agents = {a for o in ids for a, _ in spec.operation(o).durations}
+    workers = sum(2 if sides.get(a) == "any" else 1 for a in agents)
+    return max(0, min(workers, len(ids)) - 1)
 
-    Such a class (a shaft with its two bearings and a collar, three times around a drive)
-    cannot be put in a fixed order by precedences; its first operations are chained when a
-    block has one operation every other of it needs, and the state graph moves only the
-    first of equal blocks (:meth:`asp.feasibility.OperationModel.enabled`, pass the classes
-    as ``operation_model(..., symmetric=...)``).
+
+def symmetry_reduction(
+    spec: AssemblySpec, relations, *, concurrent: bool = False
+) -> tuple[AssemblySpec, list[list[list[str]]], list[tuple[int, list[str]]]]:
+    """The reduction of interchangeable parts for a state graph.
+
+    Returns the reduced spec, the classes whose blocks are not chains and, with
+    ``concurrent``, the chains kept in a loose order with their slack.
+
+    Classes of blocks that are chains are put in a fixed order position by position
+    (:func:`reduce_interchangeable`): the alternating game keeps its values. With
+    ``concurrent`` (a graph for the concurrent game too) they keep a *loose* order
+    instead (``(m, ids)``, :meth:`asp.feasibility.OperationModel._loose_order`, the slack
+    of :func:`_reduced`), so that two of them may still run at once: a fixed order would
+    forbid it and change the concurrent game's W* (and the CP-SAT schedule's makespan).
+    It holds more states (the 26-part shear mold stand-in: 459,182 instead of 15,019).
+    A class whose blocks are not chains (a shaft with its two bearings and a collar,
+    three times around a drive) cannot be put in a fixed order by precedences; its first
+    operations are chained when a block has one operation every other of it needs, and the
+    state graph moves only the first of equal blocks
+    (:meth:`asp.feasibility.OperationModel.enabled`, pass the classes as
+    ``operation_model(..., symmetric=...)``): the alternating game's values only.
     """
     model, why, _ = _derive(spec, relations)
-    reduced = reduce_interchangeable(spec, relations)
+    reduced, loose = _reduced(spec, relations, concurrent=concurrent)
     if model is None:
-        return reduced, []
+        return reduced, [], loose
     index = {op.id: i for i, op in enumerate(spec.operations)}
     chains, others = [], []
     for cls in interchangeable_blocks(spec, relations, chains_only=False):
         block = sum(1 << index[o] for o in cls[0])
         if all(bin(model.must[index[o]] & block).count("1") == k for k, o in enumerate(cls[0])):
-            continue  # a chain: reduce_interchangeable ordered it
+            continue  # a chain: _reduced ordered it
         others.append(cls)
         root = index[cls[0][0]]
         if all(model.must[index[o]] >> root & 1 for o in cls[0][1:]):
             chains.append([b[0] for b in cls])
-    return with_fixed_order(reduced, chains), others
+    return with_fixed_order(reduced, chains), others, loose
 
 
-def reduced_state_graph(spec: AssemblySpec, relations, **kwargs):
-    """The state graph of :func:`symmetry_reduction` (same TCT and W* as the full graph),
-    without the states that are stuck (dead ends, see ``build_state_graph(drop_stuck=...)``).
+def reduced_state_graph(spec: AssemblySpec, relations, *, concurrent: bool = False, **kwargs):
+    """The state graph of :func:`symmetry_reduction` (the full graph's TCT and W*; with
+    ``concurrent``, also its concurrent game's W*(k) and makespans), without the states
+    that are stuck (dead ends, see ``build_state_graph(drop_stuck=...)``).
 
     Keyword arguments go to :func:`asp.state_graph.build_state_graph`; returns None when
     there is nothing to reduce (build the full graph).
@@ -679,10 +791,10 @@ def reduced_state_graph(spec: AssemblySpec, relations, **kwargs):
     from asp.feasibility import operation_model
     from asp.state_graph import build_state_graph
 
-    reduced, others = symmetry_reduction(spec, relations)
-    if reduced is spec and not others:
+    reduced, others, loose = symmetry_reduction(spec, relations, concurrent=concurrent)
+    if reduced is spec and not others and not loose:
         return None
-    model = operation_model(reduced, relations, symmetric=others)
+    model = operation_model(reduced, relations, symmetric=others, loose=loose)
     return build_state_graph(reduced, relations, model=model, drop_stuck=True, **kwargs)
 
 

@@ -82,7 +82,8 @@ def build_with_units(
     relations=None,
     *,
     hierarchy: bool = False,
-    prepare: Callable[[AssemblySpec], AssemblySpec] | None = None,
+    reduce: bool = False,
+    concurrent: bool = False,
     on_unit: Callable[[str], None] | None = None,
     given_up: Iterable[str] | None = None,
     **kwargs,
@@ -110,9 +111,12 @@ def build_with_units(
     relations : cad Relations, optional
     hierarchy : bool
         Use the CAD file's sub-assemblies (:func:`with_cad_units`).
-    prepare : callable, optional
-        Applied to the spec with the file's units before building (e.g. the reduction of
-        interchangeable parts, :func:`asp.symmetry.reduce_interchangeable`).
+    reduce : bool
+        Build each graph with the symmetry reduction
+        (:func:`asp.symmetry.reduced_state_graph`: interchangeable parts in the main
+        assembly and in each unit's workspace in a fixed order; the full graph when there
+        is nothing to reduce), for the spec with every unit of that round; with
+        ``concurrent``, the reduction that keeps the concurrent game's values too.
     on_unit : callable, optional
         Called with a line for each unit decision (a person reads it on stderr).
     given_up : iterable of str, optional
@@ -129,6 +133,16 @@ def build_with_units(
     from asp.state_graph import build_state_graph
 
     say = on_unit or (lambda _line: None)
+
+    def build(with_units: AssemblySpec):
+        if reduce:
+            from asp.symmetry import reduced_state_graph
+
+            graph = reduced_state_graph(with_units, relations, concurrent=concurrent, **kwargs)
+            if graph is not None:
+                return graph
+        return build_state_graph(with_units, relations, **kwargs)
+
     first_error = None
     if given_up is None:
         given_up = refuted_units(spec, relations, on_unit=say) if hierarchy else set()
@@ -138,15 +152,13 @@ def build_with_units(
         optional = {u.id: set(u.members) for u in choices if u.used}
         for u in choices:
             say(hierarchy_line(u))
-        if prepare is not None:
-            base = prepare(base)
         found: list[tuple[str, ...]] = []
         current = base
         plain = None  # the units without the parts hung on them, if those fail
         for _ in range(MAX_ROUNDS + 1):
             current = prepared_units(current, relations, say)
             try:
-                return build_state_graph(current, relations, **kwargs)
+                return build(current)
             except ValueError as exc:
                 if relations is None or "infeasible assembly" not in str(exc):
                     raise

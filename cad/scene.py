@@ -176,11 +176,11 @@ class SceneParts:
     rescale: float = 1.0
 
     def find(self, node: str) -> int | None:
-        """Index of the part whose id or node name is ``node`` (None if there is none)."""
+        """Index of the part whose id, name or scene-graph node is ``node`` (None if none)."""
         for k, (pid, name) in enumerate(zip(self.ids, self.names, strict=True)):
             if node in (pid, name):
                 return k
-        return None
+        return self.nodes.index(node) if node in self.nodes else None
 
 
 def load_scene_file(path: Path) -> trimesh.Scene:

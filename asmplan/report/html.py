@@ -38,19 +38,39 @@ def _img(uri: str, alt: str, width: int | None = None) -> str:
 
 # --------------------------------------------------------------------------- pictures
 
+PICTURE_FACES = 8_000
+"""Faces drawn in one step picture, in all (the part meshes are thinned to it)."""
 
-def assembly_steps(plan: dict, *, max_pictures: int = 40) -> list[tuple[dict, str]]:
+PART_FACES_MIN = 60
+"""Faces a part keeps in a step picture however many parts share the budget."""
+
+
+def assembly_steps(
+    plan: dict, *, max_pictures: int = 40, max_faces: int = PICTURE_FACES
+) -> list[tuple[dict, str]]:
     """The principal line's steps that place parts, each with a picture (data URI).
 
     The assembly is drawn from the part meshes: parts placed before the step in blue, the
-    step's parts in orange, the parts still to come as faint grey outlines.
+    step's parts in orange, the parts still to come as faint grey outlines. The meshes are
+    thinned to ``max_faces`` faces in all (shared out among the parts, at least
+    :data:`PART_FACES_MIN` each), which keeps a picture of a 70-part product quick to draw.
     """
-    meshes = part_meshes(plan)
+    n_parts = max(1, len(plan.get("parts", [])))
+    meshes = part_meshes(plan, max_faces=max(PART_FACES_MIN, max_faces // n_parts))
     if not meshes:
         return []
+    from matplotlib.colors import to_rgba
     from matplotlib.figure import Figure
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
+    ids = list(meshes)
+    triangles = np.concatenate([v[f] for v, f in meshes.values()])  # (T, 3, 3)
+    owner = np.repeat(np.arange(len(ids)), [len(f) for _, f in meshes.values()])  # (T,)
+    colours = {
+        "new": to_rgba(NEW, 1.0),
+        "placed": to_rgba(PLACED, 1.0),
+        "ghost": to_rgba(GHOST, 0.06),
+    }
     everything = np.concatenate([v for v, _ in meshes.values()])
     lo, hi = everything.min(axis=0), everything.max(axis=0)
     placed = set(base_parts(plan))
@@ -59,17 +79,13 @@ def assembly_steps(plan: dict, *, max_pictures: int = 40) -> list[tuple[dict, st
         if not step.get("parts") or len(out) >= max_pictures:
             continue
         new = set(step["parts"])
+        kind = ["new" if p in new else "placed" if p in placed else "ghost" for p in ids]
+        part_colour = np.array([colours[k] for k in kind])  # (parts, 4)
         fig = Figure(figsize=(3.2, 3.0))
         ax = fig.add_subplot(projection="3d")
-        for pid, (v, f) in meshes.items():
-            if pid in new:
-                colour, alpha = NEW, 1.0
-            elif pid in placed:
-                colour, alpha = PLACED, 1.0
-            else:
-                colour, alpha = GHOST, 0.06
-            poly = Poly3DCollection(v[f], facecolor=colour, edgecolor="none", alpha=alpha)
-            ax.add_collection3d(poly)
+        # one collection for every part: the faces are depth-sorted together
+        poly = Poly3DCollection(triangles, facecolors=part_colour[owner], edgecolor="none")
+        ax.add_collection3d(poly)
         ax.set_xlim(lo[0], hi[0])
         ax.set_ylim(lo[1], hi[1])
         ax.set_zlim(lo[2], hi[2])
@@ -87,13 +103,16 @@ def assembly_steps(plan: dict, *, max_pictures: int = 40) -> list[tuple[dict, st
 # --------------------------------------------------------------------------- figures
 
 
-def report_figures(doc: dict, concurrent_plan=None, *, spec=None, graph=None) -> dict[str, bytes]:
+def report_figures(
+    doc: dict, concurrent_plan=None, *, spec=None, graph=None, schedule=None
+) -> dict[str, bytes]:
     """The curve and Gantt PNGs of the report (:mod:`asmplan.report.gantt`), by name.
 
     ``concurrent_plan`` (:class:`asp.concurrent_plan.ConcurrentPlan`) gives the curve and
     the two timelines; without it they are computed here from ``spec`` and ``graph`` when
     the state graph has at most :data:`REPORT_MAX_STATES` states (else ``"why"`` says why
-    they are missing). The CP-SAT schedule's Gantt chart comes from ``doc["schedule"]``.
+    they are missing; ``schedule``, the plan's CP-SAT schedule and its lower bound, spares
+    solving it again). The CP-SAT schedule's Gantt chart comes from ``doc["schedule"]``.
     """
     import tempfile
 
@@ -108,7 +127,9 @@ def report_figures(doc: dict, concurrent_plan=None, *, spec=None, graph=None) ->
                 try:
                     from asp.concurrent_plan import plan_concurrent
 
-                    concurrent_plan = plan_concurrent(spec, graph, max_nodes=200_000)
+                    concurrent_plan = plan_concurrent(
+                        spec, graph, max_nodes=200_000, schedule=schedule
+                    )
                 except (ValueError, MemoryError) as exc:
                     out["why"] = str(exc).splitlines()[0].encode()
             else:

@@ -15,13 +15,15 @@ __all__ = ["base_parts", "plan_meshes"]
 def plan_meshes(plan: dict, *, max_faces: int = 20_000) -> dict[str, dict]:
     """Part id -> ``{"x", "y", "z", "i", "j", "k", "name"}`` for every part with a mesh.
 
-    Vertices are rounded to 0.01 of the file's unit to keep the JSON small.
+    Vertices are in mm in the build frame, rounded to 0.01 mm to keep the JSON small; a
+    part of more than ``max_faces`` faces is thinned to that many
+    (:func:`asmplan.report.meshes.clustered`).
     """
     names = {p["id"]: p.get("name", "") for p in plan.get("parts", [])}
     out: dict[str, dict] = {}
-    for pid, (vertices, faces) in part_meshes(plan).items():
+    for pid, (vertices, faces) in part_meshes(plan, max_faces=max_faces).items():
         v = np.round(vertices, 2)
-        f = faces[:max_faces]
+        f = faces
         out[pid] = {
             "name": names.get(pid, ""),
             "x": v[:, 0].tolist(),

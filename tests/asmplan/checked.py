@@ -33,8 +33,10 @@ def plan_and_check(
     workspaces along the gravity ``plan.json``'s ``workspaces`` give, ``held`` as the plan's
     operations say: what the plan claims an agent holds), and the mesh replay
     (:mod:`tests.asmplan.mesh_replay`: ``plan.json`` and the meshes alone) accepts both of
-    its lines. Returns ``plan.json`` as a dict; the command's stderr (its notes) is
-    appended to ``stderr`` when given, its stdout (the summary) to ``stdout``.
+    its lines, and ``report.html`` has a picture of each step that places parts (the
+    meshes found again from ``parts[].source``). Returns ``plan.json`` as a dict; the
+    command's stderr (its notes) is appended to ``stderr`` when given, its stdout (the
+    summary) to ``stdout``.
     """
     result = CliRunner().invoke(app, ["plan", str(source), "-o", str(out), *options])
     assert result.exit_code == 0, result.output
@@ -60,4 +62,7 @@ def plan_and_check(
     down = {w["id"]: w["gravity"] for w in doc["workspaces"] if w["id"] != "main"}
     check_line(spec, assembly.relations, ops, units=doc["subassemblies"], gravity=down)
     replayed(doc)
+    if doc.get("geometry"):  # report.html pictures each step that places parts, from the meshes
+        placing = [s for s in doc["robust_plan"] if s.get("parts")]
+        assert (out / "report.html").read_text().count("<figure>") == min(40, len(placing))
     return doc
