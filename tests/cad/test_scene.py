@@ -12,7 +12,14 @@ import trimesh
 from cad import load_assembly, load_parts
 from cad.bom import PartRecord
 from cad.identical import shape_classes
-from cad.scene import clean_name, is_generic, read_scene, unique_ids
+from cad.scene import (
+    STEP_CHORD_MM,
+    clean_name,
+    is_generic,
+    load_scene_file,
+    read_scene,
+    unique_ids,
+)
 from tests.cad import shapes
 
 DATA = Path(__file__).parent / "data"
@@ -70,6 +77,20 @@ def test_step_in_inches_with_a_product_tree():
     assert shape_classes(assembly.parts) == (
         "base_plate", "cap", "pillar", "cap", "pillar", "top_plate",
     )  # fmt: skip
+
+
+def test_step_tessellation_tolerance_reaches_cascadio(monkeypatch):
+    cascadio = pytest.importorskip("cascadio")
+    seen = []
+    convert = cascadio.step_to_glb
+
+    def spy(*args, **kwargs):
+        seen.append(kwargs.get("tol_linear"))
+        return convert(*args, **kwargs)
+
+    monkeypatch.setattr(cascadio, "step_to_glb", spy)
+    scene = load_scene_file(DATA / "table_frame_in.step")
+    assert seen == [STEP_CHORD_MM] and len(scene.geometry) == 6
 
 
 def test_a_spec_may_name_one_part_of_a_scene():
