@@ -793,7 +793,7 @@ def _document(spec, policy: dict, sizes: tuple, values: tuple, extra, relations)
         "gravity": spec.gravity,
         "base_part": spec.base_part,
         "geometry": geometry_record(spec, relations),
-        "sources": list(dict.fromkeys(_split_file(p.file)[0] for p in spec.parts if p.file)),
+        "sources": list(dict.fromkeys(split_file(p.file)[0] for p in spec.parts if p.file)),
         "parts": [
             {
                 "id": p.id,
@@ -976,7 +976,7 @@ def geometry_record(spec, relations) -> dict | None:
     }
 
 
-def _split_file(file: str) -> tuple[str, str | None]:
+def split_file(file: str) -> tuple[str, str | None]:
     """``"model.step#nut_2"`` -> ``("model.step", "nut_2")``; a plain file has no node."""
     name, sep, node = file.partition("#")
     return name, (node if sep else None)
@@ -996,7 +996,7 @@ def part_source(spec, file: str | None) -> dict | None:
     trimesh reads the file, :func:`file_scale`)."""
     if not file:
         return None
-    name, node = _split_file(file)
+    name, node = split_file(file)
     folder = source_folder(spec.source)
     path = (folder / name).resolve()
     if node is not None and path.is_file():
@@ -1015,7 +1015,7 @@ def file_scale(spec, file: str) -> float | None:
     file cannot be read."""
     from cad.scene import coordinate_scale
 
-    path = (source_folder(spec.source) / _split_file(file)[0]).resolve()
+    path = (source_folder(spec.source) / split_file(file)[0]).resolve()
     if not path.is_file():
         return None
     try:

@@ -23,9 +23,10 @@ REPORT_MAX_STATES = 5_000
 """Largest state graph whose concurrent game the report solves itself."""
 
 
-def _png(fig) -> str:
-    """A matplotlib Figure as a ``data:image/png;base64,...`` URI."""
-    fig.tight_layout()
+def _png(fig, *, tight: bool = True) -> str:
+    """A matplotlib Figure as a ``data:image/png;base64,...`` URI (laid out tight first)."""
+    if tight:
+        fig.tight_layout()
     buffer = io.BytesIO()
     fig.savefig(buffer, format="png", dpi=90)
     return "data:image/png;base64," + base64.b64encode(buffer.getvalue()).decode("ascii")
@@ -73,6 +74,19 @@ def assembly_steps(
     }
     everything = np.concatenate([v for v, _ in meshes.values()])
     lo, hi = everything.min(axis=0), everything.max(axis=0)
+    # one figure drawn again for each step: only the colours and the title change
+    fig = Figure(figsize=(3.2, 3.0))
+    fig.subplots_adjust(left=0.0, right=1.0, bottom=0.0, top=0.9)
+    ax = fig.add_subplot(projection="3d")
+    # one collection for every part: the faces are depth-sorted together
+    poly = Poly3DCollection(triangles, edgecolor="none")
+    ax.add_collection3d(poly)
+    ax.set_xlim(lo[0], hi[0])
+    ax.set_ylim(lo[1], hi[1])
+    ax.set_zlim(lo[2], hi[2])
+    ax.set_box_aspect(hi - lo + 1e-9)
+    ax.view_init(elev=22, azim=-60)
+    ax.set_axis_off()
     placed = set(base_parts(plan))
     out = []
     for step in plan.get("robust_plan", []):
@@ -81,21 +95,11 @@ def assembly_steps(
         new = set(step["parts"])
         kind = ["new" if p in new else "placed" if p in placed else "ghost" for p in ids]
         part_colour = np.array([colours[k] for k in kind])  # (parts, 4)
-        fig = Figure(figsize=(3.2, 3.0))
-        ax = fig.add_subplot(projection="3d")
-        # one collection for every part: the faces are depth-sorted together
-        poly = Poly3DCollection(triangles, facecolors=part_colour[owner], edgecolor="none")
-        ax.add_collection3d(poly)
-        ax.set_xlim(lo[0], hi[0])
-        ax.set_ylim(lo[1], hi[1])
-        ax.set_zlim(lo[2], hi[2])
-        ax.set_box_aspect(hi - lo + 1e-9)
-        ax.view_init(elev=22, azim=-60)
-        ax.set_axis_off()
+        poly.set_facecolor(part_colour[owner])
         ax.set_title(
             f"{step['operation']} ({step['agent']}): {', '.join(step['parts'])}", fontsize=8
         )
-        out.append((step, _png(fig)))
+        out.append((step, _png(fig, tight=False)))
         placed |= new
     return out
 

@@ -16,6 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
+from asmplan.planfile import source_folder, split_file
+
 
 def part_meshes(
     plan: dict, *, max_faces: int | None = None
@@ -72,9 +74,8 @@ def _where(plan: dict, part: dict) -> tuple[Path, str | None, float | None] | No
     top = plan.get("source") or ""
     if not file or not top:
         return None
-    folder = Path(top) if Path(top).is_dir() else Path(top).parent
-    name, _, node = str(file).partition("#")
-    path = folder / name
+    name, node = split_file(str(file))
+    path = source_folder(top) / name
     return (path, node or None, None) if path.is_file() else None
 
 
