@@ -5,7 +5,8 @@ plan file (README, "The plan file": ``workspaces``, each step's ``insertions``,
 ``gravity``, ``geometry``, ``parts[].source``), loads the meshes it names with trimesh and
 tests each insertion with python-fcl. The rules (``geometry``):
 
-- **meshes**: each part's mesh from ``parts[].source``, times its ``scale`` (else
+- **meshes**: each part's mesh from ``parts[].source`` (a STEP tessellated to within
+  ``geometry.step_chord`` mm, as the planner read it), times its ``scale`` (else
   ``geometry.scale``: mm per coordinate as trimesh reads the file), turned into the build
   frame by ``geometry.build_rotation`` (``x_build = R @ x_file``; directions are its axes), its
   coincident vertices merged when ``merge_vertices`` (a STEP or 3DXML tessellation gives
@@ -72,6 +73,17 @@ def vector(direction: str) -> np.ndarray:
     return v
 
 
+def read_options(path: Path, geo: dict) -> dict:
+    """Keywords for ``trimesh.load`` of a scene file: a glTF mesh's primitives are one part,
+    named as its node (not randomly); a STEP is tessellated to within ``step_chord`` mm."""
+    suffix = path.suffix.lower()
+    if suffix in (".glb", ".gltf"):
+        return {"merge_primitives": True}
+    if suffix in (".step", ".stp") and geo.get("step_chord"):
+        return {"tol_linear": float(geo["step_chord"])}
+    return {}
+
+
 def load_meshes(plan: dict) -> dict[str, trimesh.Trimesh]:
     """Part id -> mesh in mm, from ``parts[].source`` and ``geometry`` only."""
     geo = plan["geometry"]
@@ -83,14 +95,10 @@ def load_meshes(plan: dict) -> dict[str, trimesh.Trimesh]:
         src = part["source"]
         path = Path(src["path"]) if src["path"] else folder / src["file"]
         if src["node"] is None:
-            mesh = trimesh.load(path, force="mesh")
+            mesh = trimesh.load(path, force="mesh", **read_options(path, geo))
         else:
             if path not in scenes:
-                # a glTF mesh's primitives are one part, named as its node (not randomly)
-                merge = (
-                    {"merge_primitives": True} if path.suffix.lower() in (".glb", ".gltf") else {}
-                )
-                scenes[path] = trimesh.load(path, force="scene", **merge)
+                scenes[path] = trimesh.load(path, force="scene", **read_options(path, geo))
             transform, geometry = scenes[path].graph[src["node"]]
             mesh = scenes[path].geometry[geometry].copy().apply_transform(transform)
         mesh = mesh.apply_scale(src.get("scale") or geo["scale"])
