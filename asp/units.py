@@ -37,6 +37,10 @@ from asp.spec import AssemblySpec, with_subassemblies
 
 MAX_ROUNDS = 8
 """Rounds of automatic detection (each adds the units of the root causes found)."""
+PROVED_ROUND_STATES = 500_000
+"""A round of automatic units whose failure the derived precedences prove builds its graph
+(for the stuck operations) up to this many states; beyond, the operation the proof names
+stands for them (a clutch's pressure plate held by its 13 pins: 15.7M states otherwise)."""
 MAX_WORKSPACE_PRODUCT = 64
 """Beyond this product of ``members + 1`` over the units, they are built one after another
 (:func:`built_in_turn`)."""
@@ -151,18 +155,39 @@ def build_with_units(
                 return graph
         return build_state_graph(with_units, relations, **kwargs)
 
-    def stuck_in(with_units: AssemblySpec):
-        """The round's view (spec and operation model) and its stuck operations: the
-        operation a proof names, else those of the graph built without the check."""
+    def next_units(with_units: AssemblySpec, base, found, optional, drop: set[str]):
+        """The round's new units (:func:`_new_units`; ``drop`` filled instead when a unit of
+        the file is stuck) and whether a whole state graph was built for them.
+
+        The stuck operations come from the graph built without the check. When the derived
+        precedences prove there is no complete sequence (:func:`asp.symmetry.refutation`),
+        that graph is built up to :data:`PROVED_ROUND_STATES` states only; beyond, the
+        operation the proof names is the stuck one, and the whole graph is built only if
+        that gives nothing new."""
         from asp.feasibility import operation_model
         from asp.symmetry import refutation
 
+        def units_of(graph, stuck: list[int]):
+            drop.update(_stuck_units(graph.spec, stuck, optional))
+            return None if drop else _new_units(graph, stuck, base, found, optional, drop)
+
+        unchecked = {**kwargs, "check": False}
         proof = refutation(with_units, relations) if reduce else None
         if proof is not None:
-            view = _Round(with_units, operation_model(with_units, relations))
-            return view, [with_units.op_index(proof.operation)], False
-        graph = build_state_graph(with_units, relations, **{**kwargs, "check": False})
-        return graph, stuck_operations(graph), True
+            cap = min(kwargs.get("max_states") or PROVED_ROUND_STATES, PROVED_ROUND_STATES)
+            try:
+                graph = build_state_graph(with_units, relations, **{**unchecked, "max_states": cap})
+            except SpecError as exc:
+                if "raise max_states" not in str(exc):
+                    raise
+                view = _Round(with_units, operation_model(with_units, relations))
+                groups = units_of(view, [with_units.op_index(proof.operation)])
+                if drop or groups is not None:
+                    return groups, False
+            else:
+                return units_of(graph, stuck_operations(graph)), False
+        graph = build_state_graph(with_units, relations, **unchecked)
+        return units_of(graph, stuck_operations(graph)), True
 
     first_error = None
     if given_up is None:
@@ -189,14 +214,10 @@ def build_with_units(
                     current, plain = plain, None
                     say("no complete sequence with the held parts in the units: without them")
                     continue
-            graph, stuck, built = stuck_in(current)
+            drop = set()
+            groups, built = next_units(current, base, found, optional, drop)
             graph_rounds += built
             proved_rounds += not built
-            drop = _stuck_units(graph.spec, stuck, optional)
-            if drop:
-                break
-            drop = set()
-            groups = _new_units(graph, stuck, base, found, optional, drop)
             if drop:
                 break
             if groups is None:

@@ -75,18 +75,28 @@ def test_automatic_subassemblies_plan_the_tower(tower):
     assert solution.tct == len(graph.spec.operations)
 
 
-def test_a_proof_finds_the_units_without_building_a_graph_that_has_no_plan(tower, monkeypatch):
+@pytest.mark.parametrize("cap", [1, 10, None])
+def test_a_proof_stands_for_a_graph_too_large_to_find_the_stuck_parts(tower, monkeypatch, cap):
     """With the reduction, the derived precedences prove that a holder can never go in alone
-    (it touches only its own bearings, which come after it): the round groups it with them
-    without building the graph of the spec that has no complete sequence."""
+    (it touches only its own bearings, which come after it). The round's graph is built up
+    to ``PROVED_ROUND_STATES`` states only (``None``: the default, the tower fits); beyond,
+    the holder the proof names is grouped with its bearings without any graph of a spec
+    that has no complete sequence. Every way finds the same units and plan."""
     import asp.state_graph
+    import asp.units
 
+    if cap is not None:
+        monkeypatch.setattr(asp.units, "PROVED_ROUND_STATES", cap)
     built = []
     real = asp.state_graph.build_state_graph
 
     def spy(spec, *args, **kwargs):
-        graph = real(spec, *args, **kwargs)
-        built.append((spec.subassemblies, kwargs.get("check", True)))
+        try:
+            graph = real(spec, *args, **kwargs)
+        except ValueError:
+            built.append((spec.subassemblies, kwargs.get("check", True), "raised"))
+            raise
+        built.append((spec.subassemblies, kwargs.get("check", True), graph.n_states))
         return graph
 
     monkeypatch.setattr(asp.state_graph, "build_state_graph", spy)
@@ -96,9 +106,13 @@ def test_a_proof_finds_the_units_without_building_a_graph_that_has_no_plan(tower
         ["bearing_1a", "bearing_1b", "holder_1"],
         ["bearing_2a", "bearing_2b", "holder_2"],
     ]
-    assert built and all(units and check for units, check in built)
+    unchecked = [n for units, check, n in built if not check]
+    if cap is None:
+        assert unchecked and all(n != "raised" for n in unchecked)
+    else:  # stopped at the cap: no whole graph without the check
+        assert unchecked and all(n == "raised" for n in unchecked)
     assert any("trying subassemblies" in line for line in lines)
-    plain = build_with_units(tower_spec(tower), tower)  # the graph-built rounds agree
+    plain = build_with_units(tower_spec(tower), tower)  # the rounds without a proof agree
     assert solve(game_dag(graph)).tct == solve(game_dag(plain)).tct
 
 
