@@ -345,6 +345,11 @@ class OperationModel:
         Classes of interchangeable operations, each with its slack ``m``: an operation of a
         class may be done only while at most ``m`` of the ones listed before it are not
         (:meth:`_loose_order`; ``m = 0`` is a fixed order).
+    fixed : tuple of classes of blocks of operation indices
+        Interchangeable blocks the spec puts in a fixed order: at every position ``i``, the
+        ``i``-th operations of the blocks are chained in block order by ``after``
+        (:func:`asp.symmetry.symmetry_reduction`). Only read by the schedule stage, which
+        undoes that order (:mod:`asp.fixed_order`).
     """
 
     spec: AssemblySpec
@@ -369,6 +374,7 @@ class OperationModel:
     unit_masks: np.ndarray | None = None
     symmetric: tuple[tuple[tuple[int, ...], ...], ...] = ()
     loose: tuple[tuple[int, tuple[int, ...]], ...] = ()
+    fixed: tuple[tuple[tuple[int, ...], ...], ...] = ()
 
     @property
     def n_ops(self) -> int:
@@ -685,7 +691,7 @@ def _split(value: int, n_words: int) -> list[int]:
 
 
 def operation_model(
-    spec: AssemblySpec, relations=None, *, _min_words: int = 1, symmetric=(), loose=()
+    spec: AssemblySpec, relations=None, *, _min_words: int = 1, symmetric=(), loose=(), fixed=()
 ) -> OperationModel:
     """Compile ``spec`` (and the cad relations, if any) into an :class:`OperationModel`.
 
@@ -694,7 +700,8 @@ def operation_model(
     interchangeable blocks of operation ids (:func:`asp.symmetry.interchangeable_blocks`),
     of which only the first of equal blocks moves (:meth:`OperationModel.enabled`);
     ``loose``: classes of interchangeable operation ids with their slack, ``(m, ids)``
-    (:attr:`OperationModel.loose`).
+    (:attr:`OperationModel.loose`); ``fixed``: classes of blocks of operation ids the spec
+    puts in a fixed order (:attr:`OperationModel.fixed`).
 
     Raises
     ------
@@ -779,6 +786,7 @@ def operation_model(
             tuple(tuple(index[o] for o in block) for block in cls) for cls in symmetric
         ),
         loose=tuple((int(m), tuple(index[o] for o in ids)) for m, ids in loose),
+        fixed=tuple(tuple(tuple(index[o] for o in block) for block in cls) for cls in fixed),
     )
 
 
