@@ -760,7 +760,8 @@ def symmetry_reduction(
     ``concurrent`` (a graph for the concurrent game too) they keep a *loose* order
     instead (``(m, ids)``, :meth:`asp.feasibility.OperationModel._loose_order`, the slack
     of :func:`_reduced`), so that two of them may still run at once: a fixed order would
-    forbid it and change the concurrent game's W* (and the CP-SAT schedule's makespan).
+    forbid it and change the concurrent game's W* (the CP-SAT schedule undoes a fixed
+    order instead, :mod:`asp.fixed_order`).
     It holds more states (the 26-part shear mold stand-in: 459,182 instead of 15,019).
     A class whose blocks are not chains (a shaft with its two bearings and a collar,
     three times around a drive) cannot be put in a fixed order by precedences; its first
