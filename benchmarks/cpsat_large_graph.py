@@ -6,8 +6,9 @@ lazy cuts from the replay). Each case runs with the default of ``asmplan plan`` 
 the whole stage within :data:`asp.concurrent.AUTO_TIME_LIMIT` seconds, stopping once neither a
 better schedule nor a new cut has come for :data:`asp.concurrent.AUTO_PATIENCE` seconds) and
 with each ``--limits`` value (a CP-SAT time limit in seconds, as ``--time-limit`` gives).
-Printed per run: the stage's wall time, status, makespan, proven lower bound, cuts and
-solves, and who found the schedule; every schedule printed has passed the replay (checked
+Printed per run: the stage's wall time and the part of it spent before CP-SAT (the
+precedences, the replay tables, the list schedules), status, makespan, proven lower bound,
+cuts and solves, and who found the schedule; every schedule printed has passed the replay (checked
 again here).
 
 Cases (those whose files are missing are skipped):
@@ -100,7 +101,8 @@ def main() -> int:
     args = parser.parse_args()
     orders = {"undo": [True], "keep": [False], "both": [True, False]}[args.fixed_order]
     print(
-        f"{'case':16s} {'order':>5s} {'limit':>6s} {'wall s':>7s} {'status':>8s} {'makespan':>9s} "
+        f"{'case':16s} {'order':>5s} {'limit':>6s} {'wall s':>7s} {'prep s':>6s} "
+        f"{'status':>8s} {'makespan':>9s} "
         f"{'bound':>6s} {'cuts':>5s} {'solves':>6s}  found by"
     )
     for case in args.cases:
@@ -147,6 +149,7 @@ def main() -> int:
             print(
                 f"{case[-16:]:16s} {'undo' if undo else 'keep':>5s} "
                 f"{'auto' if limit is None else f'{limit:g}':>6s} {out['wall']:7.1f} "
+                f"{r.detail.get('stage_s', r.wall_s) - r.wall_s:6.1f} "
                 f"{r.status:>8s} {r.objective or 0:9g} {r.bound or 0:6g} "
                 f"{r.detail.get('cuts', 0):5d} {r.detail.get('solves', 0):6d}  "
                 f"{r.detail.get('found_by', '-')}",
