@@ -609,6 +609,17 @@ class OperationModel:
                 twin = (codes[:, :j] == codes[:, j : j + 1]).any(axis=1)
                 ok[:, list(blocks[j])] &= ~twin[:, None]
 
+    def parts_of(self, keys: np.ndarray) -> np.ndarray:
+        """(k, PW) uint64: the parts placed in each state, every workspace (the base part
+        when on the fixture from the start, and the parts of every done operation)."""
+        keys = self._keys(keys)
+        parts = np.empty((keys.shape[0], self.oracle.n_words), dtype=np.uint64)
+        parts[:] = pack_words([self.initial_parts], self.oracle.n_words)
+        for i in range(self.n_ops):
+            if self.op_parts[i].any():
+                parts[self.has_op(keys, i)] |= self.op_parts[i]
+        return parts
+
     def pending_units(self, keys: np.ndarray) -> np.ndarray | None:
         """(k, PW) uint64: members of the subassemblies not yet inserted, per state."""
         if not self.unit_ops:
