@@ -510,21 +510,33 @@ class OperationModel:
         self._symmetries(keys, ok)
         return ok
 
-    def stuck(self, keys: np.ndarray, parts: np.ndarray) -> np.ndarray:
+    def stuck(self, keys: np.ndarray, parts: np.ndarray, parents=None) -> np.ndarray:
         """(k,) bool: some operation not done places a part (or unit) that the parts already
         in the set it is tested against block along every allowed direction, so it can never
         be done (a dead end). Always False for specs off the compiled path (an operation
-        placing several parts)."""
+        placing several parts).
+
+        ``parents`` (optional): the keys and parts of a state each of ``keys`` is reached
+        from by one operation, none of them stuck; then only the operations whose part the
+        parts new to its set could block are tested (:func:`asp.enabled_kernel.stuck`,
+        the same result).
+        """
         keys = self._keys(keys)
         if self._kernel_args is None:
             return np.zeros(keys.shape[0], dtype=bool)
         from asp.enabled_kernel import stuck
 
         a = self._kernel_args
+        keys = np.ascontiguousarray(keys)
         sets = np.ascontiguousarray(self.oracle.sets(parts))
-        return stuck(
-            np.ascontiguousarray(keys), sets, a[0], a[1], a[5], a[9], a[11], a[16], a[17], a[18]
-        )
+        before = (keys, sets)  # not read without parents
+        if parents is not None:
+            before = (
+                np.ascontiguousarray(self._keys(parents[0])),
+                np.ascontiguousarray(self.oracle.sets(parents[1])),
+            )
+        tables = (a[0], a[1], a[5], a[9], a[11], a[16], a[17], a[18])
+        return stuck(keys, sets, *before, parents is not None, *tables)
 
     @functools.cached_property
     def _kernel_args(self) -> tuple | None:

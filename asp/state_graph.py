@@ -256,7 +256,7 @@ def build_state_graph(
             si, oi = np.nonzero(model.enabled(keys[lo:hi], parts[lo:hi]))
             if si.size:
                 si = si.astype(index_type) + index_type(lo)
-                found.add(model, keys, parts, si, oi, drop_stuck)
+                found.add(model, keys, parts, si, oi, drop_stuck, layer > 0)
             at_least = total + found.at_least(layer + 1, max_states - total)
             if at_least > max_states:
                 raise _too_many(
@@ -475,15 +475,19 @@ class _Layer:
         self.n_merged = 0  # chunks merged into it
         self.unmerged = 0  # chunk-distinct keys added since
 
-    def add(self, model, keys, parts, si, oi, drop_stuck: bool) -> None:
-        """The moves ``si`` (states of the layer) x ``oi`` (operations) of one chunk."""
+    def add(self, model, keys, parts, si, oi, drop_stuck: bool, checked: bool = False) -> None:
+        """The moves ``si`` (states of the layer) x ``oi`` (operations) of one chunk.
+
+        ``checked``: no state of the layer is stuck (each passed the test when it was
+        found), so a successor is tested only for what its new part changes."""
         oi = oi.astype(op_type(model.n_ops))
         succ = model.successor_keys(keys[si], oi)
         firsts, inv = _distinct_rows(succ)
         succ = succ[firsts]
         succ_parts = parts[si[firsts]] | model.op_parts[oi[firsts]]
         if drop_stuck:
-            keep = ~model.stuck(succ, succ_parts)
+            parents = (keys[si[firsts]], parts[si[firsts]]) if checked else None
+            keep = ~model.stuck(succ, succ_parts, parents)
             if not keep.all():
                 live = keep[inv]
                 si, oi, inv = si[live], oi[live], (np.cumsum(keep) - 1)[inv[live]]
