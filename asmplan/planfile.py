@@ -941,7 +941,9 @@ def geometry_record(spec, relations) -> dict | None:
     pair ``(i, j)`` tolerates an overlap of ``part_shrink[i] + part_shrink[j]``
     (:mod:`cad.tolerances`), and counts a gap of ``min(contact_reach[i],
     contact_reach[j])`` as touching (``contact_tol`` for every pair when ``contact_reach``
-    is null). ``merge_vertices``: each mesh's coincident
+    is null). ``step_chord``: a STEP source is tessellated to within this many mm of its
+    surfaces (:data:`cad.scene.STEP_CHORD_MM`, OCCT's ``tol_linear``), so a checker reads
+    the same meshes. ``merge_vertices``: each mesh's coincident
     vertices are merged before anything (a STEP or 3DXML tessellation gives every face its
     own vertices; eroding such a mesh leaves its edges where they were). ``erosion``: how a
     part is shrunk. ``fits``: pairs whose inner part is shrunk further for that pair only
@@ -959,6 +961,7 @@ def geometry_record(spec, relations) -> dict | None:
     if relations is None:
         return None
     from cad.relations import replay_rules
+    from cad.scene import STEP_CHORD_MM
     from cad.units import unit_scale
 
     file_unit = str(getattr(relations, "units", "mm"))
@@ -977,6 +980,7 @@ def geometry_record(spec, relations) -> dict | None:
         "unit": "mm",
         "file_unit": file_unit,
         "scale": scale,
+        "step_chord": STEP_CHORD_MM,
         "frame": "file" if spec.frame is None else "build",
         "build_rotation": [list(row) for row in build_rotation(spec)],
         "contact_tol": float(relations.contact_tol),

@@ -32,6 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from asp.errors import SpecError
 from asp.spec import AssemblySpec, with_subassemblies
 
 MAX_ROUNDS = 8
@@ -101,7 +102,11 @@ def build_with_units(
     held by one host enter with it), overlapping groups merge (with the units of earlier
     rounds too), and the graph is built again (at most :data:`MAX_ROUNDS` rounds); if no
     new unit can be found, the file's remaining sub-assemblies are given up before the
-    first error is raised. Every unit is checked by the state graph itself: its members
+    first error is raised. With ``reduce``, a round whose derived precedences already prove
+    that no complete sequence exists (:func:`asp.symmetry.refutation`, milliseconds)
+    builds no graph: the operation the proof names is the stuck one (a clutch's pressure
+    plate blocked by its 13 pins: 15.7M states built twice before, none now).
+    Every unit is checked by the state graph itself: its members
     must go into its own workspace one by one and the finished unit into the assembly as
     one rigid body, so units only ever give sound plans.
 
@@ -136,12 +141,28 @@ def build_with_units(
 
     def build(with_units: AssemblySpec):
         if reduce:
-            from asp.symmetry import reduced_state_graph
+            from asp.symmetry import reduced_state_graph, refutation
 
+            proof = refutation(with_units, relations)
+            if proof is not None:  # no complete sequence: known without a graph
+                raise _Proved(with_units, proof.why)
             graph = reduced_state_graph(with_units, relations, concurrent=concurrent, **kwargs)
             if graph is not None:
                 return graph
         return build_state_graph(with_units, relations, **kwargs)
+
+    def stuck_in(with_units: AssemblySpec):
+        """The round's view (spec and operation model) and its stuck operations: the
+        operation a proof names, else those of the graph built without the check."""
+        from asp.feasibility import operation_model
+        from asp.symmetry import refutation
+
+        proof = refutation(with_units, relations) if reduce else None
+        if proof is not None:
+            view = _Round(with_units, operation_model(with_units, relations))
+            return view, [with_units.op_index(proof.operation)], False
+        graph = build_state_graph(with_units, relations, **{**kwargs, "check": False})
+        return graph, stuck_operations(graph), True
 
     first_error = None
     if given_up is None:
@@ -155,7 +176,8 @@ def build_with_units(
         found: list[tuple[str, ...]] = []
         current = base
         plain = None  # the units without the parts hung on them, if those fail
-        for _ in range(MAX_ROUNDS + 1):
+        graph_rounds = proved_rounds = 0
+        while graph_rounds <= MAX_ROUNDS and proved_rounds <= len(spec.operations):
             current = prepared_units(current, relations, say)
             try:
                 return build(current)
@@ -167,8 +189,9 @@ def build_with_units(
                     current, plain = plain, None
                     say("no complete sequence with the held parts in the units: without them")
                     continue
-            graph = build_state_graph(current, relations, **{**kwargs, "check": False})
-            stuck = stuck_operations(graph)
+            graph, stuck, built = stuck_in(current)
+            graph_rounds += built
+            proved_rounds += not built
             drop = _stuck_units(graph.spec, stuck, optional)
             if drop:
                 break
@@ -204,6 +227,8 @@ def build_with_units(
         else:
             drop = set(optional)
         if not drop:
+            if isinstance(first_error, _Proved):  # the graph's report names more
+                first_error = _graph_report(first_error, relations, kwargs)
             raise first_error from None
         given_up |= drop
         say(
@@ -380,6 +405,35 @@ def _stuck_units(spec: AssemblySpec, stuck: list[int], optional: dict[str, set[s
             if op.unit == uid or set(op.parts) & members:
                 out.add(uid)
     return out
+
+
+class _Proved(SpecError):
+    """No complete sequence, proved by the derived precedences without a state graph."""
+
+    def __init__(self, spec: AssemblySpec, why: str):
+        super().__init__(f"{spec.source}: infeasible assembly, no complete sequence: {why}")
+        self.spec = spec
+
+
+def _graph_report(proof: _Proved, relations, kwargs: dict) -> SpecError:
+    """The state graph's own report of a proved failure (it names the blockers along each
+    direction and a state where the part was tried), or the proof if the graph has none."""
+    from asp.state_graph import build_state_graph
+
+    try:
+        build_state_graph(proof.spec, relations, **kwargs)
+    except SpecError as exc:
+        return exc
+    return proof
+
+
+@dataclass(frozen=True)
+class _Round:
+    """What a round of :func:`build_with_units` reads of its state graph (the spec and the
+    operation model), when a proof took the place of the graph."""
+
+    spec: AssemblySpec
+    model: object
 
 
 def stuck_operations(graph) -> list[int]:

@@ -14,6 +14,7 @@ from cad.errors import GeometryError
 from cad.fits import find_fits
 from cad.freedom import eroded_meshes
 from cad.freedom import translational_freedom as _freedom
+from cad.offset import FREE_EDGE_PULL
 from cad.support import SUPPORT_RULES, SUPPORT_TRAVEL_FACTOR, support_relation
 from cad.tolerances import resolve_tolerances
 
@@ -174,7 +175,9 @@ def replay_rules(relations: Relations) -> dict:
     -------
     dict
         ``merge_vertices`` (true: coincident vertices of each mesh are merged first),
-        ``erosion`` (how a part is shrunk by its ``part_shrink``), ``contact_reach``
+        ``erosion`` (how a part is shrunk by its ``part_shrink``), ``free_edge_pull`` (an
+        open part's free edges also move back in their faces by this many shrinks,
+        :data:`cad.offset.FREE_EDGE_PULL`), ``contact_reach``
         (part -> mm, or None when ``contact_tol`` holds for every pair),
         ``support_travel_factor``, ``support`` (the rules a part is supported by,
         :data:`cad.support.SUPPORT_RULES`), ``fits`` (``inner, outer, extra_shrink`` mm: the inner
@@ -185,6 +188,7 @@ def replay_rules(relations: Relations) -> dict:
     return {
         "merge_vertices": True,
         "erosion": "face_planes",
+        "free_edge_pull": FREE_EDGE_PULL,
         "contact_reach": dict(zip(ids, map(float, reach), strict=True)) if reach else None,
         "support_travel_factor": SUPPORT_TRAVEL_FACTOR,
         "support": list(SUPPORT_RULES),

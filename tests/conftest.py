@@ -27,3 +27,18 @@ def deterministic_torch():
     yield
     torch.use_deterministic_algorithms(False)
     torch.set_num_threads(threads)
+
+
+@pytest.fixture
+def step_deflections(monkeypatch) -> list:
+    """The ``tol_linear`` (mm) of every STEP tessellation cascadio does from now on."""
+    cascadio = pytest.importorskip("cascadio")
+    seen = []
+    convert = cascadio.step_to_glb
+
+    def spy(*args, **kwargs):
+        seen.append(kwargs.get("tol_linear"))
+        return convert(*args, **kwargs)
+
+    monkeypatch.setattr(cascadio, "step_to_glb", spy)
+    return seen

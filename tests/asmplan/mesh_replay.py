@@ -5,7 +5,8 @@ plan file (README, "The plan file": ``workspaces``, each step's ``insertions``,
 ``gravity``, ``geometry``, ``parts[].source``), loads the meshes it names with trimesh and
 tests each insertion with python-fcl. The rules (``geometry``):
 
-- **meshes**: each part's mesh from ``parts[].source``, times its ``scale`` (else
+- **meshes**: each part's mesh from ``parts[].source`` (a STEP tessellated to within
+  ``geometry.step_chord`` mm, as the planner read it), times its ``scale`` (else
   ``geometry.scale``: mm per coordinate as trimesh reads the file), turned into the build
   frame by ``geometry.build_rotation`` (``x_build = R @ x_file``; directions are its axes), its
   coincident vertices merged when ``merge_vertices`` (a STEP or 3DXML tessellation gives
@@ -14,8 +15,9 @@ tests each insertion with python-fcl. The rules (``geometry``):
   inwards turned outwards;
 - **erosion**: every part shrunk by its ``part_shrink``: each vertex moved inwards along
   its normal, never moving any face plane by more than the shrink (conservative: the
-  replay tolerates at most what the plan says); the inner part of a pair in ``fits`` is
-  shrunk by ``extra_shrink`` more against that pair's outer part only;
+  replay tolerates at most what the plan says), and the free edges of an open part (edges
+  of one face) moved back in their faces by ``free_edge_pull`` shrinks; the inner part of a
+  pair in ``fits`` is shrunk by ``extra_shrink`` more against that pair's outer part only;
 - **open parts**: ``open_parts`` must be exactly the parts whose mesh is not closed once
   merged; a closed part has an inside (a body lying wholly in it collides with it, as a
   body whose surface crosses it does), an open one has none (its relations are
@@ -71,6 +73,17 @@ def vector(direction: str) -> np.ndarray:
     return v
 
 
+def read_options(path: Path, geo: dict) -> dict:
+    """Keywords for ``trimesh.load`` of a scene file: a glTF mesh's primitives are one part,
+    named as its node (not randomly); a STEP is tessellated to within ``step_chord`` mm."""
+    suffix = path.suffix.lower()
+    if suffix in (".glb", ".gltf"):
+        return {"merge_primitives": True}
+    if suffix in (".step", ".stp") and geo.get("step_chord"):
+        return {"tol_linear": float(geo["step_chord"])}
+    return {}
+
+
 def load_meshes(plan: dict) -> dict[str, trimesh.Trimesh]:
     """Part id -> mesh in mm, from ``parts[].source`` and ``geometry`` only."""
     geo = plan["geometry"]
@@ -82,14 +95,10 @@ def load_meshes(plan: dict) -> dict[str, trimesh.Trimesh]:
         src = part["source"]
         path = Path(src["path"]) if src["path"] else folder / src["file"]
         if src["node"] is None:
-            mesh = trimesh.load(path, force="mesh")
+            mesh = trimesh.load(path, force="mesh", **read_options(path, geo))
         else:
             if path not in scenes:
-                # a glTF mesh's primitives are one part, named as its node (not randomly)
-                merge = (
-                    {"merge_primitives": True} if path.suffix.lower() in (".glb", ".gltf") else {}
-                )
-                scenes[path] = trimesh.load(path, force="scene", **merge)
+                scenes[path] = trimesh.load(path, force="scene", **read_options(path, geo))
             transform, geometry = scenes[path].graph[src["node"]]
             mesh = scenes[path].geometry[geometry].copy().apply_transform(transform)
         mesh = mesh.apply_scale(src.get("scale") or geo["scale"])
@@ -105,11 +114,27 @@ def load_meshes(plan: dict) -> dict[str, trimesh.Trimesh]:
     return out
 
 
-def eroded(mesh: trimesh.Trimesh, shrink: float) -> trimesh.Trimesh:
+def eroded(mesh: trimesh.Trimesh, shrink: float, pull: float = 0.0) -> trimesh.Trimesh:
     """Each vertex moved inwards along its normal so that no face plane it touches moves by
-    more than ``shrink`` (exactly ``shrink`` for the plane closest to the normal)."""
+    more than ``shrink`` (exactly ``shrink`` for the plane closest to the normal); a vertex
+    on free edges (edges of one face) also moved back in those faces, away from them, by
+    at most ``pull * shrink`` (``free_edge_pull``)."""
     if shrink <= 0:
         return mesh
+    back = np.zeros((len(mesh.vertices), 3))
+    if pull > 0 and not mesh.is_watertight:
+        counts = np.bincount(mesh.edges_unique_inverse)
+        free = counts[mesh.edges_unique_inverse] == 1
+        ends, faces = mesh.edges[free], mesh.edges_face[free]
+        start, stop = mesh.vertices[ends[:, 0]], mesh.vertices[ends[:, 1]]
+        away = np.cross(stop - start, mesh.face_normals[faces])
+        outside = (start + stop) / 2 - mesh.triangles_center[faces]
+        away *= np.sign(np.einsum("ij,ij->i", away, outside))[:, None]
+        away /= np.maximum(np.linalg.norm(away, axis=1), 1e-300)[:, None]
+        np.add.at(back, ends[:, 0], away)
+        np.add.at(back, ends[:, 1], away)
+        size = np.linalg.norm(back, axis=1)
+        back /= np.maximum(size, 1.0)[:, None]  # at most one pull, however many free edges
     normals = mesh.vertex_normals
     cos = np.zeros(len(mesh.vertices))
     for k in range(mesh.vertex_faces.shape[1]):
@@ -118,7 +143,8 @@ def eroded(mesh: trimesh.Trimesh, shrink: float) -> trimesh.Trimesh:
         dots = np.einsum("ij,ij->i", normals[has], mesh.face_normals[f[has]])
         cos[has] = np.maximum(cos[has], dots)
     move = shrink / np.clip(cos, 0.5, 1.0)
-    return trimesh.Trimesh(mesh.vertices - normals * move[:, None], mesh.faces, process=False)
+    moved = mesh.vertices - normals * move[:, None] - back * (pull * shrink)
+    return trimesh.Trimesh(moved, mesh.faces, process=False)
 
 
 def collision_object(mesh: trimesh.Trimesh) -> fcl.CollisionObject:
@@ -181,6 +207,7 @@ class Replay:
         # a unit built in another orientation (upside down) has its own gravity
         self.down = {w["id"]: vector(w.get("gravity", plan["gravity"])) for w in plan["workspaces"]}
         self.extra = {(f["inner"], f["outer"]): f["extra_shrink"] for f in geo.get("fits", [])}
+        pull = float(geo.get("free_edge_pull", 0.0))
         self.open = {p for p, m in self.meshes.items() if not m.is_watertight}
         said = set(geo.get("open_parts", self.open))
         if said != self.open:
@@ -190,10 +217,12 @@ class Replay:
         closed = {p: p not in self.open for p in self.meshes}
         self.plain = {p: Solid(m, closed[p]) for p, m in self.meshes.items()}
         self.solid = {
-            p: Solid(eroded(m, self.shrink[p]), closed[p]) for p, m in self.meshes.items()
+            p: Solid(eroded(m, self.shrink[p], pull), closed[p]) for p, m in self.meshes.items()
         }
         self.fitted = {
-            pair: Solid(eroded(self.meshes[pair[0]], self.shrink[pair[0]] + extra), closed[pair[0]])
+            pair: Solid(
+                eroded(self.meshes[pair[0]], self.shrink[pair[0]] + extra, pull), closed[pair[0]]
+            )
             for pair, extra in self.extra.items()
         }
         thinnest = min(float(np.min(m.extents)) for m in self.meshes.values())

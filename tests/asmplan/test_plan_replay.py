@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -97,6 +98,7 @@ def _without_merging(plan):
     """Unmerged, every face is a mesh of its own: every part is open."""
     plan["geometry"]["merge_vertices"] = False
     plan["geometry"]["open_parts"] = [p["id"] for p in plan["parts"]]
+    plan["geometry"]["free_edge_pull"] = 0.0  # and the free edges left in place too
 
 
 @pytest.mark.parametrize(
@@ -189,3 +191,25 @@ def test_support_follows_the_rules_the_plan_names(tower_plan):
     rests_only = tampered(tower_plan, lambda p: p["geometry"].update(support=["rests"]))
     with pytest.raises(Rejected, match="is not supported"):
         Replay(rests_only).line("robust_plan")
+
+
+def test_a_step_plan_replays_from_the_meshes_the_planner_read(step_deflections):
+    """A STEP is tessellated to within ``geometry.step_chord`` mm (:data:`cad.scene.STEP_CHORD_MM`,
+    OCCT's linear deflection): the replay reads the file with it, so its meshes are the
+    planner's, triangle for triangle."""
+    from cad.scene import STEP_CHORD_MM, load_scene_file
+    from tests.asmplan.mesh_replay import load_meshes
+
+    step = Path(__file__).resolve().parents[1] / "cad" / "data" / "table_frame_in.step"
+    plan = pipeline.plan(step, time_limit=5).to_dict()
+    assert plan["geometry"]["step_chord"] == STEP_CHORD_MM
+    step_deflections.clear()
+    meshes = load_meshes(plan)
+    assert step_deflections == [STEP_CHORD_MM]
+    scene = load_scene_file(step)  # as the planner reads it
+    read = {
+        p["id"]: len(scene.geometry[scene.graph[p["source"]["node"]][1]].faces)
+        for p in plan["parts"]
+    }
+    assert read == {k: len(m.faces) for k, m in meshes.items()}
+    replayed(plan)

@@ -86,3 +86,42 @@ def far_apart() -> Assembly:
             "c": box_between((40, -40, 60), (45, -35, 65)),
         }
     )
+
+
+def disc_spring(z0: float = 0.0, sections: int = 48) -> trimesh.Trimesh:
+    """A slotless disc spring as a closed mesh: a cone annulus from radius 20 to 40 mm, the
+    inner edge 4 mm higher than the outer, 2 mm thick along z, its lowest point at ``z0``."""
+    angle = np.linspace(0.0, 2 * np.pi, sections, endpoint=False)
+    ring = np.c_[np.cos(angle), np.sin(angle), np.zeros(sections)]
+    lift = np.array([0.0, 0.0, 1.0])
+    rings = [(20, 6), (40, 2), (20, 4), (40, 0)]  # top inner, top outer, bottom inner, outer
+    vertices = np.vstack([r * ring + (z0 + z) * lift for r, z in rings])
+    i = np.arange(sections)
+    j = (i + 1) % sections
+    ti, to, bi, bo = (k * sections for k in range(4))
+    quads = [
+        (ti + i, to + i, to + j, ti + j),  # top cone
+        (bi + i, bi + j, bo + j, bo + i),  # bottom cone
+        (to + i, bo + i, bo + j, to + j),  # outer rim
+        (ti + i, ti + j, bi + j, bi + i),  # inner rim
+    ]
+    faces = np.vstack(
+        [np.c_[a, b, c] for a, b, c, _ in quads] + [np.c_[a, c, d] for a, _, c, d in quads]
+    )
+    mesh = trimesh.Trimesh(vertices, faces, process=True)
+    if mesh.volume < 0:
+        mesh.invert()
+    return mesh
+
+
+def open_disc_springs(sink: float = 0.0) -> Assembly:
+    """Two identical disc springs stacked 2 mm apart (the upper one's underside lies on the
+    lower one's top, sunk into it by ``sink``), tessellated like a STEP export that lost
+    their cone faces: only the rims are left, open meshes whose coincident rim bands touch
+    along a free edge."""
+    meshes = {}
+    for name, z0 in (("lower", 0.0), ("upper", 2.0 - sink)):
+        spring = disc_spring(z0)
+        rims = np.abs(spring.face_normals[:, 2]) < 0.5
+        meshes[name] = spring.submesh([rims], append=True)
+    return Assembly.from_meshes(meshes)

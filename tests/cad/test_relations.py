@@ -237,3 +237,20 @@ def test_coarse_tessellation_overlap_beyond_tolerance_is_an_error():
     with pytest.raises(ValueError, match=r"'plate' and 'peg' interpenetrate by about 0\.08"):
         compute_relations(assembly, penetration_tol=0.05)
     assert pair(compute_relations(assembly), "peg", "plate") == (SIDE, {"+z", "-z"})
+
+
+@pytest.mark.filterwarnings("ignore:part .* is not watertight")
+def test_open_disc_springs_touching_along_free_edges_are_not_interpenetrating():
+    """Open meshes (faces lost in tessellation) of two stacked disc springs: their rim bands
+    lie on one cylinder and meet along free edges; eroding the faces along their normals only
+    never parts them (the APLAN multiplate clutch), eroding the free edges too does."""
+    assembly = shapes.open_disc_springs()
+    assert not any(p.mesh.is_watertight for p in assembly.parts)
+    rel = compute_relations(assembly)
+    assert rel.tt[rel.index("upper"), rel.index("lower")].any()
+
+
+@pytest.mark.filterwarnings("ignore:part .* is not watertight")
+def test_open_disc_springs_sunk_into_each_other_are_an_error():
+    with pytest.raises(ValueError, match="'lower' and 'upper' interpenetrate"):
+        compute_relations(shapes.open_disc_springs(sink=1.5))

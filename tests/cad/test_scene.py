@@ -79,18 +79,9 @@ def test_step_in_inches_with_a_product_tree():
     )  # fmt: skip
 
 
-def test_step_tessellation_tolerance_reaches_cascadio(monkeypatch):
-    cascadio = pytest.importorskip("cascadio")
-    seen = []
-    convert = cascadio.step_to_glb
-
-    def spy(*args, **kwargs):
-        seen.append(kwargs.get("tol_linear"))
-        return convert(*args, **kwargs)
-
-    monkeypatch.setattr(cascadio, "step_to_glb", spy)
+def test_step_tessellation_tolerance_reaches_cascadio(step_deflections):
     scene = load_scene_file(DATA / "table_frame_in.step")
-    assert seen == [STEP_CHORD_MM] and len(scene.geometry) == 6
+    assert step_deflections == [STEP_CHORD_MM] and len(scene.geometry) == 6
 
 
 def test_a_spec_may_name_one_part_of_a_scene():

@@ -75,6 +75,33 @@ def test_automatic_subassemblies_plan_the_tower(tower):
     assert solution.tct == len(graph.spec.operations)
 
 
+def test_a_proof_finds_the_units_without_building_a_graph_that_has_no_plan(tower, monkeypatch):
+    """With the reduction, the derived precedences prove that a holder can never go in alone
+    (it touches only its own bearings, which come after it): the round groups it with them
+    without building the graph of the spec that has no complete sequence."""
+    import asp.state_graph
+
+    built = []
+    real = asp.state_graph.build_state_graph
+
+    def spy(spec, *args, **kwargs):
+        graph = real(spec, *args, **kwargs)
+        built.append((spec.subassemblies, kwargs.get("check", True)))
+        return graph
+
+    monkeypatch.setattr(asp.state_graph, "build_state_graph", spy)
+    lines = []
+    graph = build_with_units(tower_spec(tower), tower, reduce=True, on_unit=lines.append)
+    assert sorted(map(sorted, dict(graph.spec.subassemblies).values())) == [
+        ["bearing_1a", "bearing_1b", "holder_1"],
+        ["bearing_2a", "bearing_2b", "holder_2"],
+    ]
+    assert built and all(units and check for units, check in built)
+    assert any("trying subassemblies" in line for line in lines)
+    plain = build_with_units(tower_spec(tower), tower)  # the graph-built rounds agree
+    assert solve(game_dag(graph)).tct == solve(game_dag(plain)).tct
+
+
 def test_spec_subassemblies_and_workspaces(tower):
     units = {
         "level_1": ["holder_1", "bearing_1a", "bearing_1b"],
