@@ -24,11 +24,15 @@ The format's own down ``D`` (``-y`` for glTF/GLB, else ``-z``) is kept unless th
 direction ``b`` (fewest large parts held first, then proven feasible, then fewest held,
 ``D`` first, then ``-z, -y, -x, +z, +y, +x``) is strictly better and needs no more hands:
 ``held[b] <= held[D]``, and ``b`` is proven feasible where ``D`` is proven infeasible, or
-``b`` holds fewer large parts. Parts in holes favour a sideways gravity (the hole walls
-"support" them), which is why fewer held parts alone never switches. Measured on the
-public files of the survey: the Pro/E bolted brackets (Y-up STEP) get ``-y``, the Z-up
-exports keep ``-z``, Y-up glTF keeps ``-y``, a Z-up glTF written without turning its axes
-gets ``-z``; the cost is milliseconds to a second beside the relations.
+``b`` holds fewer large parts. When ``D`` fails even with every part held (some part is
+blocked whatever the gravity: two meshing helical gears on their shafts, each blocking the
+other along them), the switch still gives a plan, but the reason says the product is
+planned lying on its side, not that the file is another axis up. Parts in holes favour a
+sideways gravity (the hole walls "support" them), which is why fewer held parts alone
+never switches. Measured on the public files of the survey: the Pro/E bolted brackets
+(Y-up STEP) get ``-y``, the Z-up exports keep ``-z``, Y-up glTF keeps ``-y``, a Z-up glTF
+written without turning its axes gets ``-z``; the cost is milliseconds to a second beside
+the relations.
 """
 
 from __future__ import annotations
@@ -66,6 +70,10 @@ class GravityChoice:
         Per direction: how many of those are large parts.
     feasible : dict of str to bool or None
         Per direction: a complete insertion sequence exists (None: the search ran out).
+    blocked_anyway : bool
+        Along the default no order exists even with every part held: a part is blocked
+        whatever the gravity (two helical gears on their shafts), so a switch says it builds
+        the product lying on its side, not that the file is another axis up.
     """
 
     gravity: str
@@ -73,6 +81,7 @@ class GravityChoice:
     held: dict[str, int]
     held_large: dict[str, int]
     feasible: dict[str, bool | None]
+    blocked_anyway: bool = False
 
     @property
     def reason(self) -> str:
@@ -81,6 +90,12 @@ class GravityChoice:
         own = "glTF is +y up by its specification" if d == "-y" else "z up"
         if g == d:
             return f"the file format's own down ({own}); no other direction is clearly better"
+        if self.feasible[g] and self.feasible[d] is False and self.blocked_anyway:
+            return (
+                f"not the default {d} ({own}): along {d} no part order can be inserted even "
+                f"with every part held (some part is blocked whatever the gravity, as a "
+                f"helical gear behind its mate): planned lying along {g}"
+            )
         if self.feasible[g] and self.feasible[d] is False:
             why = f"along {d} no part order can be inserted"
         else:
@@ -141,7 +156,8 @@ def choose_gravity(relations, bounds: np.ndarray, default: str = "-z") -> Gravit
         held_large[best] < held_large[default]
     )
     chosen = best if better and held[best] <= held[default] else default
-    return GravityChoice(chosen, default, held, held_large, feasible)
+    anyway = feasible[default] is False and _blocked_anyway(relations, bounds, default)
+    return GravityChoice(chosen, default, held, held_large, feasible, anyway)
 
 
 def one_sequence(relations, gravity: str, base: int, held: set[int]) -> bool | None:
@@ -192,6 +208,13 @@ def one_sequence(relations, gravity: str, base: int, held: set[int]) -> bool | N
         if not stuck(s):
             stack += [s | 1 << p for p in reversed(range(n)) if not s >> p & 1 and fits(p, s)]
     return False
+
+
+def _blocked_anyway(relations, bounds: np.ndarray, gravity: str) -> bool:
+    """Whether no order exists along ``gravity`` even with every part held (support is not
+    what fails: the translational freedom does not depend on gravity)."""
+    everyone = set(range(len(relations.parts)))
+    return one_sequence(relations, gravity, base_index(bounds, gravity), everyone) is False
 
 
 def _unsupportable(relations, gravity: str, base: int) -> set[int]:

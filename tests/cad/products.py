@@ -5,6 +5,10 @@
 - :func:`gearbox`: a housing with two shafts standing in blind bores, two spur gears on the
   shafts' collars meshing with ``backlash`` (negative: the teeth overlap), a lid over the
   shafts' ends;
+- :func:`helical_pair`: two helical gears of opposite hands meshing on shafts standing in a
+  plate (the teeth of each block the other along the shafts);
+- :func:`planetary_stage`: a sun on its shaft, three identical planets on pins pressed into
+  the base, a ring gear around them and a carrier plate over the planets;
 - :func:`shear_mold`: a die set of a lower shoe with press-fitted guide pins and dowels in
   blind holes, a die plate on the dowels, a punch in the die opening (0.05 mm per side),
   an upper shoe with guide bushings pressed in, sliding on the pins.
@@ -132,6 +136,70 @@ def gearbox(backlash: float = 0.1) -> dict[str, trimesh.Trimesh]:
         "gear_a": _spur_gear(ta, (0, 0), 0.0, backlash),
         "gear_b": _spur_gear(tb, cb, np.pi + np.pi / tb, backlash),
     }
+
+
+def _bore(radius: float, sections: int) -> np.ndarray:
+    angles = np.linspace(0, 2 * np.pi, sections, endpoint=False)[::-1]  # CW hole
+    return np.stack([radius * np.cos(angles), radius * np.sin(angles)], 1)
+
+
+def _helical_gear(teeth: int, phase: float, twist: float, backlash: float, height: float):
+    """A helical gear about z (z 0..height), its section turned by ``twist`` radians from
+    bottom to top (the helix), bore of radius 5."""
+    return extrude([gear_outline(teeth, 8, phase, -backlash), _bore(5.0, 36)], 0, height, twist)
+
+
+def helical_pair(helix_deg: float = 20.0, backlash: float = 0.1) -> dict[str, trimesh.Trimesh]:
+    """Gears of 15 and 25 teeth (helix ``helix_deg``, opposite hands, 14 mm wide) meshing in
+    z 2..16 on the collars of two shafts standing in blind bores of a plate (top z = 0)."""
+    ta, tb, width = 15, 25, 14.0
+    ra, rb = MODULE * ta / 2, MODULE * tb / 2
+    cb = np.array([ra + rb, 0.0])
+    advance = width * np.tan(np.radians(helix_deg))  # along the pitch circles
+    gear_b = _helical_gear(tb, np.pi + np.pi / tb, -advance / rb, backlash, width)
+    plate = difference(box((-20, -20, -8), (cb[0] + 30, 20, 0)),
+                       cylinder(5, -5, 1, 40), cylinder(5, -5, 1, 40, cb))  # fmt: skip
+
+    def shaft(xy, n):
+        return union(cylinder(5, -5, 30, n, xy), cylinder(7, 0, 2, n, xy))
+
+    return {
+        "plate": plate,
+        "shaft_a": shaft((0, 0), 40),
+        "shaft_b": shaft(cb, 44),
+        "gear_a": _helical_gear(ta, 0.0, advance / ra, backlash, width).apply_translation(
+            (0, 0, 2)
+        ),
+        "gear_b": gear_b.apply_translation((*cb, 2)),
+    }
+
+
+def planetary_stage(backlash: float = 0.1) -> dict[str, trimesh.Trimesh]:
+    """Sun 12, planets 18 (three, on pins pressed into the base), ring 48 teeth, module 2,
+    gears in z 0..10 on a base (top z = 0), a carrier plate z 10..14 over the planets."""
+    zs, zp, zr = 12, 18, 48
+    a = MODULE * (zs + zp) / 2  # 30
+    spots = [a * np.array([np.cos(t), np.sin(t)]) for t in 2 * np.pi * np.arange(3) / 3]
+    base = difference(
+        cylinder(60, -10, 0, 96),
+        cylinder(5, -6, 1, 40),
+        *(cylinder(4, -6, 1, 32, c) for c in spots),
+    )
+    sun = union(cylinder(5, -6, 22, 40), extrude([gear_outline(zs, 8, 0.0, -backlash)], 0, 10))
+    cutter = gear_outline(zr, 8, np.pi / zr, backlash, addendum=1.25, dedendum=1.0)
+    ring = extrude([_bore(60.0, 96)[::-1], cutter[::-1]], 0, 10)
+    carrier = difference(
+        cylinder(40, 10, 14, 64),
+        cylinder(5.05, 9, 15, 40),
+        *(cylinder(4, 9, 15, 32, c) for c in spots),
+    )
+    parts = {"base": base, "sun": sun, "ring": ring, "carrier": carrier}
+    for k, c in enumerate(spots):
+        turn = trimesh.transformations.rotation_matrix(2 * np.pi * k / 3, (0, 0, 1))
+        planet = extrude([gear_outline(zp, 8, np.pi / zp, -backlash), _bore(4.0, 32)], 0, 10)
+        parts[f"planet_{k + 1}"] = planet.apply_translation((a, 0, 0)).apply_transform(turn)
+        parts[f"pin_{k + 1}"] = cylinder(4, -6, 14, 32, c)
+    return parts
 
 
 def shear_mold(press: float = 0.01) -> dict[str, trimesh.Trimesh]:

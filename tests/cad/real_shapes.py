@@ -51,10 +51,14 @@ def annulus(r_in, r_out, z0, z1, n_in, n_out, xy=(0.0, 0.0)) -> trimesh.Trimesh:
     return difference(cylinder(r_out, z0, z1, n_out, xy), cylinder(r_in, z0 - 1, z1 + 1, n_in, xy))
 
 
-def extrude(contours: list[np.ndarray], z0: float, z1: float) -> trimesh.Trimesh:
-    """Extrude closed 2-D contours (outer CCW, holes CW) from ``z0`` to ``z1``."""
+def extrude(
+    contours: list[np.ndarray], z0: float, z1: float, twist: float = 0.0
+) -> trimesh.Trimesh:
+    """Extrude closed 2-D contours (outer CCW, holes CW) from ``z0`` to ``z1``, the top
+    section turned by ``twist`` radians about the z axis (a helical gear's helix)."""
     section = manifold3d.CrossSection([np.asarray(c, dtype=float) for c in contours])
-    solid = manifold3d.Manifold.extrude(section, z1 - z0).translate((0.0, 0.0, z0))
+    turned = {"n_divisions": 12, "twist_degrees": float(np.degrees(twist))} if twist else {}
+    solid = manifold3d.Manifold.extrude(section, z1 - z0, **turned).translate((0.0, 0.0, z0))
     mesh = solid.to_mesh()
     return trimesh.Trimesh(
         vertices=np.asarray(mesh.vert_properties)[:, :3], faces=np.asarray(mesh.tri_verts)
@@ -221,13 +225,19 @@ def _inv(angle):
 
 
 def gear_outline(
-    teeth: int, flank_points: int, phase: float = 0.0, interference: float = GEAR_INTERFERENCE
+    teeth: int,
+    flank_points: int,
+    phase: float = 0.0,
+    interference: float = GEAR_INTERFERENCE,
+    addendum: float = 1.0,
+    dedendum: float = 1.25,
 ) -> np.ndarray:
     """CCW outline of an involute spur gear (module :data:`MODULE`, 20 degrees, root
     clearance 0.25 m) with tooth thickness ``pi m / 2 + interference`` at the pitch
-    circle (negative: backlash); a tooth is centred at angle ``phase``."""
+    circle (negative: backlash); a tooth is centred at angle ``phase``. ``addendum`` and
+    ``dedendum`` in modules (a cutter for a ring gear: 1.25 and 1.0)."""
     r = MODULE * teeth / 2
-    rb, ra, rf = r * np.cos(PRESSURE), r + MODULE, r - 1.25 * MODULE
+    rb, ra, rf = r * np.cos(PRESSURE), r + addendum * MODULE, r - dedendum * MODULE
     half_pitch = (np.pi * MODULE / 2 + interference) / (2 * r)  # half tooth angle at r
     radii = np.linspace(max(rb, rf), ra, flank_points)
     half = half_pitch + _inv(PRESSURE) - _inv(np.arccos(np.clip(rb / radii, -1, 1)))
