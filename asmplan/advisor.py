@@ -25,15 +25,26 @@ operation finishes, so the advisor follows every move the observations leave pos
 event's optional ``time``, seconds since the start, keeps those whose completion is nearest
 to it) and answers for the worst of them; the robots do what it answered, which removes the
 moves whose commitment differs.
+
+Alike operations (both turn models): the policy knows one canonical order of each class of
+interchangeable operations (``plan.json``'s ``interchangeable``, :mod:`asp.symmetry`). An
+observed operation of a class is mapped onto the operation the plan can take (the class's
+next canonical one) by a permutation of the class's blocks (:class:`asp.alike.AlikeMap`):
+a block of several operations (a dowel with its roller) moves as one, and later events of
+the same physical operation (its finish after its start) map the same way. Observations,
+history and advice are in physical operation ids; an instruction or option that names one
+of several alike operations lists in ``alike`` every one that is as good (and their parts
+in ``alike_parts``). The bound is the plan's: a symmetry keeps every cost.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 
 from asmplan.errors import GameError
 from asmplan.planfile import check_plan
+from asp.alike import AlikeMap
 
 EVENT_KINDS = ("started", "finished")
 
@@ -110,12 +121,15 @@ class Advice:
         The robots' next operations (``{"operation", "agent", "description"}``); empty:
         the robots wait.
     instruction : dict or None
-        What the person is asked to do next (``None``: wait).
+        What the person is asked to do next (``None``: wait); ``alike`` lists every
+        operation as good as ``operation`` (alike parts in interchangeable places, itself
+        first) and ``alike_parts`` their parts.
     options : list of dict
         At the person's turn, every operation the person may start with the worst case it
-        leads to (``{"operation", "agent", "description", "cost", "worst"}``, ``worst``
-        the guaranteed total cost after it). Concurrent: also ``durations`` (those the plan
-        knows; ``cost`` the longest) and ``deviation`` (not the instruction).
+        leads to (``{"operation", "agent", "description", "cost", "worst", "alike",
+        "alike_parts"}``, ``worst`` the guaranteed total cost after it). Concurrent: also
+        ``durations`` (those the plan knows; ``cost`` the longest) and ``deviation`` (not the
+        instruction).
     elapsed : float
         Cost so far.
     bound : float
@@ -209,6 +223,7 @@ class Advisor:
         self._agents = self._policy["agents"]
         self._agent_index = {a: k for k, a in enumerate(self._agents)}
         self._operations = plan.get("operations", {})
+        self._alike = AlikeMap(plan.get("interchangeable") or ())
 
     # ------------------------------------------------------------------ queries
     @property
@@ -221,7 +236,11 @@ class Advisor:
         return self._moves(self._cursor.state) == range(0) and self._cursor.running < 0
 
     def advice(self) -> Advice:
-        """The advice in the current state."""
+        """The advice in the current state, in physical operation ids."""
+        return self._physical(self._canonical_advice())
+
+    def _canonical_advice(self) -> Advice:
+        """The advice in the policy's (canonical) operation ids."""
         c = self._cursor
         states, moves = self._policy["states"], self._policy["moves"]
         i = c.state
@@ -247,12 +266,12 @@ class Advisor:
         else:
             robots = [self._op_dict(op, agent) for op, agent in states["robots"][i]]
             if states["instruction"][i] is not None:
-                instruction = self._op_dict(*states["instruction"][i])
+                instruction = self._person_dict(*states["instruction"][i])
             if states["turn"][i] == "human":
                 for j in self._moves(i):
                     if moves["operation"][j] < 0:
                         continue
-                    item = self._op_dict(moves["operation"][j], moves["agent"][j])
+                    item = self._person_dict(moves["operation"][j], moves["agent"][j])
                     item["cost"] = moves["cost"][j]
                     item["worst"] = c.elapsed + moves["cost"][j] + states["bound"][moves["next"][j]]
                     options.append(item)
@@ -276,6 +295,10 @@ class Advisor:
     def observe(self, event) -> Advice:
         """Take one observation; return the new advice.
 
+        An operation of a class of alike ones is taken as the canonical operation it maps
+        onto (module docstring): the instruction's if it can be, else the current mapping's,
+        else another alike one's the plan can take.
+
         Raises
         ------
         ObservationError
@@ -283,6 +306,22 @@ class Advisor:
         """
         ev = Event.parse(event)
         self._check(ev)
+        told = self._told(ev.agent)
+        first = None
+        for op, perm in self._alike.candidates(ev.operation, self._pattern, told):
+            try:
+                self._take(replace(ev, operation=op))
+            except ObservationError as exc:
+                if first is None:
+                    first = exc if op == ev.operation else _as_alike(exc, ev.operation, op)
+                continue
+            self._alike.adopt(perm)
+            self._record(ev)
+            return self.advice()
+        raise first
+
+    def _take(self, ev: Event) -> None:
+        """Take one observation in canonical ids (raises, state unchanged, if it cannot)."""
         c = self._cursor
         if self.finished:
             raise ObservationError(f"{ev.kind} {ev.operation} by {ev.agent}: the game is over")
@@ -309,8 +348,59 @@ class Advisor:
                 c.running = j
             else:
                 self._finish(j)
-        c.history.append(ev)
-        return self.advice()
+
+    def _record(self, ev: Event) -> None:
+        self._cursor.history.append(ev)
+
+    def _told(self, agent: str) -> list[str]:
+        """The canonical operations ``agent`` is asked to do now."""
+        told = self._policy["states"]["instruction"][self._cursor.state]
+        if self._cursor.running >= 0 or told is None or self._agents[told[1]] != agent:
+            return []
+        return [self._ops[told[0]]]
+
+    def _pattern(self, op: str):
+        """An alike operation's pattern (:data:`asp.alike.Pattern`): done or not; None
+        while it runs."""
+        c = self._cursor
+        if c.running >= 0 and self._ops[self._policy["moves"]["operation"][c.running]] == op:
+            return None
+        return op in self._done(c.state)
+
+    # ------------------------------------------------------------------ physical ids
+    def _physical(self, advice: Advice) -> Advice:
+        """``advice`` with every operation named by its physical id (the alike map)."""
+        if not self._alike:
+            return advice
+        done = sorted((self._alike.physical(op) for op in advice.done), key=self._op_index.get)
+        return replace(
+            advice,
+            done=done,
+            parts=placed_parts(self._operations, done),
+            running=[self._item(r) for r in advice.running],
+            robots=[self._item(r) for r in advice.robots],
+            instruction=None if advice.instruction is None else self._item(advice.instruction),
+            options=_distinct([self._item(o) for o in advice.options]),
+            instructions=[self._item(i) for i in advice.instructions],
+            finishes=[self._item(f) for f in advice.finishes],
+        )
+
+    def _item(self, item: dict) -> dict:
+        """An advice entry naming a canonical operation, in physical ids; an instruction or
+        option (it has a ``description``) also lists the alike operations as good as it."""
+        op = item.get("operation")
+        if op is None:
+            return item
+        out = {**item, "operation": self._alike.physical(op)}
+        if "description" in item:
+            out["description"] = self._operations.get(out["operation"], {}).get(
+                "description", item["description"]
+            )
+        if "alike" in item:
+            alike = self._alike.alike(op, self._pattern)
+            out["alike"] = alike
+            out["alike_parts"] = placed_parts(self._operations, alike)
+        return out
 
     def _finish(self, j: int) -> None:
         moves = self._policy["moves"]
@@ -398,6 +488,13 @@ class Advisor:
             "description": self._operations.get(name, {}).get("description", ""),
         }
 
+    def _person_dict(self, op: int, agent: int) -> dict:
+        """An instruction or option: :meth:`_op_dict` with the alike operations as good as
+        it (``alike``, ``alike_parts``; physical ids are given by :meth:`_physical`)."""
+        name = self._ops[op]
+        parts = self._operations.get(name, {}).get("parts", [])
+        return {**self._op_dict(op, agent), "alike": [name], "alike_parts": list(parts)}
+
     @classmethod
     def replay(cls, plan: dict, events: list) -> Advisor:
         """An advisor that has observed ``events`` (raises on the first it cannot explain)."""
@@ -452,21 +549,20 @@ class ConcurrentAdvisor(Advisor):
         b = self._branches[0]
         return len(self._moves(b.state)) == 0 and not b.unreported
 
-    def advice(self) -> Advice:
+    def _canonical_advice(self) -> Advice:
         states = self._policy["states"]
         b = self._branches[0]
         i = b.state
         told = {a: o for o, a in b.told if a not in self._busy(b)}
         instructions = [
-            {
-                "agent": self._agents[a],
-                "operation": None if o < 0 else self._ops[o],
-                "description": "wait" if o < 0 else self._description(o),
-            }
+            {"agent": self._agents[a], "operation": None, "description": "wait"}
+            if o < 0
+            else self._person_dict(o, a)
             for a, o in told.items()
         ]
         instruction = next(
-            (self._op_dict(o, a) for a, o in told.items() if o >= 0 and not self.finished), None
+            (self._person_dict(o, a) for a, o in told.items() if o >= 0 and not self.finished),
+            None,
         )
         running = [
             {"agent": a, "operation": op, "remaining": r} for a, op, r in states["running"][i]
@@ -526,7 +622,7 @@ class ConcurrentAdvisor(Advisor):
                     worst[(o, a)] = (max(w, after), durations | {d})
         out = []
         for (o, a), (w, durations) in sorted(worst.items()):
-            item = self._op_dict(o, a)
+            item = self._person_dict(o, a)
             item.update(
                 cost=max(durations),
                 durations=sorted(durations),
@@ -560,9 +656,9 @@ class ConcurrentAdvisor(Advisor):
         ]
 
     # ------------------------------------------------------------------ observing
-    def observe(self, event) -> Advice:
-        """Take one observation, as :meth:`Advisor.observe` (the rules: module docstring)."""
-        ev = Event.parse(event)
+    def _take(self, ev: Event) -> None:
+        """Take one observation in canonical ids, as :meth:`Advisor.observe` (the rules:
+        module docstring)."""
         o, a = self._check(ev)
         what = f"{ev.operation} {ev.kind} by {ev.agent}"
         if self.finished:
@@ -594,8 +690,26 @@ class ConcurrentAdvisor(Advisor):
         head = kept[0]
         self._branches = [br for br in kept if (br.commit, br.told) == (head.commit, head.told)]
         self._deviations = deviations
+
+    def _record(self, ev: Event) -> None:
         self._events.append(ev)
-        return self.advice()
+
+    def _told(self, agent: str) -> list[str]:
+        k = self._agent_index.get(agent)
+        b = self._branches[0]
+        return [self._ops[o] for o, a in b.told if a == k and o >= 0]
+
+    def _pattern(self, op: str):
+        """Done or not in each branch; None while it runs, is started or is committed in
+        any (:data:`asp.alike.Pattern`)."""
+        o = self._op_index[op]
+        out = []
+        for br in self._branches:
+            busy = self._running(br.state) | set(br.pending) | set(br.unreported) | set(br.commit)
+            if any(x == o for x, _ in busy):
+                return None
+            out.append(op in self._done(br.state))
+        return tuple(out)
 
     def _start(
         self, br: _Branch, o: int, a: int, what: str, duration: float | None = None
@@ -746,9 +860,24 @@ class ConcurrentAdvisor(Advisor):
 
 
 def _replace(br: _Branch, **changes) -> _Branch:
-    from dataclasses import replace
-
     return replace(br, **changes)
+
+
+def _distinct(options: list[dict]) -> list[dict]:
+    """``options`` without one that is an earlier one's alike twin (the same agent and alike
+    operations: a symmetry fixing the state swaps them, so their worst cases agree)."""
+    seen, out = set(), []
+    for o in options:
+        key = (o["agent"], frozenset(o.get("alike", [o["operation"]])))
+        if key not in seen:
+            seen.add(key)
+            out.append(o)
+    return out
+
+
+def _as_alike(exc: ObservationError, physical: str, canonical: str) -> ObservationError:
+    """``exc`` about canonical operation ``canonical``, said of the physical one observed."""
+    return ObservationError(f"{physical} (alike; the plan's {canonical} here): {exc}")
 
 
 def _worker_side(worker: str, sides: dict) -> str:

@@ -93,10 +93,15 @@ class Game:
     dag : asp.dag.GameDAG
     descriptions : dict of str to str
         Operation id -> description, for readable plans.
+    interchangeable : tuple
+        The classes of interchangeable blocks of operations its state graph's reduction
+        used (``graph.model.interchangeable``; empty for a bare graph file): the game knows
+        one canonical order of each (:mod:`asp.alike` maps a physical choice onto it).
     """
 
     dag: GameDAG
     descriptions: dict[str, str] = field(default_factory=dict)
+    interchangeable: tuple = ()
 
 
 @dataclass(frozen=True, eq=False)
@@ -231,6 +236,7 @@ class AssemblyPlan:
                 played.describe,
                 extra=extra,
                 relations=self.assembly.relations,
+                interchangeable=self.graph.model.interchangeable,
             )
         curve = self.concurrent.curve
         doc = plan_document(
@@ -240,6 +246,7 @@ class AssemblyPlan:
             game=curve.game,
             extra=extra,
             relations=self.assembly.relations,
+            interchangeable=self.graph.model.interchangeable,
         )
         from asp.concurrent_plan import plan_entries
 
@@ -559,7 +566,8 @@ def load_game(source: str | os.PathLike[str], *, cost: str | None = None) -> Gam
             raise GraphError("--cost applies to assemblies only: a graph file has its costs")
         return Game(load_dag(path))
     assembly = load(path)
-    return Game(game(state_graph(assembly), cost=cost), assembly.descriptions)
+    graph = state_graph(assembly)
+    return Game(game(graph, cost=cost), assembly.descriptions, graph.model.interchangeable)
 
 
 def solve_game(dag: GameDAG) -> Solution:

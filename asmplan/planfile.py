@@ -729,6 +729,7 @@ def plan_document(
     extra: dict | None = None,
     game=None,
     relations=None,
+    interchangeable=(),
 ) -> dict:
     """The whole plan file: policy, lines, metrics, operations and parts, plus ``extra``.
 
@@ -738,14 +739,24 @@ def plan_document(
     of its start, the largest budget). ``relations``: the part relations (``cad``
     ``Relations``, None without geometry): each line step's ``insertions`` then name the
     direction each body goes in along, and ``geometry`` the unit, scale and tolerances.
+    ``interchangeable``: the classes of interchangeable blocks of operations the state
+    graph's reduction used (``graph.model.interchangeable``, :mod:`asp.symmetry`), written
+    as the plan's ``interchangeable`` for the runtime advisor.
     """
     if game is None:
         played = played_policy(dag, solution, describe)
-        return played_document(spec, played, describe, extra=extra, relations=relations)
+        return played_document(
+            spec,
+            played,
+            describe,
+            extra=extra,
+            relations=relations,
+            interchangeable=interchangeable,
+        )
     policy = _concurrent_policy(game, solution, policy_table(dag, solution))
     sizes = (dag.cost_model, dag.n_nodes, dag.n_edges)
     values = (solution.tct, solution.minimax, float(solution.expected[dag.start, ROBOT]))
-    return _document(spec, policy, sizes, values, extra, relations)
+    return _document(spec, policy, sizes, values, extra, relations, interchangeable)
 
 
 def played_document(
@@ -755,16 +766,19 @@ def played_document(
     *,
     extra: dict | None = None,
     relations=None,
+    interchangeable=(),
 ) -> dict:
     """The whole plan file of a solved ``alternate`` game from its :class:`PlayedPolicy`
     (the game itself no longer needed; arguments as :func:`plan_document`'s)."""
     policy = played_policy_object(played, describe)
     sizes = (played.cost_model, played.n_nodes, played.n_edges)
     values = (played.tct, played.minimax, played.avg_random)
-    return _document(spec, policy, sizes, values, extra, relations)
+    return _document(spec, policy, sizes, values, extra, relations, interchangeable)
 
 
-def _document(spec, policy: dict, sizes: tuple, values: tuple, extra, relations) -> dict:
+def _document(
+    spec, policy: dict, sizes: tuple, values: tuple, extra, relations, interchangeable=()
+) -> dict:
     """The plan file around its ``policy``: lines, metrics, operations, parts, ``extra``.
 
     ``sizes``: the game's cost model, node and edge counts; ``values``: TCT, W* and the
@@ -816,6 +830,7 @@ def _document(spec, policy: dict, sizes: tuple, values: tuple, extra, relations)
         ],
         "operations": operations,
         "subassemblies": {u: list(ms) for u, ms in spec.subassemblies},
+        "interchangeable": [[list(block) for block in cls] for cls in interchangeable],
         "workspaces": workspace_records(spec, operations, principal),
         "line_check": line_check,
         "robust_plan": principal,
@@ -1189,4 +1204,5 @@ def build_plan(
         solution=solution,
         describe=alternate_states(graph, dag),
         relations=loaded.relations,
+        interchangeable=graph.model.interchangeable,
     )

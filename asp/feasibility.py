@@ -345,6 +345,11 @@ class OperationModel:
         Classes of interchangeable operations, each with its slack ``m``: an operation of a
         class may be done only while at most ``m`` of the ones listed before it are not
         (:meth:`_loose_order`; ``m = 0`` is a fixed order).
+    interchangeable : tuple of classes of blocks of operation ids
+        Every class of interchangeable blocks the reduction of the spec used (chained in
+        ``spec``, ``symmetric`` or ``loose``): each transposition of two blocks of a class
+        (position by position) is a symmetry of the game. Recorded for the runtime
+        (``plan.json``'s ``interchangeable``); the model's moves do not read it.
     """
 
     spec: AssemblySpec
@@ -369,6 +374,7 @@ class OperationModel:
     unit_masks: np.ndarray | None = None
     symmetric: tuple[tuple[tuple[int, ...], ...], ...] = ()
     loose: tuple[tuple[int, tuple[int, ...]], ...] = ()
+    interchangeable: tuple[tuple[tuple[str, ...], ...], ...] = ()
 
     @property
     def n_ops(self) -> int:
@@ -708,7 +714,13 @@ def _split(value: int, n_words: int) -> list[int]:
 
 
 def operation_model(
-    spec: AssemblySpec, relations=None, *, _min_words: int = 1, symmetric=(), loose=()
+    spec: AssemblySpec,
+    relations=None,
+    *,
+    _min_words: int = 1,
+    symmetric=(),
+    loose=(),
+    interchangeable=(),
 ) -> OperationModel:
     """Compile ``spec`` (and the cad relations, if any) into an :class:`OperationModel`.
 
@@ -717,7 +729,8 @@ def operation_model(
     interchangeable blocks of operation ids (:func:`asp.symmetry.interchangeable_blocks`),
     of which only the first of equal blocks moves (:meth:`OperationModel.enabled`);
     ``loose``: classes of interchangeable operation ids with their slack, ``(m, ids)``
-    (:attr:`OperationModel.loose`).
+    (:attr:`OperationModel.loose`); ``interchangeable``: the classes of blocks the
+    reduction used (:attr:`OperationModel.interchangeable`).
 
     Raises
     ------
@@ -802,6 +815,9 @@ def operation_model(
             tuple(tuple(index[o] for o in block) for block in cls) for cls in symmetric
         ),
         loose=tuple((int(m), tuple(index[o] for o in ids)) for m, ids in loose),
+        interchangeable=tuple(
+            tuple(tuple(str(o) for o in block) for block in cls) for cls in interchangeable
+        ),
     )
 
 

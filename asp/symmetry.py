@@ -702,7 +702,7 @@ def reduce_interchangeable(spec: AssemblySpec, relations) -> AssemblySpec:
 def _reduced(spec: AssemblySpec, relations, concurrent: bool):
     """:func:`reduce_interchangeable` and, with ``concurrent``, the chains of the classes
     of blocks kept in a loose order instead, with their slack (``(m, ids)`` for
-    :func:`asp.feasibility.operation_model`'s ``loose``).
+    :func:`asp.feasibility.operation_model`'s ``loose``), and the classes of blocks ordered.
 
     The slack of position ``p`` of a class's blocks is ``s(p) = s(p - 1) + m(p)``, ``m(p)``
     the :func:`class_slack` of the operations at ``p`` (``s(-1) = 0``): the block to move,
@@ -712,7 +712,7 @@ def _reduced(spec: AssemblySpec, relations, concurrent: bool):
     model, why, _ = _derive(spec, relations)
     if model is None:
         if why:
-            return spec, []
+            return spec, [], []
         base, classes = spec, [[[o] for o in cls] for cls in _exact_classes(spec, relations)]
     else:
         base = with_derived_precedences(spec, relations)
@@ -728,7 +728,7 @@ def _reduced(spec: AssemblySpec, relations, concurrent: bool):
                 loose.append((slack, chain))
             else:
                 chains.append(chain)
-    return with_fixed_order(base, chains), loose
+    return with_fixed_order(base, chains), loose, classes
 
 
 def class_slack(spec: AssemblySpec, ids: list[str]) -> int:
@@ -743,11 +743,14 @@ def class_slack(spec: AssemblySpec, ids: list[str]) -> int:
 
 def symmetry_reduction(
     spec: AssemblySpec, relations, *, concurrent: bool = False
-) -> tuple[AssemblySpec, list[list[list[str]]], list[tuple[int, list[str]]]]:
+) -> tuple[AssemblySpec, list[list[list[str]]], list[tuple[int, list[str]]], list[list[list[str]]]]:
     """The reduction of interchangeable parts for a state graph.
 
-    Returns the reduced spec, the classes whose blocks are not chains and, with
-    ``concurrent``, the chains kept in a loose order with their slack.
+    Returns the reduced spec, the classes whose blocks are not chains, with
+    ``concurrent`` the chains kept in a loose order with their slack, and every class of
+    interchangeable blocks the reduction uses (chains first, then the others; each block
+    in its position order): the symmetries a runtime maps a physical observation by
+    (:func:`reduced_state_graph` records them on the graph's model).
 
     Classes of blocks that are chains are put in a fixed order position by position
     (:func:`reduce_interchangeable`): the alternating game keeps its values. With
@@ -764,9 +767,9 @@ def symmetry_reduction(
     ``operation_model(..., symmetric=...)``): the alternating game's values only.
     """
     model, why, _ = _derive(spec, relations)
-    reduced, loose = _reduced(spec, relations, concurrent=concurrent)
+    reduced, loose, ordered = _reduced(spec, relations, concurrent=concurrent)
     if model is None:
-        return reduced, [], loose
+        return reduced, [], loose, ordered
     index = {op.id: i for i, op in enumerate(spec.operations)}
     chains, others = [], []
     for cls in interchangeable_blocks(spec, relations, chains_only=False):
@@ -777,7 +780,7 @@ def symmetry_reduction(
         root = index[cls[0][0]]
         if all(model.must[index[o]] >> root & 1 for o in cls[0][1:]):
             chains.append([b[0] for b in cls])
-    return with_fixed_order(reduced, chains), others, loose
+    return with_fixed_order(reduced, chains), others, loose, [*ordered, *others]
 
 
 def reduced_state_graph(spec: AssemblySpec, relations, *, concurrent: bool = False, **kwargs):
@@ -786,15 +789,20 @@ def reduced_state_graph(spec: AssemblySpec, relations, *, concurrent: bool = Fal
     that are stuck (dead ends, see ``build_state_graph(drop_stuck=...)``).
 
     Keyword arguments go to :func:`asp.state_graph.build_state_graph`; returns None when
-    there is nothing to reduce (build the full graph).
+    there is nothing to reduce (build the full graph). The graph's
+    ``model.interchangeable`` holds the classes of interchangeable blocks used (the plan
+    file's ``interchangeable``: a runtime maps an alike physical operation onto the
+    canonical one the graph keeps).
     """
     from asp.feasibility import operation_model
     from asp.state_graph import build_state_graph
 
-    reduced, others, loose = symmetry_reduction(spec, relations, concurrent=concurrent)
+    reduced, others, loose, classes = symmetry_reduction(spec, relations, concurrent=concurrent)
     if reduced is spec and not others and not loose:
         return None
-    model = operation_model(reduced, relations, symmetric=others, loose=loose)
+    model = operation_model(
+        reduced, relations, symmetric=others, loose=loose, interchangeable=classes
+    )
     return build_state_graph(reduced, relations, model=model, drop_stuck=True, **kwargs)
 
 

@@ -1,13 +1,20 @@
 """Command ``asmplan play``: a person plays one side of the game, turn by turn.
 
 The game logic is :class:`asp.play.GameSession`; this module only reads and prints. The
-person types a move number (``?`` help, ``q`` quit); end of input quits cleanly (exit 0).
-``--moves 2,1,3`` plays those numbers first (scripted demos and tests), then reads stdin.
+person types a move number or an operation id (``?`` help, ``q`` quit); end of input quits
+cleanly (exit 0). ``--moves 2,1,3`` plays those first (scripted demos and tests), then reads
+stdin.
+
+Alike parts: an assembly's game is reduced by symmetry (:mod:`asp.symmetry`), so its moves
+name one canonical order of interchangeable operations. The moves are shown in the person's
+physical operation ids with the alike ones as good (``or alike: ...``), and a typed id of any
+of them plays the canonical move it maps onto (:class:`asp.alike.AlikeMap`).
 """
 
 from __future__ import annotations
 
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import typer
@@ -19,7 +26,8 @@ from asp.rules import SIDE_NAMES, cost_at_most, costs_close
 
 HELP_TEXT = """\
 How to play
-  Type the number of a move and press Enter; '?' shows this help, 'q' quits.
+  Type the number of a move and press Enter; '?' shows this help, 'q' quits. You may type
+  an operation id instead of its number (of alike parts, any of them: 'or alike: ...').
   The robot moves first; then the turns alternate. A side with no move it may do passes
   at zero cost. The robot minimises the total cost, the human maximises it.
   'worst' = the guaranteed worst-case total if that move is taken: the most the game can
@@ -48,16 +56,57 @@ def _robot_policy(dag, robot: str):
     return policy, f"trained ({run.name})"
 
 
-def _parse_moves(text: str | None) -> list[int]:
+def _parse_moves(text: str | None, operations=()) -> list[str]:
+    """The scripted moves: numbers, or ids of ``operations`` (the game's)."""
     if not text:
         return []
+    known = set(operations)
     out = []
     for item in text.split(","):
         item = item.strip()
-        if not item.isdigit():
-            raise ValueError(f"--moves: expected comma-separated move numbers, got {item!r}")
-        out.append(int(item))
+        if not (item.isdigit() or item in known):
+            raise ValueError(
+                f"--moves: expected comma-separated move numbers or operation ids, got {item!r}"
+            )
+        out.append(item)
     return out
+
+
+class _Alike:
+    """The person's physical operation ids over a game reduced by symmetry: the moves shown
+    in them, a typed id mapped onto the canonical move (:class:`asp.alike.AlikeMap`)."""
+
+    def __init__(self, session, classes):
+        from asp.alike import AlikeMap
+
+        self.session = session
+        self.map = AlikeMap(classes)
+
+    def _pattern(self, op: str) -> bool:
+        return any(t.move is not None and t.move.operation == op for t in self.session.history)
+
+    def move(self, move):
+        """``move`` naming its physical operation, with the alike ones as good."""
+        if move is None or not self.map or not move.operation:
+            return move
+        op = self.map.physical(move.operation)
+        alike = self.map.alike(move.operation, self._pattern)
+        note = f" (or alike: {', '.join(alike[1:])})" if len(alike) > 1 else ""
+        description = self.session.descriptions.get(op, move.description) + note
+        return replace(move, operation=op, description=description.strip())
+
+    def turn(self, turn):
+        return turn if turn.move is None else replace(turn, move=self.move(turn.move))
+
+    def number(self, text: str) -> int | None:
+        """The number of the move a typed operation id stands for (None: none)."""
+        moves = self.session.moves()
+        for op, perm in self.map.candidates(text, self._pattern) if text else ():
+            for m in moves:
+                if m.operation and m.operation == op:
+                    self.map.adopt(perm)
+                    return m.number
+        return None
 
 
 def _unit(dag) -> str:
@@ -79,8 +128,8 @@ def _state_lines(session, fmt) -> list[str]:
     return out
 
 
-def _moves_table(session, fmt) -> list[str]:
-    moves = session.moves()
+def _moves_table(session, fmt, alike: _Alike) -> list[str]:
+    moves = [alike.move(m) for m in session.moves()]
     width = max(len(m.label) for m in moves)
     width = min(max(width, 4), 60)
     head = f"    {'#':>3}  {'move':<{width}}  {'cost':>6}  {'to':>6}  {'worst':>7}  {'coop':>7}"
@@ -147,9 +196,9 @@ def play_command(
     from asp.dag import HUMAN, ROBOT
     from asp.play import GameSession, fmt
 
-    script = _parse_moves(moves)
     game = load_game(source, cost=None if cost is None else cost.value)
     dag, descriptions = game.dag, game.descriptions
+    script = _parse_moves(moves, () if dag.operations is None else dag.operations)
     person = HUMAN if side is Side.human else ROBOT
     if person == ROBOT and robot != "robust":
         raise ValueError("--robot applies when you play the human (--as human)")
@@ -174,6 +223,7 @@ def play_command(
         f"TCT {fmt(sol.tct)}{u}, W* {fmt(sol.minimax)}{u}. Type a move number, "
         "? for help, q to quit."
     )
+    alike = _Alike(session, game.interchangeable)
     echo_input = not sys.stdin.isatty()
 
     while not session.finished:
@@ -188,21 +238,26 @@ def play_command(
             typer.echo(f"step {turn.step}: {who} to move")
             for line in _state_lines_at(turn, session, fmt):
                 typer.echo(line)
-            typer.echo(_turn_line(turn, fmt, person))
+            typer.echo(_turn_line(alike.turn(turn), fmt, person))
         if session.finished:
             break
         step = len(session.history) + 1
         typer.echo(f"step {step}: your move ({'human' if person == HUMAN else 'robot'})")
-        for line in _state_lines(session, fmt) + _moves_table(session, fmt):
+        for line in _state_lines(session, fmt) + _moves_table(session, fmt, alike):
             typer.echo(line)
         n = len(session.moves())
         while True:
             prompt = f"your move [1-{n}, ? help, q quit]: "
             if script:
-                choice = str(script.pop(0))
+                choice = script.pop(0)
                 typer.echo(f"{prompt}{choice} (scripted)")
-                if not 1 <= int(choice) <= n:
-                    raise ValueError(f"--moves: move {choice} at step {step}: expected 1 to {n}")
+                number = int(choice) if choice.isdigit() else alike.number(choice)
+                if number is None or not 1 <= number <= n:
+                    raise ValueError(
+                        f"--moves: move {choice} at step {step}: expected 1 to {n} or the id "
+                        "of an operation the player may do"
+                    )
+                choice = str(number)
             else:
                 typer.echo(prompt, nl=False)
                 choice = _read_line()
@@ -221,9 +276,16 @@ def play_command(
                 continue
             if choice.isdigit() and 1 <= int(choice) <= n:
                 break
-            typer.echo(f"  please type a number from 1 to {n}, ? for help or q to quit")
+            number = None if choice.isdigit() else alike.number(choice)
+            if number is not None:
+                choice = str(number)
+                break
+            typer.echo(
+                f"  please type a number from 1 to {n} (or an operation id), ? for help or q "
+                "to quit"
+            )
         turn = session.play(int(choice))
-        typer.echo(_turn_line(turn, fmt, person))
+        typer.echo(_turn_line(alike.turn(turn), fmt, person))
     if script:
         typer.echo(f"({len(script)} scripted moves left unused: the game is over)")
     _finish(session)

@@ -94,3 +94,35 @@ def concurrent_plan(data: dict | None = None, *, max_k: int = 2, step: float | N
         game=curve.game,
         extra={"robustness": curve.to_list()},
     )
+
+
+def alike_plan(spec, relations, turn_model: str = "alternate", *, cost: str = "time") -> dict:
+    """The plan document of a spec with alike parts, from the state graph reduced by
+    symmetry (:func:`asp.symmetry.reduced_state_graph`: the policy knows one canonical
+    order of each class; ``interchangeable`` lists the classes). ``concurrent``: budgets
+    0 to 2."""
+    from asp.symmetry import reduced_state_graph
+
+    concurrent = turn_model == "concurrent"
+    graph = reduced_state_graph(spec, relations, concurrent=concurrent)
+    classes = graph.model.interchangeable
+    if not concurrent:
+        dag = game_dag(graph, cost=cost)
+        return plan_document(
+            spec=graph.spec,
+            dag=dag,
+            solution=solve(dag),
+            describe=alternate_states(graph, dag),
+            interchangeable=classes,
+        )
+    from asp.concurrent import concurrent_model, robustness
+
+    curve = robustness(concurrent_model(graph.spec, graph, step=1.0), max_k=2)
+    return plan_document(
+        spec=graph.spec,
+        dag=curve.game.dag,
+        solution=curve.solution,
+        game=curve.game,
+        extra={"robustness": curve.to_list()},
+        interchangeable=classes,
+    )

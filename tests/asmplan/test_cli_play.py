@@ -162,3 +162,24 @@ def test_robot_from_a_trained_run(fig4, tmp_path):
     assert "the trained (run) policy's choice" in out
     assert f"certified worst case: {trained.certified_wcpl:g} (W* 3)" in out
     assert "the robot's guarantee held" in out
+
+
+def test_an_alike_part_may_be_typed_by_its_id(monkeypatch, tmp_path):
+    """An assembly's game knows one order of its alike pins: the moves show the physical
+    ones with those as good, and typing any of them plays the plan's move."""
+    from asmplan import pipeline
+    from asp.game import game_dag
+    from asp.symmetry import reduced_state_graph
+    from tests.asp.test_symmetry import pinned_disc
+
+    spec, rel = pinned_disc(3, 2)
+    graph = reduced_state_graph(spec, rel)
+    game = pipeline.Game(game_dag(graph, cost="time"), {}, graph.model.interchangeable)
+    monkeypatch.setattr(pipeline, "load_game", lambda source, cost=None: game)
+    result = _play(tmp_path, input="pin2\nzz\nq\n")
+    assert result.exit_code == 0, result.output
+    out = result.output
+    assert "pin0 H (or alike: pin1, pin2)" in out
+    assert "you (human): pin2 H" in out
+    assert "robot: pin1 R" in out  # the robot's next pin is a physical one still missing
+    assert "please type a number from 1 to 1 (or an operation id)" in out

@@ -104,3 +104,29 @@ def brute_force_downsets(n, pairs):
         if all(not (mask >> b & 1) or (mask >> a & 1) for a, b in pairs):
             count += 1
     return count
+
+
+def pin_roller_ring(n: int = 3):
+    """(spec, relations): a plate with ``n`` pins standing in it, a roller resting on each
+    pin's shoulder and held all round by it, a cover resting on the pins over the rollers.
+    Each pin with its roller is one block of a class of interchangeable blocks."""
+    pins = [f"pin{k}" for k in range(n)]
+    rollers = [f"roller{k}" for k in range(n)]
+    parts = ("plate", *pins, *rollers, "cover")
+    contacts = [(p, "plate", "-z") for p in pins]
+    contacts += [(r, p, "-z") for p, r in zip(pins, rollers, strict=True)]
+    contacts += [("cover", p, "-z") for p in pins]
+    blocks = [(p, "plate", d) for p in pins for d in ("-z", *LATERAL)]
+    blocks += [(r, p, d) for p, r in zip(pins, rollers, strict=True) for d in ("-z", *LATERAL)]
+    blocks += [("cover", q, "-z") for q in (*pins, *rollers)]
+    ops = [{"id": p, "agents": {"H": 2, "R": 3}, "part": p} for p in pins]
+    ops += [{"id": r, "agents": {"H": 3, "R": 3}, "part": r} for r in rollers]
+    ops += [{"id": "cover", "agents": {"H": 3, "R": 2}, "part": "cover"}]
+    data = {
+        "name": "ring",
+        "parts": [{"id": p, "file": f"{p}.stl"} for p in parts],
+        "agents": {"H": {"side": "human"}, "R": {"side": "robot"}},
+        "base_part": "plate",
+        "operations": ops,
+    }
+    return spec_from_dict(data, source="ring.yaml"), relations(parts, contacts, blocks)

@@ -87,9 +87,31 @@ async function show(advice) {
                                   "data-worst": opt.worst, class: asked ? "asked" : "" });
     button.append(el("span", {}, `${opt.operation} ${opt.description} (${fmt(opt.cost)})`));
     button.append(el("span", { class: "worst" }, `worst case ${fmt(opt.worst)}`));
-    button.addEventListener("click", () => record(opt, "human"));
+    const alike = alikePick(opt);
+    button.addEventListener("click", () =>
+      record({ ...opt, operation: alike ? alike.value : opt.operation }, "human"));
     options.append(button);
+    if (alike) options.append(alike);
   }
+}
+
+// An option naming one of several alike parts (any of them is as good): a choice of which.
+function alikePick(opt) {
+  if (!opt.alike || opt.alike.length < 2) return null;
+  const pick = el("select", { class: "alike", "data-alike-for": opt.operation,
+                              title: "alike parts: any of them is as good" });
+  for (const op of opt.alike) {
+    const info = (state.planInfo.operations || {})[op];
+    const parts = info && info.parts ? info.parts.join(", ") : op;
+    pick.append(el("option", { value: op }, `${op} (${parts})`));
+  }
+  pick.value = opt.operation;
+  pick.addEventListener("click", (ev) => ev.stopPropagation());
+  return pick;
+}
+
+function alikeNote(item) {
+  return item.alike && item.alike.length > 1 ? ` (or alike: ${item.alike.slice(1).join(", ")})` : "";
 }
 
 async function record(move, who) {
@@ -152,7 +174,7 @@ async function showConcurrent(advice) {
     el("li", { "data-op": r.operation, "data-agent": r.agent },
       `${r.agent}: ${r.operation} ${describe(r.operation)} (${fmt(r.remaining)} left)`)));
   const told = advice.instructions.map((i) => i.operation === null
-    ? `${i.agent}: wait` : `${i.agent}: ${i.operation} ${i.description}`);
+    ? `${i.agent}: wait` : `${i.agent}: ${i.operation} ${i.description}${alikeNote(i)}`);
   document.getElementById("instruction").textContent = told.length
     ? `· the plan asks ${told.join("; ")}` : "";
   const options = document.getElementById("options");
@@ -182,13 +204,16 @@ async function showConcurrent(advice) {
       button.append(el("span", {}, ` (${fmt(opt.cost)} s)`));
     }
     button.append(el("span", { class: "worst" }, `worst case ${fmt(opt.worst)}`));
+    const alike = alikePick(opt);
     button.addEventListener("click", () => {
-      if (opt.deviation) state.deviated.add(opt.operation);
-      post({ kind: "started", operation: opt.operation, agent: opt.agent,
+      const op = alike ? alike.value : opt.operation;
+      if (opt.deviation) state.deviated.add(op);
+      post({ kind: "started", operation: op, agent: opt.agent,
              duration: pick ? Number(pick.value) : opt.cost });
     });
     options.append(button);
     if (pick) options.append(pick);
+    if (alike) options.append(alike);
   }
   for (const f of advice.finishes) {
     const button = el("button", { "data-kind": "finish", "data-op": f.operation,
