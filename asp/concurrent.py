@@ -86,10 +86,12 @@ DEFAULT_MAX_NODES = 3_000_000
 """Above this many game nodes the build stops with a ``ValueError``."""
 DEFAULT_MAX_K = 12
 """Largest deviation budget tried when looking for the flat part of the curve."""
-AUTO_TIME_LIMIT = 20.0
+AUTO_TIME_LIMIT = 10.0
 """Seconds for the whole CP-SAT makespan stage by default (:func:`assembly_makespan` with
-``time_limit=None``), its preparation included."""
-AUTO_PATIENCE = 4.0
+``time_limit=None``), its preparation included. A small assembly is proven optimal in well
+under a second; on the 72-part cycloidal drive every better schedule came within the first
+7 s of the search and the cuts after them gave nothing better (20 s bought nothing)."""
+AUTO_PATIENCE = 2.0
 """By default the CP-SAT makespan stage stops once neither a better schedule nor a new cut
 has come for this many seconds (or when it is proven optimal)."""
 MIN_SOLVE_S = 0.5
