@@ -471,9 +471,10 @@ def state_graph(
     on_step : callable, optional
         Called with a line for each round of automatic subassemblies.
     concurrent : bool
-        Reduce so that the concurrent game (and the CP-SAT schedule) keep their values too:
-        alike parts in a loose order, not a fixed one (more states;
-        :func:`asp.symmetry.symmetry_reduction`).
+        Reduce so that the concurrent game keeps its values too: alike parts in a loose
+        order, not a fixed one (more states; :func:`asp.symmetry.symmetry_reduction`). The
+        CP-SAT schedule keeps its value either way (it undoes a fixed order,
+        :mod:`asp.fixed_order`).
 
     Returns
     -------

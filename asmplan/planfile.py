@@ -40,7 +40,7 @@ from asp.dag import HUMAN, ROBOT, CodedLabels, GameDAG, ids_topological, index_d
 from asp.errors import FormatError
 from asp.metrics import adversarial_tax
 from asp.numbers import plain
-from asp.rules import close_kernel
+from asp.rules import close_kernel, edge_cost
 from asp.solve import Solution, node_order
 
 FORMAT = "asmplan-plan/2"
@@ -188,11 +188,7 @@ def policy_table(dag: GameDAG, solution: Solution) -> PolicyTable:
     index[nodes, turns] = np.arange(nodes.size)
     t = rules.kernel_tables(dag)
     ptr, edge, nxt, instruction = _moves_kernel(
-        t.indptr,
-        t.targets,
-        t.cost,
-        t.sides,
-        t.may_side,
+        *t.moves,
         t.tol,
         policy,
         nodes,
@@ -215,7 +211,20 @@ def policy_table(dag: GameDAG, solution: Solution) -> PolicyTable:
 
 @numba.njit(cache=True)
 def _moves_kernel(
-    indptr, targets, costs, sides, may_side, tol, policy, nodes, turns, index, value, coop, end
+    indptr,
+    targets,
+    costs,
+    codes,
+    sides,
+    may_side,
+    tol,
+    policy,
+    nodes,
+    turns,
+    index,
+    value,
+    coop,
+    end,
 ):  # pragma: no cover - compiled
     s_count = nodes.shape[0]
     ptr = np.zeros(s_count + 1, np.int64)
@@ -250,8 +259,9 @@ def _moves_kernel(
                 t = targets[e]
                 edge[j] = e
                 nxt[j] = index[t, ROBOT]
-                val = costs[e] + value[t, ROBOT]
-                cv = costs[e] + coop[t, ROBOT]
+                c = edge_cost(costs, codes, e)
+                val = c + value[t, ROBOT]
+                cv = c + coop[t, ROBOT]
                 same = close_kernel(val, best, tol)
                 if (
                     instruction[i] < 0

@@ -64,7 +64,11 @@ class Task:
 
 @dataclass(frozen=True)
 class ScheduleProblem:
-    """Tasks, precedences ``(before, after)`` (task indices), resources and tool states."""
+    """Tasks, precedences ``(before, after)`` (task indices), resources and tool states.
+
+    ``start_order`` (task index pairs ``(a, b)``: ``start[a] <= start[b]``) breaks the
+    symmetry of interchangeable tasks (:meth:`asp.fixed_order.FixedOrder.start_order`).
+    """
 
     name: str
     tasks: tuple[Task, ...]
@@ -72,6 +76,7 @@ class ScheduleProblem:
     resources: tuple[tuple[str, int], ...] = ()
     tool_initial: tuple[tuple[str, str], ...] = ()
     credit: str = ""
+    start_order: tuple[tuple[int, int], ...] = ()
 
 
 @dataclass(frozen=True)
@@ -451,6 +456,9 @@ def min_makespan(
     # Constraints: precedence, end <= start.
     for a, b in problem.precedences:
         model.add(end[a] <= start[b])
+    # Constraints: interchangeable tasks start in order (symmetry breaking).
+    for a, b in problem.start_order:
+        model.add(start[a] <= start[b])
 
     # Constraints: renewable resources (cumulative).
     for r, (_, capacity) in enumerate(problem.resources):
@@ -795,7 +803,7 @@ class AssemblySchedule:
         return max(self.chain_bound, self.load_bound)
 
 
-def assembly_schedule(spec, graph=None) -> AssemblySchedule:
+def assembly_schedule(spec, graph=None, *, fixed_order: bool = True) -> AssemblySchedule:
     """The scheduling problem of an assembly spec.
 
     Precedences are the explicit ``after`` ones plus, when the state graph is given, every
@@ -803,13 +811,27 @@ def assembly_schedule(spec, graph=None) -> AssemblySchedule:
     ``b`` done has ``a`` done: geometry and tool logic that act as plain precedence).
     Geometric alternatives that are not plain precedences (``a`` or ``c`` before ``b``) are
     relaxed. Under the tool model the bit-change times are part of the changing operations.
+
+    A graph whose alike operations are in a fixed order (:mod:`asp.fixed_order`) gives the
+    full graph's precedences instead (the chains are none) and the order in which the
+    blocks of a class start (``start_order``, symmetry breaking); ``fixed_order=False``
+    keeps the chains as precedences (the conservative schedule, for comparison).
     """
+    from asp.fixed_order import FixedOrder
+
     ops = spec.operations
     n = len(ops)
     index = {op.id: i for i, op in enumerate(ops)}
-    pred = [{index[a] for a in op.after} for op in ops]
+    fixed = None if graph is None or not fixed_order else FixedOrder.of_graph(graph)
+    chained = set() if fixed is None else fixed.chain_pairs()
+    pred = [
+        {index[a] for a in op.after if (index[a], b) not in chained} for b, op in enumerate(ops)
+    ]
     if graph is not None:
-        for b, mask in enumerate(implied_predecessors(graph)):
+        implied = implied_predecessors(graph)
+        if fixed is not None:
+            implied = fixed.implied(implied)
+        for b, mask in enumerate(implied):
             pred[b] |= {a for a in range(n) if mask >> a & 1}
     change = {t.name: t.change_time for t in spec.tools}
     either = {a.name for a in spec.agents if a.side == "any"}
@@ -837,6 +859,7 @@ def assembly_schedule(spec, graph=None) -> AssemblySchedule:
         precedences=precedences,
         tool_initial=tuple((t.name, t.initial) for t in spec.tools),
         credit=spec.credit,
+        start_order=() if fixed is None else fixed.start_order(),
     )
     shortest = [min(d for _, d in t.modes) for t in tasks]
     finish = [0.0] * n
@@ -934,6 +957,10 @@ def schedule_violation(model, rows: list[dict]) -> tuple[str, list[tuple[int, in
     (``y`` before ``x`` whenever ``y`` ends by the time ``x`` starts) is a path of the state
     graph, whichever of two overlapping operations finishes first.
 
+    On a graph whose alike operations are in a fixed order (``model.fixed``), the order is
+    undone (:mod:`asp.fixed_order`): each block of alike operations must be done in its
+    order (a derived precedence, its own cut), then the transitions are looked up by label.
+
     Returns
     -------
     (message, cut) or None
@@ -956,6 +983,12 @@ def schedule_violation(model, rows: list[dict]) -> tuple[str, list[tuple[int, in
     for r in rows:
         if r["agent"] not in workers:
             return f"operation {r['task']}: unknown agent {r['agent']!r}", []
+    fixed = getattr(model, "fixed", None)
+    if fixed is not None:  # relabelling needs each block of alike operations in its order
+        for b in range(n):
+            for a in fixed.block_before(b):
+                if end[a] > start[b]:
+                    return f"operation {ids[b]} starts before {ids[a]} ends", [(a, b)]
     state, done = 0, set()
     by_end = sorted(range(n), key=lambda i: (end[i], start[i]))
     for t in [*sorted(set(start.values())), math.inf]:
@@ -1060,8 +1093,16 @@ def list_schedule(model, problem: ScheduleProblem, sequence=None) -> list[dict] 
         running = sorted([i for i in start if start[i] <= t < end[i]] + ([x] if d > 0 else []))
         return _together_violation(model, cur, set(done), running) is None
 
+    fixed = getattr(model, "fixed", None)
     for step in range(n):
-        cands = [order[step]] if order is not None else [o for o in range(n) if o not in start]
+        if order is not None:
+            cands = [order[step]]
+        else:  # of alike operations, the first one not placed
+            cands = [
+                o
+                for o in range(n)
+                if o not in start and (fixed is None or not fixed.waiting(o, start))
+            ]
         best = None
         for o in cands:
             nxt = model.steps.get((state, o))
@@ -1069,8 +1110,16 @@ def list_schedule(model, problem: ScheduleProblem, sequence=None) -> list[dict] 
                 if order is not None:
                     return None
                 continue
+            ready = 0  # each block of alike operations in its order
+            if fixed is not None:
+                before = fixed.block_before(o)
+                if any(a not in start for a in before):
+                    if order is not None:
+                        return None
+                    continue
+                ready = max((end[a] for a in before), default=0)
             for agent, d in modes[o]:
-                lo = max(last, free.get(agent, 0))
+                lo = max(last, free.get(agent, 0), ready)
                 times = [lo, *sorted({e for e in end.values() if e > lo})]
                 t = next(t for t in times if fits(o, t, d))
                 key = (t + d, t, o, agent, nxt[0])

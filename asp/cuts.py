@@ -32,6 +32,11 @@ a part waits for or the parts that would block it.
 ``B`` can hold millions of sets on a large state graph. The shrinking runs on a sample of
 them and the result is checked against all; sets that break it join the sample and the
 shrinking starts again (a few rounds at most), so a cut costs a few passes over ``B``.
+
+On a graph whose alike operations are in a fixed order (:mod:`asp.fixed_order`), ``B``
+holds the sorted states only: the cut is found for the sorted done set and stated again
+with counts per position (:meth:`asp.fixed_order.FixedOrder.actual`), so that it holds for
+every state of an orbit.
 """
 
 from __future__ import annotations
@@ -67,12 +72,16 @@ class PlacementCuts:
     combined : bool
         Whether cuts with both ``Y`` and ``X`` are allowed (their proof needs every
         operation to take time); else only ``X`` or ``Y`` empty.
+    fixed : asp.fixed_order.FixedOrder, optional
+        The graph's fixed order of alike operations, undone (``steps`` then has its labels).
     """
 
-    def __init__(self, graph, steps: LiveSteps | None = None, *, combined: bool = True):
+    def __init__(self, graph, steps: LiveSteps | None = None, *, combined: bool = True, fixed=None):
         self.graph = graph
         self.combined = combined
-        self.steps = LiveSteps(graph) if steps is None else steps
+        self.fixed = fixed
+        label = None if fixed is None else fixed.label
+        self.steps = LiveSteps(graph, label=label) if steps is None else steps
         self.n = graph.model.n_ops
         keys = np.asarray(graph.keys, dtype=np.uint64)
         self.width = 1 if keys.ndim == 1 else int(keys.shape[1])
@@ -81,7 +90,9 @@ class PlacementCuts:
         self._rows: dict[int, np.ndarray] = {}
 
     def rows(self, b: int) -> np.ndarray:
-        """(k, W) uint64: the done words of the sets ``B`` of operation ``b``."""
+        """(k, W) uint64: the done words of the sets ``B`` of operation ``b`` (of its label:
+        the states with a step of its chain)."""
+        b = self.steps.key(b)
         hit = self._rows.get(b)
         if hit is not None:
             return hit
@@ -107,6 +118,13 @@ class PlacementCuts:
     def sets(self, done: set[int], b: int) -> tuple[list[int], list[int]] | None:
         """The shrunk ``(Y, X)`` for ``b`` after ``done`` with the fewest literals, or None
         when even the full sets do not hold (module docstring)."""
+        if self.fixed is not None:
+            sorted_done, sorted_b = self.fixed.canonical(done, b)
+            found = self._sets(sorted_done, sorted_b)
+            return None if found is None else self.fixed.actual(*found, done, b)
+        return self._sets(done, b)
+
+    def _sets(self, done: set[int], b: int) -> tuple[list[int], list[int]] | None:
         rows = self.rows(b)
         ys = np.array([y for y in range(self.n) if y not in done and y != b], dtype=np.int64)
         xs = np.array(sorted(done), dtype=np.int64)

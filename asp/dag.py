@@ -47,6 +47,7 @@ __all__ = [
     "PLAYERS",
     "ROBOT",
     "SIDE_NAMES",
+    "CodedCosts",
     "GameDAG",
     "compact_costs",
     "from_arrays",
@@ -109,6 +110,96 @@ class CodedLabels(Sequence):
         return f"CodedLabels({len(self)} edges, names={self.names!r})"
 
 
+class CodedCosts:
+    """Edge costs stored as a small integer code per edge into a table of distinct costs.
+
+    A game of an assembly has tens of millions of edges but few distinct costs (the
+    durations of the operations by each agent): one int8 (or int16) code per edge instead
+    of a float32 (a quarter of the memory). Reads like the float array it stands for:
+    index it (an int gives one cost, an index array or a slice the costs), ``len``,
+    ``shape``, ``size``, ``dtype`` (the table's), comparisons, ``np.asarray`` (the whole
+    array, made on each call), ``tolist``, ``astype``, ``min``, ``max``. The compiled
+    kernels read ``table[codes[e]]`` (:func:`asp.rules.kernel_tables`).
+
+    Attributes
+    ----------
+    codes : (m,) int8 or int16
+        Index into ``table`` of each edge's cost.
+    table : (k,) float32 or float64
+        The distinct costs (:func:`compact_costs`: float32 only when exact).
+    """
+
+    __slots__ = ("codes", "table")
+
+    def __init__(self, codes: np.ndarray, table: np.ndarray) -> None:
+        self.codes = np.asarray(codes)
+        self.table = compact_costs(table)
+
+    def __len__(self) -> int:
+        return int(self.codes.shape[0])
+
+    @property
+    def shape(self) -> tuple[int]:
+        return self.codes.shape
+
+    @property
+    def size(self) -> int:
+        return int(self.codes.size)
+
+    @property
+    def ndim(self) -> int:
+        return 1
+
+    @property
+    def dtype(self) -> np.dtype:
+        return self.table.dtype
+
+    def __getitem__(self, i):
+        return self.table[self.codes[i]]
+
+    def __array__(self, dtype=None, copy=None) -> np.ndarray:
+        out = self.table[self.codes]
+        return out if dtype is None else out.astype(dtype, copy=False)
+
+    def __iter__(self):
+        return iter(np.asarray(self))
+
+    def tolist(self) -> list:
+        return np.asarray(self).tolist()
+
+    def astype(self, dtype, copy: bool = True) -> np.ndarray:
+        return np.asarray(self, dtype=dtype)
+
+    def min(self):
+        return self.table[np.unique(self.codes)].min()
+
+    def max(self):
+        return self.table[np.unique(self.codes)].max()
+
+    def __eq__(self, other):
+        return np.asarray(self) == other
+
+    def __ne__(self, other):
+        return np.asarray(self) != other
+
+    def __lt__(self, other):
+        return np.asarray(self) < other
+
+    def __le__(self, other):
+        return np.asarray(self) <= other
+
+    def __gt__(self, other):
+        return np.asarray(self) > other
+
+    def __ge__(self, other):
+        return np.asarray(self) >= other
+
+    __hash__ = None
+
+    def __repr__(self) -> str:
+        return f"CodedCosts({len(self)} edges, table={self.table!r})"
+
+
 @dataclass(frozen=True, eq=False)
 class GameDAG:
     """A validated game DAG.
@@ -123,9 +214,10 @@ class GameDAG:
     targets : (m,) int32 or int64
         Head node index of each edge (:func:`index_dtype`: int32 up to
         :data:`INT32_NODES` nodes).
-    costs : (m,) float32 or float64
+    costs : (m,) float32 or float64, or CodedCosts
         Cost of each edge (``>= 0``; :func:`compact_costs`: float32 only when every cost is
-        exactly a float32, so a cost read from it is the cost given).
+        exactly a float32, so a cost read from it is the cost given). A game of an
+        assembly stores them as :class:`CodedCosts` (a code per edge into a table).
     sides : (m,) int8
         Who may take each edge: ``ROBOT``, ``HUMAN`` or ``ANY``.
     start, end : int

@@ -195,12 +195,30 @@ def first_rows(keys):
 
 @numba.njit(cache=True, nogil=True)
 def stuck(
-    keys, parts, op_word, op_bit, part_of, blocked, directions, workspace, unit_op, unit_masks
+    keys,
+    parts,
+    parent_keys,
+    parent_parts,
+    after,
+    op_word,
+    op_bit,
+    part_of,
+    blocked,
+    directions,
+    workspace,
+    unit_op,
+    unit_masks,
 ):
     """(k,) bool: some operation not done places a part (or unit) that is blocked along
     every allowed direction by the parts already in the set it is tested against (it can
     never be done: parts are never removed, a workspace's members leave only with its
     finished unit).
+
+    With ``after``, each state is reached by one operation from a state that is not stuck
+    (row ``s`` of ``parent_keys`` (k, W) and ``parent_parts`` (k, PW)): only the operations
+    whose part the parts new to its set (not in the parent's) block along some allowed
+    direction are tested; for any other, the direction that was clear in the parent still
+    is. Without it every operation is tested (the parent arrays are not read).
 
     Same arrays as :func:`enabled_single`.
     """
@@ -208,20 +226,37 @@ def stuck(
     pw = parts.shape[1]
     n_ops = op_word.shape[0]
     zero = np.uint64(0)
+    reach = np.zeros((blocked.shape[0], pw), dtype=np.uint64)  # blocked along any direction
+    for p in range(blocked.shape[0]):
+        for d in range(6):
+            if directions[d]:
+                for w in range(pw):
+                    reach[p, w] |= blocked[p, d, w]
     out = np.zeros(k, dtype=np.bool_)
     main = np.empty(pw, dtype=np.uint64)
+    before = np.empty(pw, dtype=np.uint64)
     scratch = np.empty(pw, dtype=np.uint64)
     for s in range(k):
         _main_set(keys, parts, s, op_word, op_bit, unit_op, unit_masks, main)
+        if after:
+            _main_set(parent_keys, parent_parts, s, op_word, op_bit, unit_op, unit_masks, before)
         for i in range(n_ops):
             p = part_of[i]
             if p < 0 or (keys[s, op_word[i]] & op_bit[i]) != zero:
                 continue
             cur = main
+            new = not after
             if workspace[i] >= 0:
                 _workspace_set(parts, s, workspace[i], unit_masks, scratch)
                 cur = scratch
-            if not _free(cur, blocked, p, directions):
+                for w in range(pw):
+                    if after and scratch[w] & ~parent_parts[s, w] & reach[p, w]:
+                        new = True
+            elif after:
+                for w in range(pw):
+                    if main[w] & ~before[w] & reach[p, w]:
+                        new = True
+            if new and not _free(cur, blocked, p, directions):
                 out[s] = True
                 break
     return out

@@ -350,6 +350,11 @@ class OperationModel:
         ``spec``, ``symmetric`` or ``loose``): each transposition of two blocks of a class
         (position by position) is a symmetry of the game. Recorded for the runtime
         (``plan.json``'s ``interchangeable``); the model's moves do not read it.
+    fixed : tuple of classes of blocks of operation indices
+        Interchangeable blocks the spec puts in a fixed order: at every position ``i``, the
+        ``i``-th operations of the blocks are chained in block order by ``after``
+        (:func:`asp.symmetry.symmetry_reduction`). Only read by the schedule stage, which
+        undoes that order (:mod:`asp.fixed_order`).
     """
 
     spec: AssemblySpec
@@ -375,6 +380,7 @@ class OperationModel:
     symmetric: tuple[tuple[tuple[int, ...], ...], ...] = ()
     loose: tuple[tuple[int, tuple[int, ...]], ...] = ()
     interchangeable: tuple[tuple[tuple[str, ...], ...], ...] = ()
+    fixed: tuple[tuple[tuple[int, ...], ...], ...] = ()
 
     @property
     def n_ops(self) -> int:
@@ -516,21 +522,33 @@ class OperationModel:
         self._symmetries(keys, ok)
         return ok
 
-    def stuck(self, keys: np.ndarray, parts: np.ndarray) -> np.ndarray:
+    def stuck(self, keys: np.ndarray, parts: np.ndarray, parents=None) -> np.ndarray:
         """(k,) bool: some operation not done places a part (or unit) that the parts already
         in the set it is tested against block along every allowed direction, so it can never
         be done (a dead end). Always False for specs off the compiled path (an operation
-        placing several parts)."""
+        placing several parts).
+
+        ``parents`` (optional): the keys and parts of a state each of ``keys`` is reached
+        from by one operation, none of them stuck; then only the operations whose part the
+        parts new to its set could block are tested (:func:`asp.enabled_kernel.stuck`,
+        the same result).
+        """
         keys = self._keys(keys)
         if self._kernel_args is None:
             return np.zeros(keys.shape[0], dtype=bool)
         from asp.enabled_kernel import stuck
 
         a = self._kernel_args
+        keys = np.ascontiguousarray(keys)
         sets = np.ascontiguousarray(self.oracle.sets(parts))
-        return stuck(
-            np.ascontiguousarray(keys), sets, a[0], a[1], a[5], a[9], a[11], a[16], a[17], a[18]
-        )
+        before = (keys, sets)  # not read without parents
+        if parents is not None:
+            before = (
+                np.ascontiguousarray(self._keys(parents[0])),
+                np.ascontiguousarray(self.oracle.sets(parents[1])),
+            )
+        tables = (a[0], a[1], a[5], a[9], a[11], a[16], a[17], a[18])
+        return stuck(keys, sets, *before, parents is not None, *tables)
 
     @functools.cached_property
     def _kernel_args(self) -> tuple | None:
@@ -615,6 +633,17 @@ class OperationModel:
                 twin = (codes[:, :j] == codes[:, j : j + 1]).any(axis=1)
                 ok[:, list(blocks[j])] &= ~twin[:, None]
 
+    def parts_of(self, keys: np.ndarray) -> np.ndarray:
+        """(k, PW) uint64: the parts placed in each state, every workspace (the base part
+        when on the fixture from the start, and the parts of every done operation)."""
+        keys = self._keys(keys)
+        parts = np.empty((keys.shape[0], self.oracle.n_words), dtype=np.uint64)
+        parts[:] = pack_words([self.initial_parts], self.oracle.n_words)
+        for i in range(self.n_ops):
+            if self.op_parts[i].any():
+                parts[self.has_op(keys, i)] |= self.op_parts[i]
+        return parts
+
     def pending_units(self, keys: np.ndarray) -> np.ndarray | None:
         """(k, PW) uint64: members of the subassemblies not yet inserted, per state."""
         if not self.unit_ops:
@@ -698,6 +727,7 @@ def operation_model(
     symmetric=(),
     loose=(),
     interchangeable=(),
+    fixed=(),
 ) -> OperationModel:
     """Compile ``spec`` (and the cad relations, if any) into an :class:`OperationModel`.
 
@@ -707,7 +737,8 @@ def operation_model(
     of which only the first of equal blocks moves (:meth:`OperationModel.enabled`);
     ``loose``: classes of interchangeable operation ids with their slack, ``(m, ids)``
     (:attr:`OperationModel.loose`); ``interchangeable``: the classes of blocks the
-    reduction used (:attr:`OperationModel.interchangeable`).
+    reduction used (:attr:`OperationModel.interchangeable`); ``fixed``: classes of blocks
+    of operation ids the spec puts in a fixed order (:attr:`OperationModel.fixed`).
 
     Raises
     ------
@@ -795,6 +826,7 @@ def operation_model(
         interchangeable=tuple(
             tuple(tuple(str(o) for o in block) for block in cls) for cls in interchangeable
         ),
+        fixed=tuple(tuple(tuple(index[o] for o in block) for block in cls) for cls in fixed),
     )
 
 

@@ -15,7 +15,7 @@ import numba
 import numpy as np
 
 from asp import rules
-from asp.dag import ANY, HUMAN, ROBOT, CodedLabels, GameDAG, index_dtype
+from asp.dag import ANY, HUMAN, ROBOT, CodedCosts, CodedLabels, GameDAG, index_dtype
 from asp.errors import GameError
 from asp.state_graph import StateGraph
 
@@ -113,7 +113,8 @@ def game_dag(
         raise GameError(f"{spec.source}: no complete sequence: the game has no path to the end")
     if not ordered:
         raise GameError(f"{spec.source}: internal: the game DAG is not in topological order")
-    if costs.size and not (np.all(np.isfinite(costs)) and costs.min() >= 0):
+    values = costs.table if isinstance(costs, CodedCosts) else costs
+    if values.size and not (np.all(np.isfinite(values)) and values.min() >= 0):
         raise GameError(f"{spec.source}: internal: a move has a negative or non-finite cost")
     # Built as a DAG in topological order (checked above): no validation pass needed.
     return GameDAG(
@@ -159,8 +160,10 @@ def _build_edges(
     """The game's CSR arrays: ``indptr, targets, costs, sides, operation codes, agent codes``
     and whether every edge goes to a higher node index.
 
-    Costs are float32 when every one is exactly a float32 (:func:`asp.dag.compact_costs`),
-    else float64: built as float32 first, again as float64 when one is not exact.
+    Without tool changes a move's cost is its (operation, agent) slot's: the costs are
+    :class:`asp.dag.CodedCosts`, a code per edge into the distinct durations. Else they are
+    float32 when every one is exactly a float32 (:func:`asp.dag.compact_costs`), else
+    float64: built as float32 first, again as float64 when one is not exact.
     """
     counts = _edge_counts(graph.src, graph.dst, graph.op, keep, alive, new_id, per_op, n)
     indptr = np.zeros(n + 1, dtype=np.int64)
@@ -168,6 +171,18 @@ def _build_edges(
     del counts
     m = int(indptr[-1])
     tables = (graph.src, graph.dst, graph.op, keep, alive, new_id, op_first, flat_agent)
+    table, slot_code = np.unique(flat_time, return_inverse=True)
+    if extra.shape[0] == 0 and table.size <= np.iinfo(np.int16).max:
+        arrays = (
+            np.empty(m, new_id.dtype),
+            np.empty(m, _code_type(table.size)),
+            np.empty(m, np.int8),
+            np.empty(m, _code_type(len(graph.spec.operations))),
+            np.empty(m, flat_agent.dtype),
+        )
+        _, ordered = _fill_edges(*tables, slot_code.astype(np.int64), side, extra, *arrays)
+        targets, codes, *rest = arrays
+        return (indptr, targets, CodedCosts(codes, table), *rest, ordered)
     for cost_type in (np.float32, np.float64):
         arrays = (
             np.empty(m, new_id.dtype),

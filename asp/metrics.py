@@ -34,7 +34,7 @@ from asp import rules
 from asp.dag import GameDAG
 from asp.errors import GameError
 from asp.numbers import plain
-from asp.rules import HUMAN, ROBOT, close_kernel
+from asp.rules import HUMAN, ROBOT, close_kernel, edge_cost
 from asp.solve import PolicyEvaluation, Solution, evaluate_policy, node_order, play, solve
 
 DEFAULT_GAMES = 1000
@@ -187,6 +187,7 @@ def probability_within(
         t.indptr,
         t.targets,
         t.cost,
+        t.code,
         t.may,
         np.asarray(robot_policy, dtype=np.int64),
         order,
@@ -276,7 +277,7 @@ def _arrive(
 
 @numba.njit(cache=True)
 def _within_kernel(
-    indptr, targets, cost, may, policy, order, position, worst, best, start, bound, tol, cap
+    indptr, targets, cost, code, may, policy, order, position, worst, best, start, bound, tol, cap
 ):  # pragma: no cover - compiled
     """P(cost <= bound) by the forward budget program (see :func:`probability_within`);
     -1 past ``cap`` arrivals.
@@ -303,7 +304,14 @@ def _within_kernel(
         if p == ROBOT and policy[v] >= 0 and may[ROBOT, policy[v]]:
             e = policy[v]
             heap, size = _arrive(
-                heap, size, sums, targets[e], HUMAN, budget - cost[e], prob, *tables
+                heap,
+                size,
+                sums,
+                targets[e],
+                HUMAN,
+                budget - edge_cost(cost, code, e),
+                prob,
+                *tables,
             )
             continue
         count = 0
@@ -316,7 +324,7 @@ def _within_kernel(
             continue
         for e in range(indptr[v], indptr[v + 1]):
             if may[HUMAN, e]:
-                t, left = targets[e], budget - cost[e]
+                t, left = targets[e], budget - edge_cost(cost, code, e)
                 heap, size = _arrive(heap, size, sums, t, ROBOT, left, prob / count, *tables)
     return sums[0] + sums[1]
 

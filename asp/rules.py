@@ -231,9 +231,13 @@ class KernelTables:
         CSR row pointer of out-edges.
     targets : (m,) int32 or int64
         Head of each edge (the next node), as the DAG stores it.
-    cost : (m,) float32 or float64
+    cost : (m,) or (k,) float32 or float64
         Cost of each move (:func:`move_costs`) as the DAG stores it (float32 only when
-        exact); the kernels add costs in float64.
+        exact); the kernels add costs in float64. With ``code``, the table of distinct
+        costs (:class:`asp.dag.CodedCosts`).
+    code : (m,) int8 or int16, or (0,) int8
+        Index into ``cost`` of each edge's cost, or empty when ``cost`` is per edge; a
+        kernel reads a cost with :func:`edge_cost`.
     sides : (m,) int8
         The side of each edge.
     may_side : (3, 2) bool
@@ -247,9 +251,16 @@ class KernelTables:
     indptr: np.ndarray
     targets: np.ndarray
     cost: np.ndarray
+    code: np.ndarray
     sides: np.ndarray
     may_side: np.ndarray
     tol: float
+
+    @property
+    def moves(self) -> tuple:
+        """``(indptr, targets, cost, code, sides, may_side)``: the arguments a kernel that
+        plays the game takes first."""
+        return self.indptr, self.targets, self.cost, self.code, self.sides, self.may_side
 
     @property
     def may(self) -> np.ndarray:
@@ -263,12 +274,22 @@ def side_table() -> np.ndarray:
     return np.asarray(may_take(sides, np.array(PLAYERS)[None, :]), dtype=bool)
 
 
+@numba.njit(cache=True, inline="always")
+def edge_cost(cost, code, e):  # pragma: no cover - compiled
+    """The cost of edge ``e`` in a kernel (``cost``, ``code`` of :class:`KernelTables`)."""
+    if code.shape[0]:
+        return cost[code[e]]
+    return cost[e]
+
+
 def kernel_tables(dag) -> KernelTables:
     """The tables the compiled kernels play by."""
+    coded = hasattr(dag.costs, "codes")  # asp.dag.CodedCosts (asp.dag imports this module)
     return KernelTables(
         indptr=dag.indptr,
         targets=dag.targets,
-        cost=np.ascontiguousarray(dag.costs),
+        cost=dag.costs.table if coded else np.ascontiguousarray(dag.costs),
+        code=dag.costs.codes if coded else np.zeros(0, np.int8),
         sides=np.ascontiguousarray(dag.sides, dtype=np.int8),
         may_side=side_table(),
         tol=COST_TOL,
@@ -339,6 +360,7 @@ __all__ = [
     "cost_at_most",
     "costs_close",
     "has_move",
+    "edge_cost",
     "kernel_tables",
     "may_take",
     "move_cost",

@@ -28,7 +28,7 @@ import numpy as np
 from asp import rules
 from asp.dag import GameDAG, ids_topological, topological_order
 from asp.errors import GameError
-from asp.rules import HUMAN, ROBOT
+from asp.rules import HUMAN, ROBOT, edge_cost
 from asp.rules import close_kernel as _close
 
 NO_MOVE = rules.PASS
@@ -73,9 +73,7 @@ def node_order(dag: GameDAG) -> np.ndarray:
 def solve(dag: GameDAG) -> Solution:
     """Solve the game exactly: TCT, W*, the robust robot policy and the human's best reply."""
     t = rules.kernel_tables(dag)
-    value, coop, expected, robot, human = _solve_kernel(
-        t.indptr, t.targets, t.cost, t.sides, t.may_side, node_order(dag), t.tol
-    )
+    value, coop, expected, robot, human = _solve_kernel(*t.moves, node_order(dag), t.tol)
     return Solution(
         tct=float(coop[dag.start, ROBOT]),
         minimax=float(value[dag.start, ROBOT]),
@@ -126,9 +124,7 @@ def evaluate_policy(dag: GameDAG, robot_policy: np.ndarray | Mapping) -> PolicyE
     """
     policy = as_policy_array(dag, robot_policy)
     t = rules.kernel_tables(dag)
-    worst, expected, best, reply = _evaluate_kernel(
-        t.indptr, t.targets, t.cost, t.sides, t.may_side, node_order(dag), policy, t.tol
-    )
+    worst, expected, best, reply = _evaluate_kernel(*t.moves, node_order(dag), policy, t.tol)
     bad = _first_invalid_state(dag, policy, worst)
     if bad >= 0:
         raise GameError(
@@ -214,7 +210,7 @@ def robust_path(dag: GameDAG, solution: Solution) -> list:
 
 @numba.njit(cache=True)
 def _solve_kernel(
-    indptr, targets, costs, sides, may_side, order, tol
+    indptr, targets, costs, codes, sides, may_side, order, tol
 ):  # pragma: no cover - compiled
     n = indptr.shape[0] - 1
     value = np.zeros((n, 2))
@@ -233,7 +229,7 @@ def _solve_kernel(
         h_val, h_sum, h_coop, h_arg, h_cnt = -np.inf, 0.0, np.inf, -1, 0
         for e in range(lo, hi):
             t = targets[e]
-            c = costs[e]
+            c = edge_cost(costs, codes, e)
             if may_side[sides[e], ROBOT]:
                 val = c + value[t, HUMAN]
                 ex = c + expected[t, HUMAN]
@@ -273,7 +269,7 @@ def _solve_kernel(
 
 @numba.njit(cache=True)
 def _evaluate_kernel(
-    indptr, targets, costs, sides, may_side, order, policy, tol
+    indptr, targets, costs, codes, sides, may_side, order, policy, tol
 ):  # pragma: no cover
     n = indptr.shape[0] - 1
     worst = np.zeros((n, 2))
@@ -289,7 +285,7 @@ def _evaluate_kernel(
         h_worst, h_sum, h_best, h_cnt = -np.inf, 0.0, np.inf, 0
         for e in range(lo, hi):
             t = targets[e]
-            c = costs[e]
+            c = edge_cost(costs, codes, e)
             if may_side[sides[e], ROBOT]:
                 robot_moves = True
             if may_side[sides[e], HUMAN]:
@@ -311,9 +307,10 @@ def _evaluate_kernel(
                 best[v, ROBOT] = np.nan
             else:
                 t = targets[e]
-                worst[v, ROBOT] = costs[e] + worst[t, HUMAN]
-                expected[v, ROBOT] = costs[e] + expected[t, HUMAN]
-                best[v, ROBOT] = costs[e] + best[t, HUMAN]
+                c = edge_cost(costs, codes, e)
+                worst[v, ROBOT] = c + worst[t, HUMAN]
+                expected[v, ROBOT] = c + expected[t, HUMAN]
+                best[v, ROBOT] = c + best[t, HUMAN]
         else:
             worst[v, ROBOT], expected[v, ROBOT], best[v, ROBOT] = (
                 worst[v, HUMAN],

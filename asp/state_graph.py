@@ -64,20 +64,16 @@ class StateGraph:
     keys : (N, W) uint64
         State keys (``W`` words each, see :class:`asp.feasibility.OperationModel`), layer by
         layer; state 0 is the start.
-    parts : (N, PW) uint64
-        Assembled-part set of each state (``PW`` words, see
-        :class:`asp.feasibility.InsertionOracle`; any number of parts).
     layer_ptr : (L + 2,) int64
         States of layer ``l`` (``l`` operations done) are ``layer_ptr[l]:layer_ptr[l + 1]``.
     src, dst : (E,) int32
         Transitions (state indices), sorted by ``src``.
-    op : (E,) int16
-        Operation index of each transition.
+    op : (E,) int8 or int16
+        Operation index of each transition (int8 up to 127 operations).
     """
 
     model: OperationModel
     keys: np.ndarray
-    parts: np.ndarray
     layer_ptr: np.ndarray
     src: np.ndarray
     dst: np.ndarray
@@ -94,6 +90,14 @@ class StateGraph:
     @property
     def n_transitions(self) -> int:
         return int(self.src.shape[0])
+
+    @property
+    def parts(self) -> np.ndarray:
+        """(N, PW) uint64: assembled-part set of each state (``PW`` words, see
+        :class:`asp.feasibility.InsertionOracle`), computed from the keys on each call
+        (:meth:`asp.feasibility.OperationModel.parts_of`): not stored, a state's parts are
+        those of its done operations."""
+        return self.model.parts_of(self.keys)
 
     @property
     def complete(self) -> np.ndarray:
@@ -231,7 +235,7 @@ def build_state_graph(
     index_type = np.int32 if max_states < 2**31 else np.int64
     keys = model.pack([model.start_key])
     parts = pack_words([model.initial_parts], model.oracle.n_words)
-    key_layers, part_layers = [keys], [parts]
+    key_layers = [keys]
     src_l, dst_l, op_l = [], [], []
     offset, total = 0, 1
     t0 = shown = time.perf_counter()
@@ -252,7 +256,7 @@ def build_state_graph(
             si, oi = np.nonzero(model.enabled(keys[lo:hi], parts[lo:hi]))
             if si.size:
                 si = si.astype(index_type) + index_type(lo)
-                found.add(model, keys, parts, si, oi, drop_stuck)
+                found.add(model, keys, parts, si, oi, drop_stuck, layer > 0)
             at_least = total + found.at_least(layer + 1, max_states - total)
             if at_least > max_states:
                 raise _too_many(
@@ -273,7 +277,6 @@ def build_state_graph(
         offset += keys.shape[0]
         keys, parts = uniq, new_parts
         key_layers.append(keys)
-        part_layers.append(parts)
         total += keys.shape[0]
         line = (
             f"  layer {layer + 1}/{n_ops}: {keys.shape[0]:,} states, {n_new:,} "
@@ -298,11 +301,10 @@ def build_state_graph(
     graph = StateGraph(
         model=model,
         keys=_join(key_layers, np.uint64),
-        parts=_join(part_layers, np.uint64),
         layer_ptr=layer_ptr,
         src=_join(src_l, index_type),
         dst=_join(dst_l, index_type),
-        op=_join(op_l, np.int16),
+        op=_join(op_l, op_type(n_ops)),
     )
     if check and not graph.complete.any():
         raise SpecError(infeasibility_report(graph))
@@ -381,9 +383,7 @@ def _why_not(graph: StateGraph, i: int, state: int, placed_ever: int) -> tuple[b
     spec, oracle = model.spec, model.oracle
     op = spec.operations[i]
     keys = graph.keys[state : state + 1]
-    assembled, workspace = model.assembled_for(
-        i, graph.parts[state : state + 1], model.pending_units(keys)
-    )
+    assembled, workspace = model.assembled_for(i, model.parts_of(keys), model.pending_units(keys))
     s = unpack_words(assembled[0])
     missing = ((1 << len(oracle.parts)) - 1) & ~placed_ever
     why, root = [], False
@@ -440,7 +440,9 @@ def _dead_end(graph: StateGraph) -> str:
         if not op.parts:
             why.append(f"operation {op.id} is not ready")
             continue
-        _, detail = _why_not(graph, i, last, unpack_words(graph.parts[last]))
+        _, detail = _why_not(
+            graph, i, last, unpack_words(graph.model.parts_of(graph.keys[last : last + 1])[0])
+        )
         why.append(f"part {', '.join(op.parts)} (operation {op.id}) cannot be inserted ({detail})")
     return (
         f"every order ends in a dead end; the furthest, after {graph.label(last)} "
@@ -473,15 +475,19 @@ class _Layer:
         self.n_merged = 0  # chunks merged into it
         self.unmerged = 0  # chunk-distinct keys added since
 
-    def add(self, model, keys, parts, si, oi, drop_stuck: bool) -> None:
-        """The moves ``si`` (states of the layer) x ``oi`` (operations) of one chunk."""
-        oi = oi.astype(np.int16)
+    def add(self, model, keys, parts, si, oi, drop_stuck: bool, checked: bool = False) -> None:
+        """The moves ``si`` (states of the layer) x ``oi`` (operations) of one chunk.
+
+        ``checked``: no state of the layer is stuck (each passed the test when it was
+        found), so a successor is tested only for what its new part changes."""
+        oi = oi.astype(op_type(model.n_ops))
         succ = model.successor_keys(keys[si], oi)
         firsts, inv = _distinct_rows(succ)
         succ = succ[firsts]
         succ_parts = parts[si[firsts]] | model.op_parts[oi[firsts]]
         if drop_stuck:
-            keep = ~model.stuck(succ, succ_parts)
+            parents = (keys[si[firsts]], parts[si[firsts]]) if checked else None
+            keep = ~model.stuck(succ, succ_parts, parents)
             if not keep.all():
                 live = keep[inv]
                 si, oi, inv = si[live], oi[live], (np.cumsum(keep) - 1)[inv[live]]
@@ -525,6 +531,11 @@ class _Layer:
         return out
 
 
+def op_type(n_ops: int) -> type:
+    """The narrowest integer type of a transition's operation index (int8 or int16)."""
+    return np.int8 if n_ops <= np.iinfo(np.int8).max else np.int16
+
+
 def _distinct_rows(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The index of each distinct row's first occurrence, and each row's distinct number."""
     from asp.enabled_kernel import first_rows
@@ -534,7 +545,7 @@ def _distinct_rows(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def _join(layers: list[np.ndarray], dtype) -> np.ndarray:
     """Concatenate the per-layer arrays and empty the list (one array's copy at a time)."""
-    out = np.concatenate(layers) if layers else np.empty(0, dtype=dtype)
+    out = np.concatenate(layers).astype(dtype, copy=False) if layers else np.empty(0, dtype)
     layers.clear()
     return out
 

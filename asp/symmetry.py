@@ -702,7 +702,9 @@ def reduce_interchangeable(spec: AssemblySpec, relations) -> AssemblySpec:
 def _reduced(spec: AssemblySpec, relations, concurrent: bool):
     """:func:`reduce_interchangeable` and, with ``concurrent``, the chains of the classes
     of blocks kept in a loose order instead, with their slack (``(m, ids)`` for
-    :func:`asp.feasibility.operation_model`'s ``loose``), and the classes of blocks ordered.
+    :func:`asp.feasibility.operation_model`'s ``loose``), the classes of blocks ordered,
+    and those put in a fixed order at every position (``fixed``, for
+    :attr:`asp.feasibility.OperationModel.fixed`).
 
     The slack of position ``p`` of a class's blocks is ``s(p) = s(p - 1) + m(p)``, ``m(p)``
     the :func:`class_slack` of the operations at ``p`` (``s(-1) = 0``): the block to move,
@@ -712,12 +714,12 @@ def _reduced(spec: AssemblySpec, relations, concurrent: bool):
     model, why, _ = _derive(spec, relations)
     if model is None:
         if why:
-            return spec, [], []
+            return spec, [], [], []
         base, classes = spec, [[[o] for o in cls] for cls in _exact_classes(spec, relations)]
     else:
         base = with_derived_precedences(spec, relations)
         classes = interchangeable_blocks(spec, relations)
-    chains, loose = [], []
+    chains, loose, fixed = [], [], []
     for cls in classes:
         slack = 0
         for position in range(len(cls[0])):
@@ -728,7 +730,9 @@ def _reduced(spec: AssemblySpec, relations, concurrent: bool):
                 loose.append((slack, chain))
             else:
                 chains.append(chain)
-    return with_fixed_order(base, chains), loose, classes
+        if not slack:  # the slack only grows with the position: every position is fixed
+            fixed.append(cls)
+    return with_fixed_order(base, chains), loose, classes, fixed
 
 
 def class_slack(spec: AssemblySpec, ids: list[str]) -> int:
@@ -743,7 +747,13 @@ def class_slack(spec: AssemblySpec, ids: list[str]) -> int:
 
 def symmetry_reduction(
     spec: AssemblySpec, relations, *, concurrent: bool = False
-) -> tuple[AssemblySpec, list[list[list[str]]], list[tuple[int, list[str]]], list[list[list[str]]]]:
+) -> tuple[
+    AssemblySpec,
+    list[list[list[str]]],
+    list[tuple[int, list[str]]],
+    list[list[list[str]]],
+    list[list[list[str]]],
+]:
     """The reduction of interchangeable parts for a state graph.
 
     Returns the reduced spec, the classes whose blocks are not chains, with
@@ -751,13 +761,17 @@ def symmetry_reduction(
     interchangeable blocks the reduction uses (chains first, then the others; each block
     in its position order): the symmetries a runtime maps a physical observation by
     (:func:`reduced_state_graph` records them on the graph's model).
+    Last, the classes of blocks in a fixed order (the ``i``-th operations of the blocks
+    chained in block order at every position ``i``; ``operation_model(..., fixed=...)``):
+    the schedule stage undoes that order (:mod:`asp.fixed_order`).
 
     Classes of blocks that are chains are put in a fixed order position by position
     (:func:`reduce_interchangeable`): the alternating game keeps its values. With
     ``concurrent`` (a graph for the concurrent game too) they keep a *loose* order
     instead (``(m, ids)``, :meth:`asp.feasibility.OperationModel._loose_order`, the slack
     of :func:`_reduced`), so that two of them may still run at once: a fixed order would
-    forbid it and change the concurrent game's W* (and the CP-SAT schedule's makespan).
+    forbid it and change the concurrent game's W* (the CP-SAT schedule undoes a fixed
+    order instead, :mod:`asp.fixed_order`).
     It holds more states (the 26-part shear mold stand-in: 459,182 instead of 15,019).
     A class whose blocks are not chains (a shaft with its two bearings and a collar,
     three times around a drive) cannot be put in a fixed order by precedences; its first
@@ -767,9 +781,9 @@ def symmetry_reduction(
     ``operation_model(..., symmetric=...)``): the alternating game's values only.
     """
     model, why, _ = _derive(spec, relations)
-    reduced, loose, ordered = _reduced(spec, relations, concurrent=concurrent)
+    reduced, loose, ordered, fixed = _reduced(spec, relations, concurrent=concurrent)
     if model is None:
-        return reduced, [], loose, ordered
+        return reduced, [], loose, ordered, fixed
     index = {op.id: i for i, op in enumerate(spec.operations)}
     chains, others = [], []
     for cls in interchangeable_blocks(spec, relations, chains_only=False):
@@ -780,7 +794,7 @@ def symmetry_reduction(
         root = index[cls[0][0]]
         if all(model.must[index[o]] >> root & 1 for o in cls[0][1:]):
             chains.append([b[0] for b in cls])
-    return with_fixed_order(reduced, chains), others, loose, [*ordered, *others]
+    return with_fixed_order(reduced, chains), others, loose, [*ordered, *others], fixed
 
 
 def reduced_state_graph(spec: AssemblySpec, relations, *, concurrent: bool = False, **kwargs):
@@ -797,11 +811,13 @@ def reduced_state_graph(spec: AssemblySpec, relations, *, concurrent: bool = Fal
     from asp.feasibility import operation_model
     from asp.state_graph import build_state_graph
 
-    reduced, others, loose, classes = symmetry_reduction(spec, relations, concurrent=concurrent)
+    reduced, others, loose, classes, fixed = symmetry_reduction(
+        spec, relations, concurrent=concurrent
+    )
     if reduced is spec and not others and not loose:
         return None
     model = operation_model(
-        reduced, relations, symmetric=others, loose=loose, interchangeable=classes
+        reduced, relations, symmetric=others, loose=loose, interchangeable=classes, fixed=fixed
     )
     return build_state_graph(reduced, relations, model=model, drop_stuck=True, **kwargs)
 

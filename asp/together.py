@@ -12,7 +12,9 @@ builder (:meth:`asp.concurrent.ConcurrentModel.compatible`), its compiled builde
 
 The transitions are :class:`LiveSteps`: the state graph's transitions between co-reachable
 states in CSR form (per state, its out-transitions in the state graph's order), with the
-tool-change time each adds.
+tool-change time each adds. On a graph whose alike operations are in a fixed order, the
+schedule replay looks transitions up by *label* (:mod:`asp.fixed_order`: an alike operation
+takes the transition of the next one of its chain).
 """
 
 from __future__ import annotations
@@ -42,17 +44,23 @@ class LiveSteps:
         Target state and operation of each transition.
     change : (E,) int64
         Tool-change time each transition adds (zeros unless given).
+    label : (n_ops,) int64 or None
+        With labels, ``op`` holds the label of each transition's operation and an operation
+        ``o`` is looked up as ``label[o]`` (:mod:`asp.fixed_order`).
     """
 
-    def __init__(self, graph, change=None):
+    def __init__(self, graph, change=None, label=None):
         """``change(src, op)``: the tool-change time of the live transitions with those
-        sources and operations (optional; default 0)."""
+        sources and operations (optional; default 0); ``label``: see the attribute."""
         alive = graph.coreachable()
         if alive.all():  # no dead ends (a reduced graph drops them): the graph's own arrays
             src, self.dst, self.op = graph.src, graph.dst, graph.op
         else:
             keep = alive[graph.src] & alive[graph.dst]
             src, self.dst, self.op = graph.src[keep], graph.dst[keep], graph.op[keep]
+        self.label = None if label is None else np.asarray(label, dtype=np.int64)
+        if self.label is not None:
+            self.op = self.label.astype(self.op.dtype)[self.op]
         self.change = np.zeros(self.dst.size, dtype=np.int64)
         if change is not None and src.size:
             self.change = np.asarray(change(src, self.op), dtype=np.int64)
@@ -75,8 +83,12 @@ class LiveSteps:
         """``(next state, change)`` of operation ``o`` in state ``s`` (``key = (s, o)``), or
         None when it is no live transition (a dict's ``get``)."""
         s, o = key
-        e = edge(int(s), int(o), self.indptr, self.op)
+        e = edge(int(s), self.key(o), self.indptr, self.op)
         return None if e < 0 else (int(self.dst[e]), int(self.change[e]))
+
+    def key(self, o) -> int:
+        """What operation ``o`` is looked up as in ``op`` (its label)."""
+        return int(o) if self.label is None else int(self.label[o])
 
     def arrays(self) -> tuple:
         """``(indptr, dst, op)``, as :func:`together` takes them."""
@@ -94,7 +106,15 @@ def edge(s, o, indptr, op):  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def together(s, ops, m, indptr, dst, op, conflict):  # pragma: no cover - compiled
-    """Whether ``ops[:m]`` may run together on top of state ``s`` (module docstring).
+    """Whether ``ops[:m]`` may run together on top of state ``s`` (module docstring):
+    :func:`together_as` with each operation looked up as itself."""
+    return together_as(s, ops, ops, m, indptr, dst, op, conflict)
+
+
+@numba.njit(cache=True)
+def together_as(s, ops, keys, m, indptr, dst, op, conflict):  # pragma: no cover - compiled
+    """Whether ``ops[:m]`` may run together on top of state ``s`` (module docstring), the
+    transition of ``ops[i]`` looked up as ``keys[i]`` (its label, :class:`LiveSteps`).
 
     Returns
     -------
@@ -114,7 +134,7 @@ def together(s, ops, m, indptr, dst, op, conflict):  # pragma: no cover - compil
         cur = reached[mask]
         for i in range(m):
             if not (mask >> i) & 1:
-                e = edge(cur, ops[i], indptr, op)
+                e = edge(cur, keys[i], indptr, op)
                 if e < 0:
                     return ORDER, mask, i
                 reached[mask | (1 << i)] = dst[e]
@@ -124,4 +144,5 @@ def together(s, ops, m, indptr, dst, op, conflict):  # pragma: no cover - compil
 def first_failure(steps: LiveSteps, conflict: np.ndarray, state: int, ops) -> tuple[int, int, int]:
     """:func:`together` on a sequence of operation indices (Python callers)."""
     arr = np.asarray(ops, dtype=np.int64)
-    return together(int(state), arr, arr.size, *steps.arrays(), conflict)
+    keys = arr if steps.label is None else steps.label[arr]
+    return together_as(int(state), arr, keys, arr.size, *steps.arrays(), conflict)

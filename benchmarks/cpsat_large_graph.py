@@ -6,8 +6,9 @@ lazy cuts from the replay). Each case runs with the default of ``asmplan plan`` 
 the whole stage within :data:`asp.concurrent.AUTO_TIME_LIMIT` seconds, stopping once neither a
 better schedule nor a new cut has come for :data:`asp.concurrent.AUTO_PATIENCE` seconds) and
 with each ``--limits`` value (a CP-SAT time limit in seconds, as ``--time-limit`` gives).
-Printed per run: the stage's wall time, status, makespan, proven lower bound, cuts and
-solves, and who found the schedule; every schedule printed has passed the replay (checked
+Printed per run: the stage's wall time and the part of it spent before CP-SAT (the
+precedences, the replay tables, the list schedules), status, makespan, proven lower bound,
+cuts and solves, and who found the schedule; every schedule printed has passed the replay (checked
 again here).
 
 Cases (those whose files are missing are skipped):
@@ -17,12 +18,19 @@ Cases (those whose files are missing are skipped):
   models; not part of the repository), loaded as ``asmplan plan`` does;
 - ``cyc``: a pickled state graph (``--graph-pickle``, e.g. the 72-part cycloidal drive's
   4.19M-state reduced graph, ``/tmp/cyc/g.pkl``);
+- ``file:PATH``: any assembly file or folder, loaded as ``asmplan plan`` does (e.g.
+  ``file:/tmp/realcad_pub/cycloidal.3DXML``, the 72-part cycloidal drive);
 - ``j30:NAME``: PSPLIB instances (shared data), plain CP-SAT without a state graph
   (:func:`asp.baseline.min_makespan`; ``auto`` is then the same time limit with the
   patience).
 
+With ``--fixed-order both`` every assembly run is made twice: with the graph's fixed order
+of alike parts undone (``undo``, the default of ``asmplan plan``: :mod:`asp.fixed_order`,
+the full graph's schedules) and kept (``keep``: the chain a precedence, no two alike parts
+at once; the conservative makespan of before).
+
     python benchmarks/cpsat_large_graph.py [--cases pump rod cyc j30:j3010_1.sm]
-        [--limits 30] [--graph-pickle /tmp/cyc/g.pkl]
+        [--limits 30] [--graph-pickle /tmp/cyc/g.pkl] [--fixed-order undo|keep|both]
 """
 
 from __future__ import annotations
@@ -59,12 +67,13 @@ def assembly_case(path: Path):
     return graph.spec, graph, [s.operation for s in steps if s.operation]
 
 
-def run_assembly(spec, graph, line, limit) -> dict:
+def run_assembly(spec, graph, line, limit, undo: bool = True) -> dict:
     t0 = time.perf_counter()
-    _, result = assembly_makespan(spec, graph, time_limit=limit, sequence=line)
+    _, result = assembly_makespan(spec, graph, time_limit=limit, sequence=line, fixed_order=undo)
     wall = time.perf_counter() - t0
     rows = result.detail.get("schedule")
-    if rows and schedule_violation(replay_model(spec, graph, cuts=False), rows) is not None:
+    replay = replay_model(spec, graph, cuts=False, fixed_order=undo)
+    if rows and schedule_violation(replay, rows) is not None:
         raise SystemExit(f"{spec.name}: a reported schedule fails the replay")
     return {"wall": wall, "result": result}
 
@@ -88,9 +97,12 @@ def main() -> int:
     )
     parser.add_argument("--limits", type=float, nargs="*", default=[30.0])
     parser.add_argument("--graph-pickle", type=Path, default=GRAPH)
+    parser.add_argument("--fixed-order", choices=["undo", "keep", "both"], default="undo")
     args = parser.parse_args()
+    orders = {"undo": [True], "keep": [False], "both": [True, False]}[args.fixed_order]
     print(
-        f"{'case':16s} {'limit':>6s} {'wall s':>7s} {'status':>8s} {'makespan':>9s} "
+        f"{'case':16s} {'order':>5s} {'limit':>6s} {'wall s':>7s} {'prep s':>6s} "
+        f"{'status':>8s} {'makespan':>9s} "
         f"{'bound':>6s} {'cuts':>5s} {'solves':>6s}  found by"
     )
     for case in args.cases:
@@ -109,6 +121,11 @@ def main() -> int:
             with open(args.graph_pickle, "rb") as handle:
                 graph = pickle.load(handle)  # noqa: S301 - a local file the user names
             prepared = (graph.spec, graph, None)
+        elif case.startswith("file:"):
+            if not Path(case[5:]).exists():
+                print(f"{case}: missing, skipped")
+                continue
+            prepared = assembly_case(Path(case[5:]))
         elif case.startswith("j30:"):
             prepared = DATA / "psplib_j30" / case[4:]
         else:
@@ -120,14 +137,19 @@ def main() -> int:
                 f"({time.perf_counter() - t0:.1f} s to prepare)",
                 flush=True,
             )
-        for limit in [None, *args.limits]:
+        runs = [(limit, undo) for limit in [None, *args.limits] for undo in orders]
+        for limit, undo in runs:
             if isinstance(prepared, tuple):
-                out = run_assembly(*prepared, limit)
+                out = run_assembly(*prepared, limit, undo)
+            elif not undo:
+                continue  # no state graph
             else:
                 out = run_psplib(prepared, limit)
             r = out["result"]
             print(
-                f"{case:16s} {'auto' if limit is None else f'{limit:g}':>6s} {out['wall']:7.1f} "
+                f"{case[-16:]:16s} {'undo' if undo else 'keep':>5s} "
+                f"{'auto' if limit is None else f'{limit:g}':>6s} {out['wall']:7.1f} "
+                f"{r.detail.get('stage_s', r.wall_s) - r.wall_s:6.1f} "
                 f"{r.status:>8s} {r.objective or 0:9g} {r.bound or 0:6g} "
                 f"{r.detail.get('cuts', 0):5d} {r.detail.get('solves', 0):6d}  "
                 f"{r.detail.get('found_by', '-')}",

@@ -40,14 +40,17 @@ class FaceSet:
         return self.uv[idx], self.h[idx]
 
     def subset(self, mask: np.ndarray) -> FaceSet:
-        """The faces where ``mask`` is true."""
+        """The faces where ``mask`` is true (``self`` when it is true everywhere)."""
+        rows = np.flatnonzero(mask)
+        if rows.size == len(self.h):
+            return self
         return FaceSet(
-            self.uv[mask],
-            self.h[mask],
-            self.box[mask],
-            self.hmin[mask],
-            self.hmax[mask],
-            self.nk[mask],
+            self.uv[rows],
+            self.h[rows],
+            self.box[rows],
+            self.hmin[rows],
+            self.hmax[rows],
+            self.nk[rows],
         )
 
 
@@ -57,8 +60,10 @@ def _crop(faces: FaceSet, other: FaceSet, lo: float, hi: float, sign: float) -> 
     ``sign`` is +1 when ``faces`` is the front set (heights compared as ``other - faces``)
     and -1 when it is the back set.
     """
-    o_lo, o_hi = other.box[:, :2].min(axis=0), other.box[:, 2:].max(axis=0)
-    keep = np.all(faces.box[:, :2] <= o_hi, axis=1) & np.all(faces.box[:, 2:] >= o_lo, axis=1)
+    o_lo, o_hi = other.box.min(axis=0)[:2], other.box.max(axis=0)[2:]
+    box = faces.box
+    keep = (box[:, 0] <= o_hi[0]) & (box[:, 1] <= o_hi[1])
+    keep &= (box[:, 2] >= o_lo[0]) & (box[:, 3] >= o_lo[1])
     if sign > 0:
         keep &= (faces.hmax >= other.hmin.min() - hi) & (faces.hmin <= other.hmax.max() - lo)
     else:

@@ -43,6 +43,11 @@ def _barycentric(tri: np.ndarray, pts: np.ndarray) -> np.ndarray:
     return np.stack([1.0 - l1 - l2, l1, l2], axis=-1)
 
 
+def _inside(lam: np.ndarray) -> np.ndarray:
+    """(N, m) bool: every barycentric coordinate of ``lam`` (N, m, 3) at least ``-_EPS``."""
+    return (lam[..., 0] >= -_EPS) & (lam[..., 1] >= -_EPS) & (lam[..., 2] >= -_EPS)
+
+
 def height_gap_range(
     p_uv: np.ndarray, p_h: np.ndarray, q_uv: np.ndarray, q_h: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -71,11 +76,11 @@ def height_gap_range(
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
         # vertices of p inside q
         lam = _barycentric(q_uv, p_uv)
-        valid.append(np.all(lam >= -_EPS, axis=-1))
+        valid.append(_inside(lam))
         values.append(np.einsum("nmk,nk->nm", lam, q_h) - p_h)
         # vertices of q inside p
         lam = _barycentric(p_uv, q_uv)
-        valid.append(np.all(lam >= -_EPS, axis=-1))
+        valid.append(_inside(lam))
         values.append(q_h - np.einsum("nmk,nk->nm", lam, p_h))
         # crossings of an edge of p with an edge of q
         nxt = [1, 2, 0]

@@ -131,14 +131,23 @@ def threaded_on(outer: trimesh.Trimesh, inner: trimesh.Trimesh, axis: int) -> bo
     normal[axis] = 1.0
     origin = np.zeros(3)
     origin[axis] = 0.5 * (lo + hi)
-    cut_inner = inner.section(plane_origin=origin, plane_normal=normal)
-    cut_outer = outer.section(plane_origin=origin, plane_normal=normal)
-    if cut_inner is None or cut_outer is None:
+    b_in = _section_bounds(inner, origin, normal)
+    b_out = _section_bounds(outer, origin, normal)
+    if b_in is None or b_out is None:
         return False
     others = [k for k in range(3) if k != axis]
-    b_in = np.asarray(cut_inner.bounds)[:, others]
-    b_out = np.asarray(cut_outer.bounds)[:, others]
+    b_in, b_out = b_in[:, others], b_out[:, others]
     slack = _INSIDE_MARGIN * float(np.ptp(b_out, axis=0).max())
     inside = np.all(b_in[0] >= b_out[0] - slack) and np.all(b_in[1] <= b_out[1] + slack)
     smaller = np.any(np.ptp(b_in, axis=0) < np.ptp(b_out, axis=0) - slack)
     return bool(inside and smaller)
+
+
+def _section_bounds(mesh: trimesh.Trimesh, origin: np.ndarray, normal: np.ndarray):
+    """(2, 3) bounds of the cross-section of ``mesh`` by a plane, or None when the plane
+    misses it: the bounds of ``mesh.section``'s segments, without building its path."""
+    lines = trimesh.intersections.mesh_plane(mesh, plane_normal=normal, plane_origin=origin)
+    if len(lines) == 0:
+        return None
+    points = np.asarray(lines, dtype=float).reshape(-1, 3)
+    return np.array([points.min(axis=0), points.max(axis=0)])

@@ -25,8 +25,8 @@ from asp.symmetry import (
     reduced_state_graph,
 )
 from tests.asp.test_symmetry import pinned_disc
-from tests.asp.test_symmetry_ring import _random_spec, _random_tables
-from tests.asp.test_symmetry_workspaces import GROUPINGS, alike_copies
+from tests.asp.test_symmetry_ring import _random_spec
+from tests.asp.test_symmetry_workspaces import GROUPINGS, random_alike_spec
 
 
 def curve(graph, max_k: int = 2) -> tuple:
@@ -86,12 +86,7 @@ def test_random_tables_keep_the_concurrent_game(data, copies, singles, grouping)
     """Random tables, with or without units: whenever the blocks of interchangeable
     operations are chains (single operations, or a pin with its roller), the reduced graph
     has the full graph's W*(k)."""
-    rel = alike_copies(_random_tables(data.draw, copies, singles), copies, singles)
-    held = data.draw(st.sets(st.sampled_from("psr")))
-    spec = _random_spec(rel.parts, held)
-    units = GROUPINGS[grouping](copies, singles) if grouping else []
-    if units:
-        spec = with_subassemblies(spec, units)
+    spec, rel = random_alike_spec(data.draw, copies, singles, grouping)
     try:
         full = build_state_graph(spec, rel)
     except SpecError:

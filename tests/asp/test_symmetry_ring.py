@@ -77,12 +77,17 @@ def values(spec, rel, cost):
     return graph, (sol.tct, sol.minimax)
 
 
-@pytest.fixture(scope="module", params=[False, True], ids=["ring", "ring+hub"])
-def ring(request):
+def ring_case(hub: bool):
+    """``(spec, relations)`` of the ring of pins with their rollers (and the hub)."""
     from cad import Assembly, compute_relations
 
-    meshes = ring_meshes(hub=request.param)
+    meshes = ring_meshes(hub=hub)
     return ring_spec(list(meshes)), compute_relations(Assembly.from_meshes(meshes))
+
+
+@pytest.fixture(scope="module", params=[False, True], ids=["ring", "ring+hub"])
+def ring(request):
+    return ring_case(request.param)
 
 
 def test_pins_with_their_rollers_are_one_class_of_blocks(ring):

@@ -53,6 +53,19 @@ def alike_copies(rel, copies: int, singles: int):
     return type(rel)(rel.parts, tc, tt, sp)
 
 
+def random_alike_spec(draw, copies: int, singles: int, grouping):
+    """``(spec, rel)``: random tables of alike pins with their rollers
+    (:func:`alike_copies`), random ``held`` parts and the units of ``GROUPINGS[grouping]``
+    (none for None)."""
+    rel = alike_copies(_random_tables(draw, copies, singles), copies, singles)
+    held = draw(st.sets(st.sampled_from("psr")))
+    spec = _random_spec(rel.parts, held)
+    units = GROUPINGS[grouping](copies, singles) if grouping else []
+    if units:
+        spec = with_subassemblies(spec, units)
+    return spec, rel
+
+
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(
     data=st.data(),
