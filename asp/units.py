@@ -108,8 +108,9 @@ def build_with_units(
     new unit can be found, the file's remaining sub-assemblies are given up before the
     first error is raised. With ``reduce``, a round whose derived precedences already prove
     that no complete sequence exists (:func:`asp.symmetry.refutation`, milliseconds)
-    builds no graph: the operation the proof names is the stuck one (a clutch's pressure
-    plate blocked by its 13 pins: 15.7M states built twice before, none now).
+    builds no checked graph, and its graph for the stuck operations only up to
+    :data:`PROVED_ROUND_STATES` states; beyond, the operation the proof names is the stuck
+    one (a clutch's pressure plate blocked by its 13 pins: 15.7M states built twice before).
     Every unit is checked by the state graph itself: its members
     must go into its own workspace one by one and the finished unit into the assembly as
     one rigid body, so units only ever give sound plans.
@@ -149,30 +150,28 @@ def build_with_units(
 
             proof = refutation(with_units, relations)
             if proof is not None:  # no complete sequence: known without a graph
-                raise _Proved(with_units, proof.why)
+                raise _Proved(with_units, proof)
             graph = reduced_state_graph(with_units, relations, concurrent=concurrent, **kwargs)
             if graph is not None:
                 return graph
         return build_state_graph(with_units, relations, **kwargs)
 
-    def next_units(with_units: AssemblySpec, base, found, optional, drop: set[str]):
+    def next_units(with_units: AssemblySpec, proof, base, found, optional, drop: set[str]):
         """The round's new units (:func:`_new_units`; ``drop`` filled instead when a unit of
         the file is stuck) and whether a whole state graph was built for them.
 
         The stuck operations come from the graph built without the check. When the derived
-        precedences prove there is no complete sequence (:func:`asp.symmetry.refutation`),
+        precedences prove there is no complete sequence (``proof``, from :func:`build`),
         that graph is built up to :data:`PROVED_ROUND_STATES` states only; beyond, the
         operation the proof names is the stuck one, and the whole graph is built only if
         that gives nothing new."""
         from asp.feasibility import operation_model
-        from asp.symmetry import refutation
 
         def units_of(graph, stuck: list[int]):
             drop.update(_stuck_units(graph.spec, stuck, optional))
             return None if drop else _new_units(graph, stuck, base, found, optional, drop)
 
         unchecked = {**kwargs, "check": False}
-        proof = refutation(with_units, relations) if reduce else None
         if proof is not None:
             cap = min(kwargs.get("max_states") or PROVED_ROUND_STATES, PROVED_ROUND_STATES)
             try:
@@ -210,12 +209,13 @@ def build_with_units(
                 if relations is None or "infeasible assembly" not in str(exc):
                     raise
                 first_error = first_error or exc
+                proof = exc.proof if isinstance(exc, _Proved) else None
                 if plain is not None:
                     current, plain = plain, None
                     say("no complete sequence with the held parts in the units: without them")
                     continue
             drop = set()
-            groups, built = next_units(current, base, found, optional, drop)
+            groups, built = next_units(current, proof, base, found, optional, drop)
             graph_rounds += built
             proved_rounds += not built
             if drop:
@@ -431,9 +431,9 @@ def _stuck_units(spec: AssemblySpec, stuck: list[int], optional: dict[str, set[s
 class _Proved(SpecError):
     """No complete sequence, proved by the derived precedences without a state graph."""
 
-    def __init__(self, spec: AssemblySpec, why: str):
-        super().__init__(f"{spec.source}: infeasible assembly, no complete sequence: {why}")
-        self.spec = spec
+    def __init__(self, spec: AssemblySpec, proof):
+        super().__init__(f"{spec.source}: infeasible assembly, no complete sequence: {proof.why}")
+        self.spec, self.proof = spec, proof
 
 
 def _graph_report(proof: _Proved, relations, kwargs: dict) -> SpecError:
