@@ -16,7 +16,7 @@ installed files: :mod:`asmplan.serve.docs`):
 - ``GET /api/questionnaire``; ``POST /api/sessions/{session}/answers`` ``{"answers": {...}}``.
 - ``GET /api/export.csv``: every session, one row each.
 - ``GET /api/sessions/{session}/explain``, ``GET /api/plans/{plan}/explain``: the advice
-  that explains itself (:mod:`asmplan.serve.page`).
+  that explains itself (:mod:`asmplan.serve.explain`).
 
 Request bodies are validated (pydantic, unknown keys refused) and limited to
 :data:`MAX_BODY` bytes (413 above).
@@ -35,8 +35,8 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from asmplan.advisor import ObservationError
 from asmplan.serve.docs import add_docs
+from asmplan.serve.explain import add_explain_routes
 from asmplan.serve.meshes import base_parts, plan_meshes
-from asmplan.serve.page import add_page_routes
 from asmplan.serve.sessions import SessionStore, UnknownSession
 
 MAX_BODY = 16 * 1024
@@ -165,7 +165,7 @@ def create_app(
         redoc_url=None,
     )
     add_docs(app, "asmplan advisor")
-    add_page_routes(app, store, by_id)
+    add_explain_routes(app, store, by_id)
     app.state.store = store
 
     def _plan(pid: str) -> dict:

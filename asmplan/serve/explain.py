@@ -1,4 +1,4 @@
-"""The API the page adds to the advisor's: advice that explains itself.
+"""The routes of the advice that explains itself (the page asks for them beside the events).
 
 :meth:`asmplan.advisor.Advisor.explain` gives each option the robots' reply, the worst line
 it leads to and a sentence saying both, and the plan ahead (the Gantt chart's). It costs
@@ -18,7 +18,7 @@ from asmplan.advisor import Advisor
 from asmplan.serve.sessions import SessionStore, UnknownSession
 
 
-def add_page_routes(app: FastAPI, store: SessionStore, plans: dict[str, dict]) -> None:
+def add_explain_routes(app: FastAPI, store: SessionStore, plans: dict[str, dict]) -> None:
     """Add the explanation routes for the sessions of ``store`` and ``plans`` (id -> plan)."""
     starts: dict[str, dict] = {}
 
