@@ -78,7 +78,7 @@ def report_figures(
                     bars,
                     folder / f"{name}.png",
                     makespan=makespan,
-                    title=f"concurrent: the person {who}, makespan {makespan:g}",
+                    title=f"concurrent: the person {who}, makespan {makespan:g} s",
                 ).read_bytes()
         rows = (doc.get("schedule") or {}).get("schedule") or []
         if rows:
@@ -90,7 +90,8 @@ def report_figures(
             out["gantt_schedule"] = plot_gantt(
                 bars,
                 folder / "s.png",
-                title=f"CP-SAT schedule: makespan {sched.get('objective')} ({sched.get('status')})",
+                title=f"CP-SAT schedule: makespan {sched.get('objective')} s "
+                f"({sched.get('status')})",
             ).read_bytes()
     return out
 
@@ -134,14 +135,17 @@ def report_html(plan: dict, figures: dict[str, bytes] | None = None) -> str:
     for r in plan.get("robustness") or []:
         k = "inf" if r["k"] is None else r["k"]
         rows.append(
-            (f"concurrent game: W*({k}), the person deviates at most {k} times", r["bound"])
+            (
+                f"concurrent game: W*({k}), the person deviates at most {k} times",
+                f"{r['bound']:g} s",
+            )
         )
     if sched:
         rows.append(
             (
                 "CP-SAT makespan (agents in parallel)",
                 f"{sched.get('objective')} s ({sched.get('status')}), lower bound "
-                f"{sched.get('lower_bound', '-')}",
+                f"{sched.get('lower_bound', '-')} s",
             )
         )
     body = [f"<h1>{esc(str(plan.get('assembly', 'plan')))}: the robust plan</h1>"]
@@ -216,7 +220,7 @@ def _line_table(steps: list[dict], unit: str) -> str:
         out.append(
             f"<tr><td>{s['step']}</td><td>{esc(s['player'])}</td><td>{esc(s['operation'])}</td>"
             f"<td>{esc(s['agent'])}</td><td>{esc(s['description'])}</td>"
-            f"<td>{esc(', '.join(s['parts']))}</td><td>{s['cost']:g}</td>"
+            f"<td>{esc(', '.join(s['parts']))}</td><td>{s['cost']:g}{unit}</td>"
             f"<td>{s['elapsed']:g}{unit}</td><td>{s['bound']:g}{unit}</td></tr>"
         )
     out.append("</table>")

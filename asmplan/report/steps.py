@@ -129,7 +129,7 @@ def step_title(step: dict, names: dict[str, str], ways: list[str]) -> str:
     title = f"{step['operation']} by {step['agent']}: {parts}"
     if ways:
         title += " (in along\u00a0" + ", ".join(dict.fromkeys(ways)) + ")"
-    return "\n".join(textwrap.wrap(title, 46, break_on_hyphens=False))
+    return "\n".join(textwrap.wrap(title, 42, break_on_hyphens=False))
 
 
 def assembly_steps(
@@ -196,7 +196,7 @@ def assembly_steps(
             )
             for start, vector in view.arrows
         ]
-        ax.set_title(step_title(step, names, view.ways), fontsize=8.5)
+        ax.set_title(step_title(step, names, view.ways), fontsize=9.5)
         out.append((step, _png(fig)))
         placed |= new
     return out
