@@ -35,18 +35,19 @@ def load_source(source: Path, turn_model: str | None = None) -> dict:
 
 
 def read_questionnaire(path: Path | None) -> list[dict] | None:
-    """Questionnaire items from a JSON file: ``[{"id", "text", "scale": [lo, hi] | null}]``."""
+    """Questionnaire items from a JSON file: ``[{"id", "text", "scale": [lo, hi] | null}]``
+    (checked as :func:`asmplan.study.questionnaire.items_from_data` does)."""
     if path is None:
         return None
+    from asmplan.study.questionnaire import items_from_data
+
     try:
         items = json.loads(path.read_text(encoding="utf-8"))
     except json.JSONDecodeError as exc:
         raise ValueError(f"{path}: not JSON ({exc.msg} at line {exc.lineno})") from None
-    if not isinstance(items, list) or not all(
-        isinstance(i, dict) and isinstance(i.get("id"), str) and isinstance(i.get("text"), str)
-        for i in items
-    ):
+    if not isinstance(items, list):
         raise ValueError(f"{path}: expected a list of {{'id', 'text', 'scale'}} items")
+    items_from_data(items, str(path))
     return items
 
 
@@ -79,7 +80,9 @@ def bind(host: str, port: int) -> socket.socket:
 @app.command("serve")
 def serve_command(
     sources: list[Path] = typer.Argument(
-        ..., help="Plan folder (plan.json) or assembly (folder, assembly.yaml, .IN2); several."
+        None,
+        help="Plan folder (plan.json) or assembly (folder, assembly.yaml, .IN2); several "
+        "(none with --study: the study's plans).",
     ),
     host: str = typer.Option("127.0.0.1", "--host", help="Address to bind (default: local)."),
     port: int = typer.Option(8000, "--port", min=0, max=65535, help="TCP port."),
@@ -110,6 +113,9 @@ def serve_command(
     fsync: bool = typer.Option(
         False, "--fsync", help="Wait for the disk at every event (survives a power cut)."
     ),
+    study: Path | None = typer.Option(
+        None, "--study", help="A study file (study.yaml): conditions, participants, questionnaire."
+    ),
 ) -> None:
     """Serve the advisor's JSON API and the page to play the plan (FastAPI + uvicorn)."""
     import uvicorn
@@ -118,13 +124,26 @@ def serve_command(
 
     folder = sessions if sessions is not None else default_sessions_folder()
     turn = None if turn_model is None else turn_model.value
-    plans = [load_source(s, turn) for s in sources]
+    if not sources and study is None:
+        raise ValueError("serve: expected a plan folder or assembly, or --study study.yaml")
+    the_study = variants = None
+    if study is not None:
+        from asmplan.study.config import load_study
+        from asmplan.study.plans import study_plans
+
+        if questionnaire is not None:
+            raise ValueError("--questionnaire: the study file holds the questionnaire")
+        the_study = load_study(study)
+        variants = study_plans(the_study, say=say)
+    plans = [load_source(s, turn) for s in sources or ()]
     items = read_questionnaire(questionnaire)
     sock = bind(host, port)
     application = create_app(
         plans,
         folder,
         questionnaire=items,
+        study=the_study,
+        variants=variants,
         max_sessions=max_sessions,
         session_ttl=session_ttl,
         fsync=fsync,
@@ -141,8 +160,10 @@ def serve_command(
             "service has no authentication"
         )
     port = sock.getsockname()[1]
+    count = len(plans) + len({pid for pid, _ in variants or {}})
+    what = f"study {the_study.title!r}: " if the_study else ""
     say(
-        f"serving {len(plans)} plan(s) on http://{host}:{port}/ (sessions in {folder}, "
+        f"serving {what}{count} plan(s) on http://{host}:{port}/ (sessions in {folder}, "
         f"{store.open_count} open)"
     )
     config = uvicorn.Config(application, log_level="warning", **fast_server())

@@ -46,6 +46,7 @@ from asmplan.serve.sessions import (
     StorageError,
     UnknownSession,
 )
+from asmplan.study.questionnaire import AnswerError, check_answers, items_from_data
 
 MAX_BODY = 16 * 1024
 """Largest request body accepted, bytes."""
@@ -80,7 +81,7 @@ class SessionIn(BaseModel):
     """A new session on one of the service's plans, with its first event when given."""
 
     model_config = ConfigDict(extra="forbid")
-    plan: str = Field(min_length=1, max_length=64)
+    plan: str | None = Field(None, min_length=1, max_length=64)
     condition: str | None = Field(None, min_length=1, max_length=64)
     participant: str | None = Field(None, min_length=1, max_length=64, pattern=r"^[A-Za-z0-9_.-]+$")
     block: int | None = Field(None, ge=0, le=1000)
@@ -91,7 +92,7 @@ class AnswersIn(BaseModel):
     """The questionnaire's answers: item id -> a number or a short text."""
 
     model_config = ConfigDict(extra="forbid")
-    answers: dict[str, int | float | str] = Field(max_length=50)
+    answers: dict[str, int | float | str | None] = Field(max_length=200)
 
 
 def plan_id(plan: dict) -> str:
@@ -189,6 +190,8 @@ def create_app(
     state_dir: str | Path,
     *,
     questionnaire: list[dict] | None = None,
+    study=None,
+    variants: dict | None = None,
     max_sessions: int = DEFAULT_MAX_SESSIONS,
     session_ttl: float = DEFAULT_TTL,
     fsync: bool = False,
@@ -196,17 +199,36 @@ def create_app(
 ) -> FastAPI:
     """The service for ``plans`` (plan documents), keeping its sessions in ``state_dir``
     (:class:`~asmplan.serve.sessions.SessionStore`: ``max_sessions`` open at once, aged out
-    after ``session_ttl`` seconds without an event, ``fsync`` at every commit)."""
+    after ``session_ttl`` seconds without an event, ``fsync`` at every commit).
+
+    ``study``: a :class:`~asmplan.study.config.Study` (``asmplan serve --study``), served
+    with ``variants``, ``(plan id, condition id) -> plan document``
+    (:func:`asmplan.study.plans.study_plans`)."""
     by_id: dict[str, dict] = {}
     for plan in plans:
         pid = plan_id(plan)
         if pid in by_id:
             raise ValueError(f"two plans named {pid!r}: give each assembly its own name")
         by_id[pid] = plan
+    served: dict = dict(by_id)
+    for (pid, cond), doc in (variants or {}).items():
+        served[(pid, cond)] = doc
+        by_id.setdefault(pid, doc)
     store = SessionStore(
-        Path(state_dir), by_id, max_sessions=max_sessions, ttl=session_ttl, fsync=fsync, clock=clock
+        Path(state_dir),
+        served,
+        max_sessions=max_sessions,
+        ttl=session_ttl,
+        fsync=fsync,
+        clock=clock,
     )
-    items = list(questionnaire if questionnaire is not None else DEFAULT_QUESTIONNAIRE)
+    if study is not None:
+        items = list(study.questionnaire)
+    else:
+        given = questionnaire if questionnaire is not None else DEFAULT_QUESTIONNAIRE
+        items = items_from_data(list(given), "questionnaire")
+    with contextlib.suppress(StorageError):  # the export's columns; a full disk can wait
+        store.set_meta("questionnaire", [item.id for item in items])
 
     app = FastAPI(
         title="asmplan advisor",
@@ -216,8 +238,12 @@ def create_app(
         "guaranteed bound. See README.md, 'The advisor service'.",
     )
     app.state.store = store
-    _page_routes(app, by_id)
-    _session_routes(app, store, by_id, items)
+    _page_routes(app, by_id, store.plans)
+    _session_routes(app, store, items, study)
+    if study is not None:
+        from asmplan.study.routes import add_study_routes
+
+        add_study_routes(app, store, study, json_response)
     app.add_exception_handler(ValueError, _value_error)
     app.add_middleware(EventFastPath, store=store)
     app.add_middleware(BodyLimit, limit=MAX_BODY)
@@ -225,8 +251,9 @@ def create_app(
     return app
 
 
-def _page_routes(app: FastAPI, by_id: dict[str, dict]) -> None:
-    """The page, its files and the plans (read only)."""
+def _page_routes(app: FastAPI, by_id: dict[str, dict], served: dict) -> None:
+    """The page, its files and the plans (read only; ``served``: ``(plan id, condition)``
+    -> plan document, a study's conditions included)."""
     meshes: dict[str, dict] = {}
     static_dir = resources.files("asmplan.serve").joinpath("static")
 
@@ -255,9 +282,12 @@ def _page_routes(app: FastAPI, by_id: dict[str, dict]) -> None:
         return [_plan_summary(pid, plan) for pid, plan in by_id.items()]
 
     @app.get("/api/plans/{pid}")
-    def get_plan(pid: str) -> dict:
-        """One plan: metrics, operations, parts, agents, the principal and worst lines."""
-        plan = _plan(pid)
+    def get_plan(pid: str, condition: str | None = None) -> dict:
+        """One plan: metrics, operations, parts, agents, the principal and worst lines (of a
+        study's ``condition``: that robot's)."""
+        plan = _plan(pid) if condition is None else served.get((pid, condition))
+        if plan is None:
+            raise HTTPException(404, f"unknown plan {pid!r} or condition {condition!r}")
         keys = ("assembly", "turn_model", "cost", "tct", "minimax", "metrics", "agents")
         keys += ("robustness",)
         out = {k: plan.get(k) for k in keys}
@@ -280,7 +310,7 @@ def _page_routes(app: FastAPI, by_id: dict[str, dict]) -> None:
         return meshes[pid]
 
 
-def _session_routes(app: FastAPI, store: SessionStore, by_id: dict, items: list[dict]) -> None:
+def _session_routes(app: FastAPI, store: SessionStore, items: list, study) -> None:
     """Sessions, their events and answers (the engine: :mod:`asmplan.serve.sessions`).
 
     The handlers are coroutines that answer with JSON text made here: an event is taken,
@@ -310,13 +340,28 @@ def _session_routes(app: FastAPI, store: SessionStore, by_id: dict, items: list[
     async def new_session(body: SessionIn) -> Response:
         """Start a session (a cell, or a person playing) on a plan, with its first event
         when given (then a refused event makes no session)."""
-        if (body.plan, body.condition) not in store.plans:
-            raise HTTPException(404, f"unknown plan {body.plan!r}")
+        plan, condition = body.plan, body.condition
+        if body.block is not None:
+            if body.participant is None or study is None:
+                raise HTTPException(422, "block: only with a participant of a study (--study)")
+            from asmplan.study.routes import block_of
+
+            assigned = block_of(store, body.participant, body.block)
+            plan, condition = assigned["plan"], assigned["condition"]
+            if body.plan not in (None, plan) or body.condition not in (None, condition):
+                raise HTTPException(
+                    409, f"block {body.block} of {body.participant} is {plan} / {condition}"
+                )
+        if plan is None:
+            raise HTTPException(422, "plan: expected a plan id (or a participant's block)")
+        if (plan, condition) not in store.plans:
+            what = "" if condition is None else f" under condition {condition!r}"
+            raise HTTPException(404, f"unknown plan {plan!r}{what}")
         event = body.event.model_dump(exclude_none=True) if body.event else None
         with _errors():
             session = store.create(
-                body.plan,
-                condition=body.condition,
+                plan,
+                condition=condition,
                 participant=body.participant,
                 block=body.block,
                 event=event,
@@ -343,19 +388,20 @@ def _session_routes(app: FastAPI, store: SessionStore, by_id: dict, items: list[
 
     @app.get("/api/questionnaire")
     def get_questionnaire() -> list[dict]:
-        """The end-of-game questionnaire's items (``scale``: ``[min, max]`` or null: text)."""
-        return items
+        """The end-of-game questionnaire's items: ``id, text, scale`` (``[min, max]``, or
+        null: free text), ``labels`` (point -> text), ``required``."""
+        return [item.to_dict() for item in items]
 
     @app.post("/api/sessions/{sid}/answers")
     async def post_answers(sid: str, body: AnswersIn) -> Response:
         """Store the questionnaire's answers with the session (once)."""
         _session(sid)
-        known = {item["id"] for item in items}
-        unknown = sorted(set(body.answers) - known)
-        if unknown:
-            raise HTTPException(422, f"unknown questionnaire item {unknown[0]!r}")
+        try:
+            answers = check_answers(items, body.answers)
+        except AnswerError as exc:
+            raise HTTPException(422, str(exc)) from None
         with _errors():
-            session = store.answer(sid, body.answers)
+            session = store.answer(sid, answers)
         return json_response(session_view(session))
 
     @app.get("/api/set-aside")

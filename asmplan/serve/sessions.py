@@ -745,6 +745,12 @@ class SessionStore:
         self._open.pop(session.id, None)
         self._append_log(session, {"t": self.clock(), "change": "closed", "reason": reason})
 
+    def set_meta(self, key: str, value) -> None:
+        """Keep ``value`` (JSON) under ``key`` in the database's ``meta`` table (the study's
+        questionnaire item ids, for the export's columns)."""
+        with self._transaction() as db:
+            db.execute("INSERT OR REPLACE INTO meta VALUES (?, ?)", (key, json.dumps(value)))
+
     # ------------------------------------------------------------------ participants
     def participant(self, pid: str) -> dict | None:
         """A study participant: ``{"id", "number", "created", "blocks"}``, or None."""
