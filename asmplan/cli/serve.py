@@ -116,6 +116,13 @@ def serve_command(
     study: Path | None = typer.Option(
         None, "--study", help="A study file (study.yaml): conditions, participants, questionnaire."
     ),
+    realtime: float | None = typer.Option(
+        None,
+        "--realtime",
+        min=0.001,
+        max=1000,
+        help="The clock runs: game seconds per wall-clock second (operations finish on it).",
+    ),
 ) -> None:
     """Serve the advisor's JSON API and the page to play the plan (FastAPI + uvicorn)."""
     import uvicorn
@@ -144,6 +151,7 @@ def serve_command(
         questionnaire=items,
         study=the_study,
         variants=variants,
+        realtime=realtime,
         max_sessions=max_sessions,
         session_ttl=session_ttl,
         fsync=fsync,

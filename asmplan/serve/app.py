@@ -34,6 +34,7 @@ from fastapi.responses import FileResponse, HTMLResponse, JSONResponse, Response
 from pydantic import BaseModel, ConfigDict, Field
 
 from asmplan.advisor import Advisor, ObservationError
+from asmplan.serve.clock import clock_view
 from asmplan.serve.meshes import base_parts, plan_meshes
 from asmplan.serve.sessions import (
     DEFAULT_MAX_SESSIONS,
@@ -192,6 +193,7 @@ def create_app(
     questionnaire: list[dict] | None = None,
     study=None,
     variants: dict | None = None,
+    realtime: float | None = None,
     max_sessions: int = DEFAULT_MAX_SESSIONS,
     session_ttl: float = DEFAULT_TTL,
     fsync: bool = False,
@@ -203,7 +205,9 @@ def create_app(
 
     ``study``: a :class:`~asmplan.study.config.Study` (``asmplan serve --study``), served
     with ``variants``, ``(plan id, condition id) -> plan document``
-    (:func:`asmplan.study.plans.study_plans`)."""
+    (:func:`asmplan.study.plans.study_plans`). ``realtime``: game seconds per wall-clock
+    second of every new session (:mod:`asmplan.serve.clock`; a study's own ``realtime``
+    otherwise)."""
     by_id: dict[str, dict] = {}
     for plan in plans:
         pid = plan_id(plan)
@@ -239,7 +243,8 @@ def create_app(
     )
     app.state.store = store
     _page_routes(app, by_id, store.plans)
-    _session_routes(app, store, items, study)
+    speed = study.speed if study is not None and realtime is None else realtime
+    _session_routes(app, store, items, study, speed)
     if study is not None:
         from asmplan.study.routes import add_study_routes
 
@@ -310,7 +315,7 @@ def _page_routes(app: FastAPI, by_id: dict[str, dict], served: dict) -> None:
         return meshes[pid]
 
 
-def _session_routes(app: FastAPI, store: SessionStore, items: list, study) -> None:
+def _session_routes(app: FastAPI, store: SessionStore, items: list, study, speed) -> None:
     """Sessions, their events and answers (the engine: :mod:`asmplan.serve.sessions`).
 
     The handlers are coroutines that answer with JSON text made here: an event is taken,
@@ -365,8 +370,9 @@ def _session_routes(app: FastAPI, store: SessionStore, items: list, study) -> No
                 participant=body.participant,
                 block=body.block,
                 event=event,
+                speed=speed,
             )
-        return json_response(session_view(session), 201)
+        return json_response(session_view(session, store.clock()), 201)
 
     @app.get("/api/sessions")
     async def list_sessions() -> Response:
@@ -375,8 +381,29 @@ def _session_routes(app: FastAPI, store: SessionStore, items: list, study) -> No
 
     @app.get("/api/sessions/{sid}")
     async def get_session(sid: str) -> Response:
-        """A session's record and its current advice."""
-        return json_response(session_view(_session(sid)))
+        """A session's record and its current advice (a real-time session's clock first
+        takes the completions due)."""
+        _session(sid)
+        with _errors():
+            store.tick(sid)
+        return json_response(session_view(_session(sid), store.clock()))
+
+    @app.get("/api/sessions/{sid}/advice")
+    async def get_advice(sid: str) -> Response:
+        """The current advice, the clock (real time) and the number of events: what a page
+        polls while the clock runs."""
+        _session(sid)
+        with _errors():
+            store.tick(sid)
+        session = _session(sid)
+        return json_response(
+            {
+                "advice": advice_dict(session.current()),
+                "clock": clock_view(session, store.clock()),
+                "events": len(session.events),
+                "finished": session.finished_at,
+            }
+        )
 
     @app.post("/api/sessions/{sid}/events")
     async def post_event(sid: str, body: EventIn) -> Response:
@@ -402,7 +429,7 @@ def _session_routes(app: FastAPI, store: SessionStore, items: list, study) -> No
             raise HTTPException(422, str(exc)) from None
         with _errors():
             session = store.answer(sid, answers)
-        return json_response(session_view(session))
+        return json_response(session_view(session, store.clock()))
 
     @app.get("/api/set-aside")
     async def set_aside() -> Response:
@@ -476,8 +503,8 @@ class EventFastPath:
         await send({"type": "http.response.body", "body": raw})
 
 
-def session_view(session) -> dict:
-    """A session as the API gives it: its record and current advice."""
+def session_view(session, now: float) -> dict:
+    """A session as the API gives it: its record, current advice and (real time) clock."""
     return {
         "id": session.id,
         "plan": session.plan_id,
@@ -491,6 +518,7 @@ def session_view(session) -> dict:
         "answers": session.answers,
         "outcome": session.outcome(),
         "advice": advice_dict(session.current()),
+        "clock": clock_view(session, now),
     }
 
 

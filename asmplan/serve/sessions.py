@@ -96,7 +96,8 @@ CREATE TABLE IF NOT EXISTS sessions (
     created REAL NOT NULL,
     finished REAL,
     outcome TEXT,
-    closed TEXT
+    closed TEXT,
+    speed REAL
 );
 CREATE INDEX IF NOT EXISTS sessions_participant ON sessions (participant, block);
 CREATE TABLE IF NOT EXISTS events (
@@ -191,6 +192,8 @@ class Session:
     advice: object = None
     """The advisor's current :class:`~asmplan.advisor.Advice` (kept: an event's record
     needs the advice before it, and its answer the advice after)."""
+    speed: float | None = None
+    """Real time: game seconds per wall-clock second (None: the game waits for events)."""
 
     def current(self):
         """The current advice (made once per change)."""
@@ -478,13 +481,13 @@ class SessionStore:
         """A session from the database, replayed (raises ``ValueError`` naming the event it
         cannot replay, ``UnknownSession``)."""
         row = self._db.execute(
-            "SELECT plan, condition, participant, block, created, finished, closed "
+            "SELECT plan, condition, participant, block, created, finished, closed, speed "
             "FROM sessions WHERE id = ?",
             (sid,),
         ).fetchone()
         if row is None:
             raise UnknownSession(sid)
-        plan_id, condition, participant, block, created, finished, closed = row
+        plan_id, condition, participant, block, created, finished, closed, speed = row
         plan = self.plans.get((plan_id, condition))
         if plan is None:
             raise UnknownSession(sid)
@@ -512,6 +515,7 @@ class SessionStore:
             block=block,
             closed=closed,
             last_active=last,
+            speed=speed,
         )
 
     def get(self, session_id: str) -> Session:
@@ -575,8 +579,10 @@ class SessionStore:
         participant: str | None = None,
         block: int | None = None,
         event: dict | None = None,
+        speed: float | None = None,
     ) -> Session:
-        """A new session, with its first event when given (one transaction: a session
+        """A new session (in real time at ``speed``, :mod:`asmplan.serve.clock`), with its
+        first event when given (one transaction: a session
         refused its first event is not made). Raises ``KeyError`` (unknown plan),
         :class:`SessionLimit`, ``ObservationError``, :class:`StorageError`."""
         plan = self.plans.get((plan_id, condition))
@@ -600,15 +606,16 @@ class SessionStore:
                 participant=participant,
                 block=block,
                 last_active=now,
+                speed=speed,
             )
             record, advice = (None, None)
             if event is not None:
                 record, advice = self._apply(session, event, now)
             with self._transaction() as db:
                 db.execute(
-                    "INSERT INTO sessions (id, plan, condition, participant, block, created) "
-                    "VALUES (?, ?, ?, ?, ?, ?)",
-                    (session.id, plan_id, condition, participant, block, now),
+                    "INSERT INTO sessions (id, plan, condition, participant, block, created, "
+                    "speed) VALUES (?, ?, ?, ?, ?, ?, ?)",
+                    (session.id, plan_id, condition, participant, block, now, speed),
                 )
                 if record is not None:
                     self._write_event(session, record, db)
@@ -623,9 +630,13 @@ class SessionStore:
                 )
             return session
 
-    def observe(self, session_id: str, event: dict):
+    def observe(self, session_id: str, event: dict, *, at: float | None = None):
         """Apply an event; return the advice. Raises ``ObservationError`` (the plan cannot
-        explain it), :class:`SessionClosed`, :class:`StorageError`: the session unchanged."""
+        explain it), :class:`SessionClosed`, :class:`StorageError`: the session unchanged.
+
+        A real-time session first takes the completions its clock has made due
+        (:meth:`tick`) and refuses a ``finished`` event from outside: the clock finishes
+        operations. ``at``: the wall-clock time to record (the clock's own events)."""
         with self._lock:
             session = self._open.get(session_id)
             if session is None:
@@ -635,7 +646,14 @@ class SessionStore:
                         f"session {session_id} is closed ({session.closed}): it takes no "
                         "more events"
                     )
-            now = self.clock()
+            if session.speed is not None and at is None:
+                self.tick(session_id)
+                if isinstance(event, dict) and event.get("kind") == "finished":
+                    raise ObservationError(
+                        f"finished {event.get('operation')} by {event.get('agent')}: a real-time "
+                        "session's operations finish on its clock"
+                    )
+            now = self.clock() if at is None else at
             record, advice = self._apply(session, event, now)
             try:
                 self._write_event(session, record)
@@ -646,6 +664,22 @@ class SessionStore:
             self._commit_event(session, record, advice)
             self._append_log(session, {"change": "event", **record, "outcome": session.outcome()})
             return advice
+
+    def tick(self, session_id: str) -> list[dict]:
+        """Take the completions a real-time session's clock has made due
+        (:func:`asmplan.serve.clock.due`); return their records (none for other sessions)."""
+        from asmplan.serve.clock import due
+
+        with self._lock:
+            session = self._open.get(session_id)
+            taken = []
+            while session is not None and session.speed is not None and session.is_open:
+                event, at = due(session, self.clock())
+                if event is None:
+                    break
+                self.observe(session_id, event, at=at)
+                taken.append(session.events[-1])
+            return taken
 
     def _apply(self, session: Session, event: dict, now: float):
         """Take ``event`` in the session's advisor; return its record and the advice after
@@ -674,6 +708,9 @@ class SessionStore:
                 record[key] = getattr(ev, key)
         if isinstance(event, dict) and event.get("source"):
             record["source"] = event["source"]
+        elif session.speed is not None:  # real time: how long the person took to choose
+            last = session.events[-1]["t"] if session.events else session.created
+            record["decision_s"] = round(max(0.0, now - last), 3)
         return record, advice
 
     def _write_event(self, session: Session, record: dict, db=None) -> None:

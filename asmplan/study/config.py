@@ -128,7 +128,7 @@ def load_study(path: str | Path) -> Study:
     try:
         data = yaml.safe_load(text)
     except yaml.YAMLError as exc:
-        raise ValueError(f"{path}: not YAML ({str(exc).splitlines()[0]})") from None
+        raise ValueError(f"{path}: not YAML ({_yaml_problem(exc)})") from None
     top = _Keys(
         data,
         str(path),
@@ -178,6 +178,14 @@ def load_study(path: str | Path) -> Study:
         ),
         speed=speed,
     )
+
+
+def _yaml_problem(exc: yaml.YAMLError) -> str:
+    mark = getattr(exc, "problem_mark", None)
+    problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+    if mark is None:
+        return problem
+    return f"{problem} at line {mark.line + 1}, column {mark.column + 1}"
 
 
 def _plans(data, where: str, base: Path) -> tuple[StudyPlan, ...]:
@@ -247,8 +255,10 @@ def _questionnaire(data, where: str, base: Path) -> list[Item]:
         source = base / keys.text("file", limit=1000)
         try:
             loaded = yaml.safe_load(source.read_text(encoding="utf-8"))
-        except (OSError, yaml.YAMLError) as exc:
-            raise ValueError(f"{where}: file {source}: cannot read ({exc})") from None
+        except OSError as exc:
+            raise ValueError(f"{where}: file {source}: cannot read ({exc.strerror})") from None
+        except yaml.YAMLError as exc:
+            raise ValueError(f"{source}: not YAML ({_yaml_problem(exc)})") from None
         if isinstance(loaded, list):
             loaded = {"items": loaded}
         inner = _Keys(loaded, str(source), ("scales", "items"))

@@ -12,7 +12,8 @@ service may go on writing). Event rows (:data:`EVENT_COLUMNS`):
 - ``deviation`` (1: the person did something else), ``bound_before`` and ``bound_after``
   (the guaranteed total, cost so far included, before and after it), ``elapsed`` (game
   time after it), ``time`` and ``duration`` when the event gave them, ``source`` (``clock``:
-  a completion the real-time clock made).
+  a completion the real-time clock made), ``decision_s`` (real time: the wall-clock
+  seconds the person took to choose, since the event before).
 
 Session rows (:data:`SESSION_COLUMNS` and one column per questionnaire item, ``answer.<item>``:
 the items the service last served, and any other answered; an unanswered item is empty,
@@ -56,6 +57,7 @@ EVENT_COLUMNS = (
     "time",
     "duration",
     "source",
+    "decision_s",
 )
 SESSION_COLUMNS = (
     "session",
@@ -122,6 +124,7 @@ def event_rows(db: sqlite3.Connection) -> list[dict]:
                 "time": r.get("time"),
                 "duration": r.get("duration"),
                 "source": r.get("source"),
+                "decision_s": r.get("decision_s"),
             }
         )
     return rows

@@ -259,3 +259,19 @@ def test_two_participants_two_conditions_end_to_end(tmp_path, two_robots):
     deviating = [s for s in doc["sessions"] if s["participant"] == "P02"]
     cost = {s["condition"]: s["cost"] for s in deviating}
     assert cost["schedule"] > cost["robust"]  # the fixed plan lost time to the deviations
+
+
+def test_serve_study_from_the_command_line(tmp_path):
+    """``asmplan serve --study`` plans the study's conditions, says so, and serves them."""
+    from tests.asmplan.serve_proc import serve_args, serving
+
+    path = write_study(tmp_path, realtime={"speed": 4})
+    args = serve_args("--study", path, "--sessions", tmp_path / "state")
+    with serving(args, timeout=300) as (url, _, lines), httpx.Client(base_url=url) as c:
+        info = c.get("/api/study").json()
+        part = c.post("/api/participants", json={}).json()
+    assert info["title"] == "Two robots" and info["realtime"] == {"speed": 4.0}
+    assert part["id"].startswith("P") and len(part["blocks"]) == 2
+    text = "\n".join(lines)
+    assert "choices-concurrent / schedule (cp-sat): worst case" in text
+    assert "serving study 'Two robots'" in text
