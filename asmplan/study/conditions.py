@@ -4,10 +4,10 @@ A condition is a robot policy over the assembly's game (either turn model):
 
 - ``robust``: the exact robust policy (the plan as ``asmplan plan`` writes it);
 - ``fast-greedy``: at each decision the robots take the move of the cooperative fastest
-  line from there, trusting the person to help (:func:`asp.play.fast_greedy_policy`);
+  line from there, trusting the person to help (:func:`asp.game.play.fast_greedy_policy`);
 - ``cp-sat``: the CP-SAT makespan schedule run as a fixed plan: each robot keeps its list
   of operations in the schedule's order, whatever the person does (in the concurrent game
-  :func:`asp.concurrent.schedule_rule`, which also tells the person the schedule's next
+  :func:`asp.concurrent.robustness.schedule_rule`, which also tells the person the schedule's next
   operation);
 - ``ignores-person``: a scripted robot, the same rule over a list the study gives
   (``script: {R1: [op, ...], ...}``; default: the robust plan's own line when the person
@@ -15,7 +15,7 @@ A condition is a robot policy over the assembly's game (either turn model):
 - ``{run: DIR}``: a policy learned by ``asmplan train`` on this game (its run folder).
 
 For each, :func:`condition_plan` evaluates the policy exactly against a best-response person
-(:func:`asp.solve.evaluate_policy`) and writes the plan document of that policy: its table
+(:func:`asp.game.solve.evaluate_policy`) and writes the plan document of that policy: its table
 holds every state the robot reaches against any person, and each state's ``bound`` is that
 robot's certified worst case from there (not W*), so the advisor, the page and the export
 tell the truth about the robot the participant meets. The document says which robot in
@@ -94,10 +94,10 @@ def _tagged(doc: dict, condition: Condition, worst: list[dict]) -> dict:
 
 
 def _fixed_solution(dag, solution, policy: np.ndarray):
-    """A :class:`~asp.solve.Solution` whose robot plays ``policy``: values are its certified
+    """A :class:`~asp.game.solve.Solution` whose robot plays ``policy``: values are its certified
     worst case, ``coop`` its best case (for the instruction's ties)."""
-    from asp.rules import ROBOT
-    from asp.solve import Solution, evaluate_policy
+    from asp.game.rules import ROBOT
+    from asp.game.solve import Solution, evaluate_policy
 
     ev = evaluate_policy(dag, policy)
     return Solution(
@@ -126,7 +126,7 @@ def _alternate_plan(result, condition: Condition) -> dict:
 
 
 def _alternate_policy(result, condition, dag, solution, describe) -> np.ndarray:
-    from asp.play import fast_greedy_policy
+    from asp.game.play import fast_greedy_policy
 
     if condition.robot == "fast-greedy":
         return fast_greedy_policy(dag, solution)
@@ -161,8 +161,8 @@ def _scripted_policy(dag, describe, script: dict[str, list[str]]) -> np.ndarray:
     """The alternating game's robot that keeps ``script``: at its turn it does the first
     operation of the script not done that it can, by its agent; if none can be done, its
     first move (it must move when it can)."""
-    from asp import rules
-    from asp.rules import ROBOT
+    from asp.game import rules
+    from asp.game.rules import ROBOT
 
     wanted = [(op, agent) for agent, ops in script.items() for op in ops]
     order = {pair: n for n, pair in enumerate(wanted)}
@@ -186,8 +186,8 @@ def _scripted_policy(dag, describe, script: dict[str, list[str]]) -> np.ndarray:
 
 
 def _concurrent_plan(result, condition: Condition) -> dict:
-    from asp.concurrent import certified_worst_case, policy_array, schedule_rule
-    from asp.play import fast_greedy_policy
+    from asp.concurrent.robustness import certified_worst_case, policy_array, schedule_rule
+    from asp.game.play import fast_greedy_policy
 
     plan = result.concurrent
     curve = plan.curve

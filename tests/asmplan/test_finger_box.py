@@ -26,7 +26,7 @@ def variants():
 
 def test_meshes_are_closed_and_the_fingers_interlock():
     from asmplan import pipeline
-    from asp.plan import relations_summary
+    from asp.game.plan import relations_summary
 
     for path in sorted((EXAMPLE / "meshes").glob("*.stl")):
         assert trimesh.load(path).is_watertight, path.name
