@@ -22,5 +22,6 @@ from asmplan.cli import train as _train  # noqa: F401, E402  isort: skip
 from asmplan.cli import play as _play  # noqa: F401, E402  isort: skip
 from asmplan.cli import experiment as _experiment  # noqa: F401, E402  isort: skip
 from asmplan.cli import serve as _serve  # noqa: F401, E402  isort: skip
+from asmplan.cli import study as _study  # noqa: F401, E402  isort: skip
 
 __all__ = ["app", "main"]

@@ -6,8 +6,9 @@ more than the plain advice (the options times the operations left), so the event
 answers the plain advice at once and the page asks for the explanation beside it:
 
 - ``GET /api/sessions/{session}/explain``: the session's current advice, explained;
-- ``GET /api/plans/{plan}/explain``: the advice at the plan's start, explained (no session
-  is made: a page shows the first move before anyone has played).
+- ``GET /api/plans/{plan}/explain[?condition=C]``: the advice at the plan's start (of a
+  study's robot condition ``C``), explained (no session is made: a page shows the first move
+  before anyone has played).
 """
 
 from __future__ import annotations
@@ -18,9 +19,10 @@ from asmplan.advisor import Advisor
 from asmplan.serve.sessions import SessionStore, UnknownSession
 
 
-def add_explain_routes(app: FastAPI, store: SessionStore, plans: dict[str, dict]) -> None:
-    """Add the explanation routes for the sessions of ``store`` and ``plans`` (id -> plan)."""
-    starts: dict[str, dict] = {}
+def add_explain_routes(app: FastAPI, store: SessionStore, plans: dict) -> None:
+    """Add the explanation routes for the sessions of ``store`` and ``plans`` (``(plan id,
+    condition or None) -> plan document``, as ``store.plans``)."""
+    starts: dict[tuple, dict] = {}
 
     @app.get("/api/sessions/{sid}/explain")
     def explain_session(sid: str) -> dict:
@@ -32,11 +34,14 @@ def add_explain_routes(app: FastAPI, store: SessionStore, plans: dict[str, dict]
         return session.advisor.explain().to_dict()
 
     @app.get("/api/plans/{pid}/explain")
-    def explain_start(pid: str) -> dict:
-        """The advice at the plan's start, explained (the same for every new session)."""
-        plan = plans.get(pid)
+    def explain_start(pid: str, condition: str | None = None) -> dict:
+        """The advice at the plan's start (of a study's ``condition``), explained (the same
+        for every new session)."""
+        key = (pid, condition)
+        plan = plans.get(key)
         if plan is None:
-            raise HTTPException(404, f"unknown plan {pid!r}")
-        if pid not in starts:
-            starts[pid] = Advisor(plan).explain().to_dict()
-        return starts[pid]
+            what = "" if condition is None else f" or condition {condition!r}"
+            raise HTTPException(404, f"unknown plan {pid!r}{what}")
+        if key not in starts:
+            starts[key] = Advisor(plan).explain().to_dict()
+        return starts[key]

@@ -1,0 +1,7 @@
+"""The service's bounds, in a module of their own so the command line reads them without
+loading the service."""
+
+DEFAULT_MAX_SESSIONS = 10_000
+"""Most sessions open at once (``asmplan serve --max-sessions``; one more is refused, 429)."""
+DEFAULT_TTL = 24 * 3600.0
+"""Seconds without an event after which an open session ages out (``--session-ttl``)."""
