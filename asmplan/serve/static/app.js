@@ -4,8 +4,9 @@
 // behind that worst case opens on request. After each move the focus goes to the next one.
 "use strict";
 
-const state = { plan: null, planInfo: null, meshes: {}, session: null, advice: null,
-                bars: [], lastParts: [], busy: false, open: {}, deviated: new Set() };
+const state = { plan: null, condition: null, planInfo: null, meshes: {}, session: null,
+                advice: null, bars: [], lastParts: [], busy: false, open: {},
+                deviated: new Set(), study: null, participant: null, block: null };
 
 // Plotly with nothing that leaves the machine: no "Share chart" (plotly.js 4 uploads the
 // chart, meshes included, to Plotly's cloud), no link to plotly's site, no server to send to.
@@ -96,10 +97,24 @@ async function pickPlan() {
   return found.id;
 }
 
+// Without a study: the plan picked (or the session in ?session= resumed). With a study
+// (asmplan serve --study): the consent, the participant's code, then each round in turn.
 async function start() {
-  state.plan = await pickPlan();
-  state.planInfo = await api("GET", `/api/plans/${encodeURIComponent(state.plan)}`);
-  document.getElementById("title").textContent =
+  const params = new URLSearchParams(location.search);
+  state.study = await api("GET", "/api/study").catch(() => null);
+  if (state.study) return startStudy(params);
+  if (params.get("session")) return resume(params.get("session"));
+  await openPlan(await pickPlan(), null);
+  await show(await startAdvice());
+}
+
+// Load a plan (of a study's robot condition): its numbers, meshes, and an empty record.
+async function openPlan(plan, condition, title) {
+  state.plan = plan;
+  state.condition = condition;
+  const query = condition ? `?condition=${encodeURIComponent(condition)}` : "";
+  state.planInfo = await api("GET", `/api/plans/${encodeURIComponent(plan)}${query}`);
+  document.getElementById("title").textContent = title ||
     `${state.planInfo.assembly}: you are the person, the robots follow the robust plan`;
   const steps = state.planInfo.cost === "steps";
   document.querySelector("#numbers div dt").textContent = steps ? "cost so far" : "time so far";
@@ -109,11 +124,106 @@ async function start() {
   document.getElementById("wstar").textContent = qty(state.planInfo.minimax);
   document.getElementById("concurrent-panel").hidden = !isConcurrent();
   document.getElementById("finishes-panel").hidden = !isConcurrent();
-  state.meshes = await api("GET", `/api/plans/${encodeURIComponent(state.plan)}/meshes`);
-  const session = await api("POST", "/api/sessions", { plan: state.plan });
-  state.session = session.id;
-  document.body.dataset.session = session.id;
-  await show(await explained(session.advice));
+  state.meshes = await api("GET", `/api/plans/${encodeURIComponent(plan)}/meshes`);
+  Object.assign(state, { session: null, advice: null, bars: [], lastParts: [], open: {},
+                         deviated: new Set() });
+  delete document.body.dataset.session;
+  document.getElementById("robot-log").replaceChildren();
+  document.getElementById("last-move").textContent = "";
+  for (const id of ["final", "thanks", "next-round"]) document.getElementById(id).hidden = true;
+  document.getElementById("questionnaire").hidden = false;
+  document.getElementById("play-panel").hidden = false;
+}
+
+// The advice at the plan's start, explained; no session is made until the first move.
+function startAdvice() {
+  const query = state.condition ? `?condition=${encodeURIComponent(state.condition)}` : "";
+  return api("GET", `/api/plans/${encodeURIComponent(state.plan)}/explain${query}`);
+}
+
+// Resume a session (a reload): its plan and condition, the Gantt chart from its events.
+async function resume(sid, title) {
+  const view = await api("GET", `/api/sessions/${encodeURIComponent(sid)}`);
+  await openPlan(view.plan, view.condition || null, title);
+  useSession(view.id);
+  let last = 0;
+  for (const e of view.events) {
+    const who = e.by === "robot" ? "robot" : "human";
+    if (e.kind === "started") {
+      state.open[e.operation] = { agent: e.agent, operation: e.operation, start: e.elapsed, who,
+                                  deviation: !!e.deviation };
+    } else if (state.open[e.operation]) {
+      state.bars.push({ ...state.open[e.operation], end: e.elapsed });
+      delete state.open[e.operation];
+    } else {
+      state.bars.push({ agent: e.agent, operation: e.operation, start: last, end: e.elapsed, who,
+                        deviation: !!e.deviation });
+    }
+    last = e.elapsed;
+  }
+  document.getElementById("last-move").textContent =
+    `Resumed: ${view.events.length} event(s) so far.`;
+  if (view.advice.finished) return show(view.advice);
+  return show(await explained(view.advice));
+}
+
+function useSession(sid) {
+  state.session = sid;
+  document.body.dataset.session = sid;
+  const params = new URLSearchParams(location.search);
+  params.set("session", sid);
+  if (state.study) params.delete("session");
+  history.replaceState(null, "", `?${params}`);
+}
+
+// ---------------------------------------------------------------- a study
+async function startStudy(params) {
+  const panel = document.getElementById("study-panel");
+  panel.hidden = false;
+  document.getElementById("play-panel").hidden = true;
+  document.getElementById("title").textContent = state.study.title;
+  document.getElementById("consent").textContent = state.study.consent || "";
+  const code = document.getElementById("participant");
+  code.value = params.get("participant") || "";
+  document.body.dataset.ready = "consent";
+  document.getElementById("agree").focus();
+  document.getElementById("study-form").onsubmit = async (ev) => {
+    ev.preventDefault();
+    try {
+      const body = code.value.trim() ? { participant: code.value.trim() } : {};
+      const record = await api("POST", "/api/participants", body);
+      state.participant = record.id;
+      history.replaceState(null, "", `?participant=${encodeURIComponent(record.id)}`);
+      panel.hidden = true;
+      setError("");
+      await nextRound(record);
+    } catch (err) {
+      setError(err.message);
+    }
+  };
+}
+
+// The participant's next round (block): resumed if its session is open, else new.
+async function nextRound(record) {
+  const n = record.blocks.length;
+  if (record.next === null) {
+    document.getElementById("play-panel").hidden = false;
+    document.getElementById("final").hidden = false;
+    document.getElementById("questionnaire").hidden = true;
+    document.getElementById("thanks").hidden = false;
+    document.getElementById("thanks").textContent =
+      `Thank you, ${record.id}: the study is complete (${n} round${n > 1 ? "s" : ""}).`;
+    document.getElementById("thanks").focus();
+    document.body.dataset.ready = "study-done";
+    return;
+  }
+  const b = record.blocks[record.next];
+  state.block = b.block;
+  const title = `${state.study.title}: round ${b.block + 1} of ${n}, ${b.label}`;
+  document.body.dataset.round = String(b.block);
+  if (b.session) return resume(b.session, title);
+  await openPlan(b.plan, b.condition, title);
+  await show(await startAdvice());
 }
 
 // The advice with its explanation (each option's reply and worst line, the plan ahead),
@@ -121,6 +231,16 @@ async function start() {
 async function explained(advice) {
   if (advice.finished || (!isConcurrent() && advice.turn === "robot")) return advice;
   return api("GET", `/api/sessions/${state.session}/explain`);
+}
+
+// An event: the session's next, or the first move, which makes the session.
+async function send(event) {
+  if (state.session) return api("POST", `/api/sessions/${state.session}/events`, event);
+  const body = state.study ? { participant: state.participant, block: state.block, event }
+    : { plan: state.plan, event };
+  const view = await api("POST", "/api/sessions", body);
+  useSession(view.id);
+  return view.advice;
 }
 
 function isConcurrent() {
@@ -372,13 +492,14 @@ function describe(op) {
 }
 
 // The advice is shown: mark the page ready and put the focus on the next move (the plan's
-// instruction if it is an option, else the first option, else the first completion); an
+// instruction if it is an option, else the cell's next completion (the plan says wait), else
+// the first option); an
 // option's pickers (which part, how long) are one Shift+Tab before its button.
 function ready() {
   document.body.dataset.ready = "1";
   const target = document.querySelector("#options button.move.asked") ||
-    document.querySelector("#options button.move") ||
-    document.querySelector("#finishes button");
+    document.querySelector("#finishes button") ||
+    document.querySelector("#options button.move");
   if (target) target.focus();
 }
 
@@ -388,7 +509,7 @@ async function post(event, then) {
   state.busy = true;
   document.body.dataset.ready = "0";
   try {
-    const plain = await api("POST", `/api/sessions/${state.session}/events`, event);
+    const plain = await send(event);
     if (then) then(plain);
     const advice = await explained(plain);
     setError("");
@@ -408,10 +529,8 @@ function setStatus(text) {
 function drawView(advice) {
   const ids = Object.keys(state.meshes);
   const note = document.getElementById("view-note");
-  if (!ids.length) {
-    note.textContent = "no part meshes in this plan: the 3D view is empty";
-    return;
-  }
+  document.getElementById("view-panel").hidden = !ids.length;  // no meshes: no empty box
+  if (!ids.length) return;
   const present = new Set([...state.planInfo.base_parts, ...advice.parts]);
   const fresh = new Set(advice.parts.filter((p) => !state.lastParts.includes(p)));
   state.lastParts = advice.parts.slice();
@@ -486,6 +605,7 @@ function drawGantt() {
     shapes: [{ type: "line", x0: now, x1: now, yref: "paper", y0: 0, y1: 1,
                line: { color: DEVIATION_COLOUR, width: 2, dash: "dot" } }],
     annotations: [{ x: now, y: 1, yref: "paper", yanchor: "bottom", text: `now ${qty(now)}`,
+                    xanchor: now > 0.8 * end ? "right" : "left",
                     showarrow: false, font: { size: 11, color: DEVIATION_COLOUR } }],
   };
   plot("gantt", traces, layout);
@@ -533,18 +653,17 @@ function questionnaire(items) {
   for (const item of items) {
     if (item.scale) {
       const set = el("fieldset", { "data-item": item.id });
-      set.append(el("legend", {}, item.text));
+      set.append(el("legend", {}, item.text + (item.required ? " (required)" : "")));
       const row = el("div", { class: "scale" });
       const [lo, hi] = item.scale;
-      row.append(el("span", { class: "ends" }, item.labels ? item.labels[0] : "disagree"));
+      const words = item.labels || {};
       for (let v = lo; v <= hi; v++) {
         const id = `q-${item.id}-${v}`;
         const label = el("label", { for: id });
         label.append(el("input", { type: "radio", id, name: item.id, value: v }));
-        label.append(document.createTextNode(` ${v}`));
+        label.append(document.createTextNode(` ${v}${words[v] ? ` (${words[v]})` : ""}`));
         row.append(label);
       }
-      row.append(el("span", { class: "ends" }, item.labels ? item.labels[1] : "agree"));
       set.append(row);
       form.append(set);
     } else {
@@ -569,12 +688,24 @@ function questionnaire(items) {
       await api("POST", `/api/sessions/${state.session}/answers`, { answers });
       form.hidden = true;
       document.getElementById("thanks").hidden = false;
-      document.getElementById("thanks").focus();
       setError("");
+      if (state.study) return offerNextRound();
+      document.getElementById("thanks").focus();
     } catch (err) {
       setError(err.message);
     }
   };
+}
+
+// After a study round's answers: a button to the next round (or the end of the study).
+async function offerNextRound() {
+  const record = await api("GET", `/api/participants/${encodeURIComponent(state.participant)}`);
+  const button = document.getElementById("next-round");
+  button.textContent = record.next === null ? "finish the study" : "go on to the next round";
+  button.hidden = false;
+  button.onclick = () => nextRound(record);
+  button.focus();
+  document.body.dataset.ready = "answered";
 }
 
 start().catch((err) => {
