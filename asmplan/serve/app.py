@@ -1,6 +1,7 @@
 """The advisor service: a FastAPI application over plans and sessions.
 
-Routes (the OpenAPI document is at ``/openapi.json``, its browsable form at ``/docs``):
+Routes (the OpenAPI document is at ``/openapi.json``, its browsable form at ``/docs``, from
+installed files: :mod:`asmplan.serve.docs`):
 
 - ``GET /``: the page (play the person's side against the robots' policy).
 - ``GET /static/{name}``: the page's own files and plotly's JavaScript from the installed
@@ -36,6 +37,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from asmplan.advisor import Advisor, ObservationError
 from asmplan.serve.clock import clock_view
+from asmplan.serve.docs import add_docs
 from asmplan.serve.meshes import base_parts, plan_meshes
 from asmplan.serve.sessions import (
     DEFAULT_MAX_SESSIONS,
@@ -241,7 +243,10 @@ def create_app(
         description="The robust plan's policy for a cell: observe operations started and "
         "finished, get the robots' next operations, the person's instruction and the "
         "guaranteed bound. See README.md, 'The advisor service'.",
+        docs_url=None,
+        redoc_url=None,
     )
+    add_docs(app, "asmplan advisor")
     app.state.store = store
     _page_routes(app, by_id, store.plans)
     speed = study.speed if study is not None and realtime is None else realtime

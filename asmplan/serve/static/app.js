@@ -5,6 +5,27 @@
 const state = { plan: null, planInfo: null, meshes: {}, session: null, advice: null,
                 bars: [], lastParts: [], busy: false, open: {}, deviated: new Set() };
 
+// Plotly with nothing that leaves the machine: no "Share chart" (plotly.js 4 uploads the
+// chart, meshes included, to Plotly's cloud), no link to plotly's site, no server to send to.
+const PLOT_CONFIG = {
+  displaylogo: false, responsive: true, showLink: false, showSendToCloud: false,
+  plotlyServerURL: "", modeBarButtonsToRemove: ["sendChartToCloud", "sendDataToCloud"],
+};
+
+// Draw a plotly figure; its toolbar stays out of the Tab order (the moves come first).
+async function plot(id, traces, layout) {
+  const gd = await Plotly.react(id, traces, layout, PLOT_CONFIG);
+  untab(gd);
+  if (!gd.dataset.untab) {
+    gd.dataset.untab = "1";
+    gd.on("plotly_afterplot", () => untab(gd));
+  }
+}
+
+function untab(gd) {
+  for (const node of gd.querySelectorAll(".modebar-btn, .modebar a")) node.tabIndex = -1;
+}
+
 function fmt(x) {
   return Number.isInteger(x) ? String(x) : Number(x).toFixed(2).replace(/\.?0+$/, "");
 }
@@ -281,7 +302,7 @@ function drawView(advice) {
   const layout = { margin: { l: 0, r: 0, t: 0, b: 0 }, uirevision: "keep",
                    scene: { aspectmode: "data", xaxis: { visible: false },
                             yaxis: { visible: false }, zaxis: { visible: false } } };
-  Plotly.react("view", traces, layout, { displaylogo: false, responsive: true });
+  plot("view", traces, layout);
   note.textContent = `placed: ${[...present].join(", ") || "nothing yet"}` +
     (fresh.size ? ` (just now: ${[...fresh].join(", ")})` : "");
 }
@@ -305,7 +326,7 @@ function drawGantt() {
   const layout = { margin: { l: 50, r: 10, t: 30, b: 30 }, title: { text: "Gantt chart", font: { size: 13 } },
                    xaxis: { title: { text: "time" }, rangemode: "tozero" },
                    yaxis: { type: "category" } };
-  Plotly.react("gantt", [trace], layout, { displaylogo: false, responsive: true });
+  plot("gantt", [trace], layout);
 }
 
 async function finish(advice) {
