@@ -25,7 +25,7 @@ _EXPORTS = {
     "HumanEnv": "arl.envs",
     "GameVecEnv": "arl.envs",
     "GameAEC": "arl.pettingzoo_env",
-    "GameTables": "arl.game",
+    "GameTables": "arl.moves",
 }
 
 __all__ = sorted(_EXPORTS)

@@ -36,7 +36,7 @@ import dataclasses
 from dataclasses import dataclass
 
 from arl.envs import OBSERVATIONS
-from arl.game import REWARDS, check_choice
+from arl.moves import REWARDS, check_choice
 
 ALGOS = ("ppo", "maskable_ppo")
 STOPS = ("rewards", "policy")

@@ -29,7 +29,7 @@ import numpy as np
 from gymnasium import spaces
 from stable_baselines3.common.vec_env import VecEnv
 
-from arl.game import (
+from arl.moves import (
     AGENTS,
     INVALID,
     NO_MOVE,
@@ -41,8 +41,8 @@ from arl.game import (
     move_rewards,
     player_of,
 )
-from asp import rules
-from asp.dag import GameDAG
+from asp.game import rules
+from asp.game.dag import GameDAG
 
 OBSERVATIONS = ("node", "features")
 

@@ -19,8 +19,8 @@ from gymnasium import spaces
 from pettingzoo import AECEnv
 
 from arl.envs import Observer
-from arl.game import AGENTS, REWARDS, Game, GameTables, check_choice, move_rewards
-from asp.dag import GameDAG
+from arl.moves import AGENTS, REWARDS, Game, GameTables, check_choice, move_rewards
+from asp.game.dag import GameDAG
 
 
 class GameAEC(AECEnv):

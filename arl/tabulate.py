@@ -11,7 +11,7 @@ import numpy as np
 import torch
 
 from arl.envs import Observer
-from arl.game import NO_MOVE, GameTables
+from arl.moves import NO_MOVE, GameTables
 
 
 def action_probabilities(model, tables: GameTables, player: int, observer: Observer) -> np.ndarray:

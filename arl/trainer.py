@@ -36,15 +36,15 @@ from stable_baselines3.common.vec_env import DummyVecEnv, VecEnv, VecEnvWrapper
 
 from arl.config import TrainConfig, get_config
 from arl.envs import GameVecEnv, Observer, TurnEnv
-from arl.game import AGENTS, NO_MOVE, GameTables
 from arl.memory import check_training_size
+from arl.moves import AGENTS, NO_MOVE, GameTables
 from arl.runfolder import LOG_FORMAT, RunFolder
 from arl.tabulate import action_probabilities, tabulate
-from asp import rules
-from asp.dag import HUMAN, ROBOT, GameDAG
-from asp.metrics import is_robust_optimal
+from asp.game import rules
+from asp.game.dag import HUMAN, ROBOT, GameDAG
+from asp.game.metrics import is_robust_optimal
+from asp.game.solve import certified_worst_case, play, solve
 from asp.numbers import plain
-from asp.solve import certified_worst_case, play, solve
 
 LOG_VERSION = 1
 CycleCallback = Callable[[dict], bool | None]
@@ -618,7 +618,7 @@ def evaluate(
         robust_optimal, ...`` (every :class:`asp.metrics.PlanMetrics` field) plus
         ``robot_policy`` (edge indices).
     """
-    from asp.metrics import plan_metrics
+    from asp.game.metrics import plan_metrics
 
     target = robot_policy_or_model_dir
     if isinstance(target, str | Path):

@@ -13,7 +13,7 @@ event of an operation that was not seen to start counts as its start and finish 
 may only see completions). Passes (a side with nothing it may do) are taken automatically.
 
 Turn model ``concurrent`` (:class:`ConcurrentAdvisor`, which ``Advisor(plan)`` returns for
-such a plan): decisions are taken at events, as in the game (``asp/concurrent.py``). At the
+such a plan): decisions are taken at events, as in the game (``asp/concurrent/``). At the
 start and after every completion the robots commit first: the advisor takes the plan's
 commitment at once (the robots' next operations, ``robots``; a robot's ``started`` event
 confirms it, any other robot start is refused) and says what each free person is asked to do
@@ -44,7 +44,7 @@ from dataclasses import asdict, dataclass, field, replace
 
 from asmplan.errors import GameError
 from asmplan.planfile import check_plan
-from asp.alike import AlikeMap
+from asp.game.alike import AlikeMap
 
 EVENT_KINDS = ("started", "finished")
 

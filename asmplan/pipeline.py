@@ -38,13 +38,13 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:  # pragma: no cover - types only
     from asmplan.planfile import AlternateStates, PlayedPolicy
     from asmplan.report.plot import DagFigure
-    from asp.baseline import BaselineResult
-    from asp.concurrent_plan import ConcurrentPlan
-    from asp.dag import GameDAG
-    from asp.plan import PlanStep
-    from asp.solve import Solution
+    from asp.concurrent.plan import ConcurrentPlan
+    from asp.game.dag import GameDAG
+    from asp.game.plan import PlanStep
+    from asp.game.solve import Solution
+    from asp.graph.state_graph import StateGraph
+    from asp.schedule.cpsat import BaselineResult
     from asp.spec import AssemblySpec
-    from asp.state_graph import StateGraph
     from cad.relations import Relations
 
 PLAN_FORMAT = "asmplan-plan/2"
@@ -248,7 +248,7 @@ class AssemblyPlan:
             relations=self.assembly.relations,
             interchangeable=self.graph.model.interchangeable,
         )
-        from asp.concurrent_plan import plan_entries
+        from asp.concurrent.plan import plan_entries
 
         doc.update(plan_entries(self.concurrent))
         doc["schedule"].update(
@@ -281,7 +281,7 @@ def load_assembly(source: str | os.PathLike[str]) -> AssemblySpec:
     FileNotFoundError
         ``source`` does not exist.
     """
-    from asp.generate import load_any
+    from asp.fromcad.generate import load_any
 
     return load_any(source)
 
@@ -300,7 +300,7 @@ def relations(spec: AssemblySpec, *, progress: bool = False) -> Relations | None
     cad.relations.Relations or None
         ``tc``, ``tt``: ``(n_parts, n_parts, 6)`` bool.
     """
-    from asp.feasibility import load_relations
+    from asp.graph.feasibility import load_relations
 
     return load_relations(spec, progress=progress)
 
@@ -321,8 +321,8 @@ def load(
     falling) are each said in a note. ``contact_tol`` and
     ``penetration_tol`` (mm) replace the spec's tolerances when given.
     """
-    from asp.feasibility import load_relations
-    from asp.generate import decide_generated, spec_geometry
+    from asp.fromcad.generate import decide_generated, spec_geometry
+    from asp.graph.feasibility import load_relations
 
     spec = with_tolerances(load_assembly(source), contact_tol, penetration_tol)
 
@@ -430,7 +430,7 @@ def part_geometry(source: str | os.PathLike[str], *, units: str | None = None):
     from dataclasses import replace
 
     import cad
-    from asp.generate import spec_geometry
+    from asp.fromcad.generate import spec_geometry
 
     spec = _spec_file(source)
     if spec is not None:
@@ -481,8 +481,8 @@ def state_graph(
     asp.state_graph.StateGraph
     """
     from asp.errors import SpecError
-    from asp.symmetry import reduced_state_graph
-    from asp.units import (
+    from asp.graph.symmetry import reduced_state_graph
+    from asp.subassemblies import (
         build_with_units,
         hierarchy_line,
         prepared_units,
@@ -536,7 +536,7 @@ def game(graph: StateGraph, *, cost: str | None = None) -> GameDAG:
     -------
     asp.dag.GameDAG
     """
-    from asp.game import game_dag
+    from asp.graph.game_dag import game_dag
 
     return game_dag(graph, cost=cost)
 
@@ -561,7 +561,7 @@ def load_game(source: str | os.PathLike[str], *, cost: str | None = None) -> Gam
     if not path.exists():
         raise FileNotFoundError(f"{path}: no such file or folder")
     if path.is_file() and path.suffix.lower() in GRAPH_SUFFIXES:
-        from asp.io import load_dag
+        from asp.game.io import load_dag
 
         if cost is not None:
             raise GraphError("--cost applies to assemblies only: a graph file has its costs")
@@ -573,7 +573,7 @@ def load_game(source: str | os.PathLike[str], *, cost: str | None = None) -> Gam
 
 def solve_game(dag: GameDAG) -> Solution:
     """Solve the game exactly (backward induction): TCT, W* and both policies."""
-    from asp.solve import solve
+    from asp.game.solve import solve
 
     return solve(dag)
 
@@ -582,7 +582,7 @@ def played_game(graph: StateGraph, game: Game, solution: Solution) -> PlayedGame
     """What the outputs of a plan take from its solved game (:class:`PlayedGame`)."""
     from asmplan.planfile import alternate_states, played_policy
     from asmplan.report.plot import dag_figure
-    from asp.solve import play
+    from asp.game.solve import play
 
     dag = game.dag
     every_state = alternate_states(graph, dag)
@@ -595,7 +595,7 @@ def played_game(graph: StateGraph, game: Game, solution: Solution) -> PlayedGame
 
 def robust_plan(game: Game, solution: Solution) -> tuple[PlanStep, ...]:
     """The robust robot policy against the maximising human, turn by turn."""
-    from asp.plan import robust_plan as steps
+    from asp.game.plan import robust_plan as steps
 
     return tuple(steps(game.dag, solution, game.descriptions))
 
@@ -638,7 +638,7 @@ def schedule(
     -------
     Schedule
     """
-    from asp.concurrent import assembly_makespan
+    from asp.schedule.assembly_makespan import assembly_makespan
 
     sched, result = assembly_makespan(
         assembly.spec,
@@ -704,8 +704,8 @@ def plan(
     AssemblyPlan
         ``to_dict()`` is the ``plan.json`` object.
     """
-    from asp.memory import map_large_blocks, release_memory
-    from asp.plan import relations_summary
+    from asp.game.plan import relations_summary
+    from asp.heap import map_large_blocks, release_memory
 
     map_large_blocks()  # a freed array of a few MB goes back to the system at once
     say = on_step or (lambda _message: None)
@@ -738,7 +738,7 @@ def plan(
         on_step=on_step,
         concurrent=turn == "concurrent",
     )
-    from asp.units import units_report
+    from asp.subassemblies import units_report
 
     units = units_report(assembly.spec, assembly.relations, graph.spec.subassemblies)
     if graph.spec is not assembly.spec:  # subassemblies found: their insertions are operations
@@ -761,8 +761,8 @@ def plan(
     release_memory()  # CP-SAT's model and the replay tables
     concurrent = None
     if turn == "concurrent":
-        from asp.concurrent import DEFAULT_MAX_K
-        from asp.concurrent_plan import plan_concurrent
+        from asp.concurrent.plan import plan_concurrent
+        from asp.concurrent.robustness import DEFAULT_MAX_K
 
         say("[4/5] solving the concurrent game, W*(k) until flat ...")
         concurrent = plan_concurrent(

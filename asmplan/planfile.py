@@ -34,14 +34,14 @@ from pathlib import Path
 import numba
 import numpy as np
 
-from asp import rules
 from asp.atomic import write_text
-from asp.dag import HUMAN, ROBOT, CodedLabels, GameDAG, ids_topological, index_dtype
 from asp.errors import FormatError
-from asp.metrics import adversarial_tax
+from asp.game import rules
+from asp.game.dag import HUMAN, ROBOT, CodedLabels, GameDAG, ids_topological, index_dtype
+from asp.game.metrics import adversarial_tax
+from asp.game.rules import close_kernel, edge_cost
+from asp.game.solve import Solution, node_order
 from asp.numbers import plain
-from asp.rules import close_kernel, edge_cost
-from asp.solve import Solution, node_order
 
 FORMAT = "asmplan-plan/2"
 MAIN = "main"
@@ -522,7 +522,7 @@ def _concurrent_policy(game, solution: Solution, table: PolicyTable) -> dict:
     the durations they take; ``moves.deviations``), each followed by the wait for the next
     completion (``moves.cost``, the time until it).
     """
-    from asp.concurrent import commit_description, move_starts, state_description
+    from asp.concurrent.describe import commit_description, move_starts, state_description
 
     dag = game.dag
     op_names = list(game.model.spec.op_ids)
@@ -890,7 +890,7 @@ def add_insertions(steps: list[dict], spec, relations, operations: dict) -> str 
     :func:`asp.checker.check_line`; returns None when it accepts the line, else its error
     (the insertions then carry no directions).
     """
-    from asp.checker import check_line
+    from asp.graph.checker import check_line
 
     ops = [s["operation"] for step in steps for s in step["starts"]]
     error = None

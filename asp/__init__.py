@@ -6,11 +6,11 @@ The game DAG (:mod:`asp.dag`), the rules of play on it (:mod:`asp.rules`), its f
 This package never imports torch.
 """
 
-from asp.dag import ANY, HUMAN, ROBOT, GameDAG, from_arrays, from_edges, from_networkx
-from asp.io import load_dag, save_dag
-from asp.metrics import PlanMetrics, plan_metrics
-from asp.solve import Solution, certified_worst_case, evaluate_policy, solve
-from asp.synth import synthetic_dag
+from asp.game.dag import ANY, HUMAN, ROBOT, GameDAG, from_arrays, from_edges, from_networkx
+from asp.game.io import load_dag, save_dag
+from asp.game.metrics import PlanMetrics, plan_metrics
+from asp.game.solve import Solution, certified_worst_case, evaluate_policy, solve
+from asp.game.synth import synthetic_dag
 
 __all__ = [
     "ANY",

@@ -20,7 +20,7 @@ An ``assembly.yaml`` names everything the planner needs besides the part geometr
                                        # directions and gravity are its axes (cad/frame.py)
     gripper_approach: [+z, -z]         # directions d a part may leave along (inserted along -d)
     constraints: {topological: true, stability: true, functional: true}
-    turn_model: alternate              # or concurrent (asp/concurrent.py)
+    turn_model: alternate              # or concurrent (asp/concurrent/)
     cost: steps                        # or time
     max_states: 20000000               # state graph limit (asmplan plan --max-states)
     contact_tol: 0.1                   # mm, largest gap that counts as touching, every pair
@@ -71,8 +71,8 @@ from pathlib import Path
 
 import networkx as nx
 
-from asp.dag import MAX_COST
-from asp.rules import COST_MODELS
+from asp.game.dag import MAX_COST
+from asp.game.rules import COST_MODELS
 from cad.bom import PartRecord, part_records, refuse_unknown_keys
 from cad.directions import DIRECTIONS
 from cad.frame import parse_frame
@@ -304,7 +304,7 @@ def load_spec(path: str | os.PathLike[str]) -> AssemblySpec:
     """
     path = Path(path)
     if path.suffix.lower() == ".in2":
-        from asp.readers.in2 import in2_assembly
+        from asp.salbp import in2_assembly
 
         return spec_from_dict(in2_assembly(path), source=str(path))
     path = resolve_spec_path(path)

@@ -30,7 +30,9 @@ import torch  # noqa: E402
 from arl.config import get_config  # noqa: E402
 from arl.trainer import train  # noqa: E402
 from asmplan import pipeline  # noqa: E402
-from asp.concurrent import build_game, certified_worst_case, concurrent_model  # noqa: E402
+from asp.concurrent.build import build_game  # noqa: E402
+from asp.concurrent.model import concurrent_model  # noqa: E402
+from asp.concurrent.robustness import certified_worst_case  # noqa: E402
 
 
 def main() -> None:

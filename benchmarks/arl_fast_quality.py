@@ -30,7 +30,7 @@ import torch  # noqa: E402
 from arl.config import get_config  # noqa: E402
 from arl.trainer import train  # noqa: E402
 from asp.atomic import write_text  # noqa: E402
-from asp.synth import synthetic_dag  # noqa: E402
+from asp.game.synth import synthetic_dag  # noqa: E402
 
 
 def _sizes(text: str) -> list[tuple[int, int]]:

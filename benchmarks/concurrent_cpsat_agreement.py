@@ -2,7 +2,7 @@
 
 DESIGN.md ("The concurrent game"): every schedule whose operations start at time 0 or at a
 completion is a policy of the cooperative game, so ``W*(0)`` must equal the CP-SAT optimum
-on the same constraints. ``tests/asp/test_concurrent_baseline.py`` checks the graphs of up
+on the same constraints. ``tests/asp/schedule/test_concurrent_baseline.py`` checks the graphs of up
 to 5,000 states; this script checks every graph whose concurrent game fits in
 ``--max-nodes`` (SAWYER30 included) and prints, per graph, the states, both values, the
 CP-SAT status and the seconds of each side. It exits 1 on a disagreement.
@@ -20,11 +20,14 @@ import sys
 import time
 from pathlib import Path
 
-from asp.concurrent import assembly_makespan, build_game, concurrent_model, value
+from asp.concurrent.build import build_game
+from asp.concurrent.model import concurrent_model
+from asp.concurrent.robustness import value
 from asp.errors import AsmplanError
-from asp.solve import solve
+from asp.game.solve import solve
+from asp.graph.state_graph import build_state_graph
+from asp.schedule.assembly_makespan import assembly_makespan
 from asp.spec import load_spec
-from asp.state_graph import build_state_graph
 
 SALBP = Path(__file__).resolve().parents[2] / "shared" / "data" / "salbp"
 

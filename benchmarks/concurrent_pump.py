@@ -12,10 +12,11 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from asp.concurrent import concurrent_model, robustness
-from asp.feasibility import load_relations
+from asp.concurrent.model import concurrent_model
+from asp.concurrent.robustness import robustness
+from asp.graph.feasibility import load_relations
+from asp.graph.state_graph import build_state_graph
 from asp.spec import load_spec
-from asp.state_graph import build_state_graph
 
 EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 

@@ -17,9 +17,10 @@ import argparse
 import resource
 import time
 
-from asp.concurrent import concurrent_model, robustness
+from asp.concurrent.model import concurrent_model
+from asp.concurrent.robustness import robustness
+from asp.graph.state_graph import build_state_graph
 from asp.spec import Agent, AssemblySpec, Operation, Tool
-from asp.state_graph import build_state_graph
 
 
 def job(n_ops: int = 20, robots: int = 2, chains: int = 4, spread: int = 4) -> AssemblySpec:

@@ -43,8 +43,9 @@ import warnings
 from pathlib import Path
 
 from asmplan.pipeline import Assembly, game, load, robust_plan, solve_game, state_graph
-from asp.baseline import min_makespan, schedule_violation
-from asp.concurrent import AUTO_PATIENCE, AUTO_TIME_LIMIT, assembly_makespan, replay_model
+from asp.schedule.assembly_makespan import AUTO_PATIENCE, AUTO_TIME_LIMIT, assembly_makespan
+from asp.schedule.makespan import min_makespan
+from asp.schedule.replay import replay_model, schedule_violation
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO.parent / "shared" / "data"
@@ -79,7 +80,7 @@ def run_assembly(spec, graph, line, limit, undo: bool = True) -> dict:
 
 
 def run_psplib(path: Path, limit) -> dict:
-    from asp.readers.sm import read_sm
+    from asp.schedule.psplib import read_sm
 
     problem = read_sm(path)
     t0 = time.perf_counter()

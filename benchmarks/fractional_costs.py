@@ -22,8 +22,8 @@ import time
 import numpy as np
 from solve_scale import layered_dag
 
-from asp.dag import ANY, HUMAN, ROBOT, from_arrays
-from asp.metrics import plan_metrics
+from asp.game.dag import ANY, HUMAN, ROBOT, from_arrays
+from asp.game.metrics import plan_metrics
 
 
 def peak_mb() -> float:

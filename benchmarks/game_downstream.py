@@ -87,7 +87,7 @@ def main(argv: list[str]) -> None:
     args = parser.parse_args(argv)
 
     from asmplan import pipeline
-    from asp.state_graph import build_state_graph
+    from asp.graph.state_graph import build_state_graph
 
     stages = Stages()
     if args.graph:
@@ -121,7 +121,7 @@ def main(argv: list[str]) -> None:
         sched = pipeline.schedule(assembly, graph, sequence=line, time_limit=5, seed=0)
         stages.lap("CP-SAT schedule (limit 5 s)")
     else:  # not a stage downstream of the game: an empty schedule in the document
-        from asp.baseline import BaselineResult
+        from asp.schedule.cpsat import BaselineResult
 
         empty = BaselineResult("schedule", graph.spec.name, "UNKNOWN", None, None, 0.0)
         sched = pipeline.Schedule(empty, 0.0, 0.0, 0.0)

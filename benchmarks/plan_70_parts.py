@@ -133,7 +133,7 @@ def stages(source) -> None:
     """Plan ``source`` (a path, or an ``Assembly`` already loaded) as ``asmplan plan`` does,
     printing the seconds and memory of each step of :data:`STAGES`."""
     from asmplan import pipeline
-    from asp.checker import check_line, plan_operations
+    from asp.graph.checker import check_line, plan_operations
 
     meter = Meter()
     t0, names = time.perf_counter(), dict(STAGES)

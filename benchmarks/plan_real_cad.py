@@ -102,7 +102,7 @@ def source_unit(path: str) -> str:
 def check_plan(path: str, doc: dict) -> str:
     """``"ok"`` if the independent checker accepts the plan's principal line, else why not."""
     from asmplan import pipeline
-    from asp.checker import PlanCheckError, check_line, plan_operations
+    from asp.graph.checker import PlanCheckError, check_line, plan_operations
     from asp.spec import with_subassemblies
 
     assembly = pipeline.load(path, on_step=lambda _: None)

@@ -15,16 +15,16 @@ import time
 from pathlib import Path
 
 from asmplan.planfile import alternate_states, plan_document, read_plan, write_plan
-from asp.game import game_dag
-from asp.solve import solve
-from asp.state_graph import build_state_graph
+from asp.game.solve import solve
+from asp.graph.game_dag import game_dag
+from asp.graph.state_graph import build_state_graph
 
 REPO = Path(__file__).resolve().parents[1]
 DATA = REPO.parent / "shared" / "data" / "salbp"
 
 
 def _spec(name: str):
-    from asp.generate import load_any
+    from asp.fromcad.generate import load_any
 
     path = Path(name)
     if not path.exists():
@@ -42,7 +42,8 @@ def _alternate(spec):
 
 
 def _concurrent(spec, max_k: int = 2):
-    from asp.concurrent import concurrent_model, robustness
+    from asp.concurrent.model import concurrent_model
+    from asp.concurrent.robustness import robustness
 
     graph = build_state_graph(spec)
     curve = robustness(concurrent_model(spec, graph), max_k=max_k)

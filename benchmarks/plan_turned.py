@@ -5,7 +5,7 @@ by a seeded random rotation (an axis drawn uniformly, 15 to 60 degrees), as a CA
 in the product's own orientation is. Both are planned with ``asmplan plan`` and default
 settings (:func:`benchmarks.plan_real_cad.plan_one`: a child process, the plan checked
 against relations loaded afresh). Prints one row per assembly: the frame the turned one was
-given (``asp/framing.py``; stderr of the plan command), the seconds and peak memory of
+given (``asp/fromcad/framing.py``; stderr of the plan command), the seconds and peak memory of
 each, and TCT / W* of each, which should agree.
 
 Run: ``.venv/bin/python benchmarks/plan_turned.py [--seed N] [NAME ...]`` (names:

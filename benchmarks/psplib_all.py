@@ -12,8 +12,8 @@ import argparse
 import csv
 from pathlib import Path
 
-from asp.baseline import min_makespan
-from asp.readers.sm import read_sm
+from asp.schedule.makespan import min_makespan
+from asp.schedule.psplib import read_sm
 
 DEFAULT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "psplib_j30"
 

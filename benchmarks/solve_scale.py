@@ -14,8 +14,8 @@ import time
 
 import numpy as np
 
-from asp.dag import ANY, HUMAN, ROBOT, from_arrays
-from asp.solve import solve
+from asp.game.dag import ANY, HUMAN, ROBOT, from_arrays
+from asp.game.solve import solve
 
 
 def layered_dag(n: int, out_degree: int, width: int, seed: int):

@@ -20,11 +20,11 @@ import sys
 import time
 from pathlib import Path
 
-from asp.game import game_dag
-from asp.solve import solve
+from asp.game.solve import solve
+from asp.game.synth import synthetic_dag
+from asp.graph.game_dag import game_dag
+from asp.graph.state_graph import build_state_graph
 from asp.spec import Agent, AssemblySpec, Constraints, Operation, load_spec
-from asp.state_graph import build_state_graph
-from asp.synth import synthetic_dag
 
 DEFAULT = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "salbp"
 TARGET_S = 5.0

@@ -14,15 +14,16 @@ from asmplan.cli.options import WORKERS_MAX, seed_option, time_limit_option
 def baseline_result(source: Path, *, time_limit: float, workers: int, seed: int):
     """Dispatch by input: PSPLIB ``.sm``, a game DAG file, or an assembly."""
     from asmplan import pipeline
-    from asp.baseline import min_cost_path, min_makespan
+    from asp.schedule.makespan import min_makespan
+    from asp.schedule.path import min_cost_path
 
     suffix = source.suffix.lower()
     if suffix == ".sm":
-        from asp.readers.sm import read_sm
+        from asp.schedule.psplib import read_sm
 
         return min_makespan(read_sm(source), time_limit=time_limit, workers=workers, seed=seed)
     if suffix in pipeline.GRAPH_SUFFIXES:
-        from asp.io import load_dag
+        from asp.game.io import load_dag
 
         dag = load_dag(source)
         return min_cost_path(dag, time_limit=time_limit, workers=workers, seed=seed)

@@ -42,7 +42,7 @@ def graph_command(
 ) -> None:
     """Build the assembly state graph and the game DAG; print the sizes, write the DAG."""
     from asmplan import pipeline
-    from asp.io import save_dag
+    from asp.game.io import save_dag
 
     check_output(output, folder=False)
     t0 = time.perf_counter()

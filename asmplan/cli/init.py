@@ -26,9 +26,9 @@ def init_command(
     import yaml
 
     from asp.atomic import write_text
-    from asp.generate import spec_text
+    from asp.fromcad.generate import spec_text
     from asp.spec import spec_from_dict
-    from asp.units import cad_units
+    from asp.subassemblies import cad_units
     from cad.yamlfile import DecimalsAsText
 
     if not source.exists():

@@ -12,7 +12,7 @@ from pathlib import Path
 import typer
 
 from asmplan.cli.app import choices
-from asp.rules import COST_MODELS
+from asp.game.rules import COST_MODELS
 from asp.spec import TURN_MODELS
 
 SEED_MAX = 2**32 - 1

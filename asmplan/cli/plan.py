@@ -24,7 +24,7 @@ from asmplan.cli.options import (
     tolerance_option,
     turn_model_option,
 )
-from asp.concurrent import AUTO_PATIENCE, AUTO_TIME_LIMIT
+from asp.schedule.assembly_makespan import AUTO_PATIENCE, AUTO_TIME_LIMIT
 
 AUTO_TIME_LIMIT_HELP = (
     "Seconds for CP-SAT's minimum-makespan search. Default: automatic, the whole schedule "
@@ -57,7 +57,7 @@ def plan_summary(result) -> list[str]:
         f"{result.sequences:,} feasible sequences"
     )
     if result.concurrent is not None:
-        from asp.concurrent_plan import robustness_table, timeline_text
+        from asp.concurrent.plan import robustness_table, timeline_text
 
         plan = result.concurrent
         lines.append("concurrent game (the person and the robots working at once), makespan:")

@@ -21,8 +21,8 @@ import typer
 
 from asmplan.cli.app import app, choices
 from asmplan.cli.options import CostModel, seed_option
+from asp.game.rules import SIDE_NAMES, cost_at_most, costs_close
 from asp.numbers import cost_unit
-from asp.rules import SIDE_NAMES, cost_at_most, costs_close
 
 HELP_TEXT = """\
 How to play
@@ -40,7 +40,7 @@ Side = choices("Side", SIDE_NAMES[:2], "The side the person plays.")
 
 def _robot_policy(dag, robot: str):
     """``robust``/``fast-greedy`` as they are; anything else is a run folder of ``train``."""
-    from asp.play import ROBOT_KINDS
+    from asp.game.play import ROBOT_KINDS
 
     if robot in ROBOT_KINDS:
         return robot, robot
@@ -77,7 +77,7 @@ class _Alike:
     in them, a typed id mapped onto the canonical move (:class:`asp.alike.AlikeMap`)."""
 
     def __init__(self, session, classes):
-        from asp.alike import AlikeMap
+        from asp.game.alike import AlikeMap
 
         self.session = session
         self.map = AlikeMap(classes)
@@ -144,8 +144,8 @@ def _moves_table(session, fmt, alike: _Alike) -> list[str]:
 
 
 def _turn_line(turn, fmt, person: int) -> str:
-    from asp.dag import HUMAN, ROBOT
-    from asp.play import side_name
+    from asp.game.dag import HUMAN, ROBOT
+    from asp.game.play import side_name
 
     who = side_name(turn.player)
     if turn.passed:
@@ -193,8 +193,8 @@ def play_command(
 ) -> None:
     """Play against the robust plan: you take one side, the computer the other."""
     from asmplan.pipeline import load_game
-    from asp.dag import HUMAN, ROBOT
-    from asp.play import GameSession, fmt
+    from asp.game.dag import HUMAN, ROBOT
+    from asp.game.play import GameSession, fmt
 
     game = load_game(source, cost=None if cost is None else cost.value)
     dag, descriptions = game.dag, game.descriptions

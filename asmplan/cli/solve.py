@@ -28,8 +28,8 @@ def solve_command(
 ) -> None:
     """Solve the robot-vs-human game exactly and print the robust plan and its metrics."""
     from asmplan.report.metrics import metrics_text
-    from asp.io import load_dag
-    from asp.metrics import plan_metrics
+    from asp.game.io import load_dag
+    from asp.game.metrics import plan_metrics
 
     dag = load_dag(graph)
     metrics = plan_metrics(dag, wcpl=wcpl, n_games=games, seed=seed)

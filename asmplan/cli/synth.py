@@ -33,8 +33,8 @@ def synth_command(
     output: Path = typer.Option(..., "--output", "-o", help="Graph file (.json or .graphml)."),
 ) -> None:
     """Generate a synthetic assembly DAG (paper, section 3.2)."""
-    from asp.io import save_dag
-    from asp.synth import synthetic_dag
+    from asp.game.io import save_dag
+    from asp.game.synth import synthetic_dag
 
     check_output(output, folder=False)
     dag = synthetic_dag(layers, max_nodes, max_actions, seed=seed)

@@ -18,7 +18,7 @@ from asmplan.cli.options import (
 )
 
 if TYPE_CHECKING:  # pragma: no cover - types only
-    from asp.dag import GameDAG
+    from asp.game.dag import GameDAG
 
 
 SOURCE_HELP = (
@@ -49,7 +49,8 @@ def load_training_game(source: Path, turn_model: TurnModel | None = None) -> Gam
     chosen = turn_model or TurnModel(getattr(assembly.spec, "turn_model", "alternate"))
     if chosen is TurnModel.alternate:
         return pipeline.game(graph)
-    from asp.concurrent import build_game, concurrent_model
+    from asp.concurrent.build import build_game
+    from asp.concurrent.model import concurrent_model
 
     return build_game(concurrent_model(assembly.spec, graph), None).dag
 

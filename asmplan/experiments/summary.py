@@ -17,8 +17,8 @@ from asmplan.experiments.paper_values import (
     PAPER_TABLE4_QUOTED,
 )
 from asmplan.experiments.tasks import ResultRow
+from asp.game.rules import cost_at_most, costs_close
 from asp.numbers import cost_text
-from asp.rules import cost_at_most, costs_close
 
 TITLES = {"table3": "Table 3 (six configurations)", "table4": "Table 4 (ten 20/10 graphs)"}
 

@@ -27,7 +27,7 @@ from enum import StrEnum
 
 import numpy as np
 
-from asp.metrics import PlanMetrics
+from asp.game.metrics import PlanMetrics
 
 EXPERIMENT_KEYS = {"table3": 3, "table4": 4}
 """Spawn-key component of each experiment (its table number in the paper)."""
@@ -312,9 +312,9 @@ def run_task(spec: TaskSpec) -> TaskResult:
     -------
     TaskResult
     """
-    from asp.metrics import plan_metrics
-    from asp.solve import solve
-    from asp.synth import synthetic_dag
+    from asp.game.metrics import plan_metrics
+    from asp.game.solve import solve
+    from asp.game.synth import synthetic_dag
 
     start = time.perf_counter()
     seeds = spec.seeds

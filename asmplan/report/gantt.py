@@ -12,7 +12,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from asp.atomic import write_bytes
-from asp.concurrent_plan import ConcurrentPlan
+from asp.concurrent.plan import ConcurrentPlan
 
 AGENT_COLOURS = {"H": "#9e9e9e", "R1": "#2e9d4a", "R2": "#f28c28"}
 """The paper's Figure 9 colours: operator grey, R1 green, R2 orange."""

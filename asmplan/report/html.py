@@ -121,7 +121,7 @@ def report_figures(
     import tempfile
 
     from asmplan.report.gantt import plot_gantt, plot_robustness
-    from asp.concurrent import Bar
+    from asp.concurrent.describe import Bar
 
     out: dict[str, bytes] = {}
     with tempfile.TemporaryDirectory() as tmp:
@@ -129,7 +129,7 @@ def report_figures(
         if concurrent_plan is None and spec is not None and graph is not None:
             if graph.n_states <= REPORT_MAX_STATES:
                 try:
-                    from asp.concurrent_plan import plan_concurrent
+                    from asp.concurrent.plan import plan_concurrent
 
                     concurrent_plan = plan_concurrent(
                         spec, graph, max_nodes=200_000, schedule=schedule

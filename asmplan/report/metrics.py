@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from asp.metrics import PlanMetrics
+from asp.game.metrics import PlanMetrics
 from asp.numbers import cost_text
 
 

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
+from asp.game.plan import PlanStep
 from asp.numbers import cost_text
-from asp.plan import PlanStep
 
 
 def plan_text(steps: list) -> str:

@@ -19,8 +19,8 @@ import numba
 import numpy as np
 
 from asp.atomic import write_bytes
-from asp.dag import GameDAG, ids_topological
-from asp.solve import node_order
+from asp.game.dag import GameDAG, ids_topological
+from asp.game.solve import node_order
 
 AGENT_COLOURS = {"H": "#9e9e9e", "R1": "#2e9d4a", "R2": "#f28c28"}
 """The paper's Figure 9 colours: operator grey (white there), R1 green, R2 orange."""

@@ -1,6 +1,6 @@
 """Small game DAGs for the arl tests."""
 
-from asp.dag import ANY, HUMAN, ROBOT, GameDAG, from_edges
+from asp.game.dag import ANY, HUMAN, ROBOT, GameDAG, from_edges
 from tests.asp.figures import FIGURE4_EDGES, figure4  # noqa: F401  (re-exported)
 
 

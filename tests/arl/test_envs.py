@@ -10,10 +10,10 @@ from hypothesis import strategies as st
 from stable_baselines3.common.env_checker import check_env as sb3_check_env
 
 from arl.envs import GameVecEnv, HumanEnv, RobotEnv, probability_table
-from arl.game import GameTables
-from asp.dag import HUMAN, ROBOT, from_arrays
-from asp.solve import solve
-from asp.synth import synthetic_dag
+from arl.moves import GameTables
+from asp.game.dag import HUMAN, ROBOT, from_arrays
+from asp.game.solve import solve
+from asp.game.synth import synthetic_dag
 from tests.arl.graphs import figure4, sided_time_dag
 
 GRAPHS = {"figure4": figure4, "sided": sided_time_dag, "synth": lambda: synthetic_dag(4, 3, 3, 1)}

@@ -11,9 +11,9 @@ import torch
 
 from arl import train
 from arl.envs import RobotEnv
-from arl.game import GameTables
-from asp.io import load_dag
-from asp.solve import solve
+from arl.moves import GameTables
+from asp.game.io import load_dag
+from asp.game.solve import solve
 
 
 def _graphml(tmp_path):

@@ -7,7 +7,7 @@ import pytest
 from arl.config import get_config
 from arl.memory import check_training_size, training_bytes
 from arl.trainer import train
-from asp.synth import synthetic_dag
+from asp.game.synth import synthetic_dag
 
 
 @pytest.mark.parametrize("name", ["paper", "fast"])

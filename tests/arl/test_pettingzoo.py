@@ -6,7 +6,7 @@ import numpy as np
 from pettingzoo.test import api_test
 
 from arl.pettingzoo_env import GameAEC
-from asp.synth import synthetic_dag
+from asp.game.synth import synthetic_dag
 from tests.arl.graphs import figure4, sided_time_dag
 
 

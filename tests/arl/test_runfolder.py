@@ -9,7 +9,7 @@ import pytest
 from arl import get_config, runfolder, train
 from arl.trainer import read_log
 from asmplan.cli.app import main
-from asp.io import save_dag
+from asp.game.io import save_dag
 from tests.arl.graphs import figure4
 
 pytestmark = pytest.mark.usefixtures("deterministic_torch")

@@ -10,9 +10,9 @@ import torch
 
 import arl.tabulate as tabulate
 from arl.envs import Observer
-from arl.game import GameTables
-from asp.dag import HUMAN, ROBOT
-from asp.synth import synthetic_dag
+from arl.moves import GameTables
+from asp.game.dag import HUMAN, ROBOT
+from asp.game.synth import synthetic_dag
 
 
 class FakePolicy:

@@ -7,8 +7,8 @@ import pytest
 
 from arl import evaluate, get_config, train
 from asmplan.cli.app import main
-from asp.io import save_dag
-from asp.solve import solve
+from asp.game.io import save_dag
+from asp.game.solve import solve
 from tests.arl.graphs import figure4, sided_time_dag
 
 # A smaller `fast` so that each cycle takes a few hundredths of a second.
@@ -105,9 +105,9 @@ def test_cli_train_and_evaluate(tmp_path, capsys):
 
 
 def test_trains_on_an_in2_assembly_with_time_costs(shared_data):
-    from asp.game import game_dag
+    from asp.graph.game_dag import game_dag
+    from asp.graph.state_graph import build_state_graph
     from asp.spec import load_spec
-    from asp.state_graph import build_state_graph
 
     spec = load_spec(shared_data / "salbp" / "BOWMAN8.IN2")  # Bowman (1960), via Scholl
     dag = game_dag(build_state_graph(spec), cost="time")

@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 from asmplan import pipeline
 from asmplan.cli import app
 from asmplan.planfile import build_rotation
-from asp.checker import check_line, plan_operations
+from asp.graph.checker import check_line, plan_operations
 from asp.spec import with_subassemblies
 from tests.asmplan.mesh_replay import replayed
 

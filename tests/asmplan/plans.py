@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 from asmplan.planfile import alternate_states, plan_document
-from asp.game import game_dag
-from asp.solve import solve
+from asp.game.solve import solve
+from asp.graph.game_dag import game_dag
+from asp.graph.state_graph import build_state_graph
 from asp.spec import spec_from_dict
-from asp.state_graph import build_state_graph
 
 CELL = {
     "name": "cell",
@@ -77,7 +77,8 @@ def cell_plan(cost: str | None = None) -> dict:
 def concurrent_cell(data: dict | None = None, *, max_k: int = 2, step: float | None = 1.0):
     """(spec, curve) of a job in the concurrent game (default: the small cell), budgets
     ``0..max_k`` (:func:`asp.concurrent.robustness`)."""
-    from asp.concurrent import concurrent_model, robustness
+    from asp.concurrent.model import concurrent_model
+    from asp.concurrent.robustness import robustness
 
     spec = spec_from_dict(data or CELL, source="cell.yaml")
     graph = build_state_graph(spec)
@@ -101,7 +102,7 @@ def alike_plan(spec, relations, turn_model: str = "alternate", *, cost: str = "t
     symmetry (:func:`asp.symmetry.reduced_state_graph`: the policy knows one canonical
     order of each class; ``interchangeable`` lists the classes). ``concurrent``: budgets
     0 to 2."""
-    from asp.symmetry import reduced_state_graph
+    from asp.graph.symmetry import reduced_state_graph
 
     concurrent = turn_model == "concurrent"
     graph = reduced_state_graph(spec, relations, concurrent=concurrent)
@@ -115,7 +116,8 @@ def alike_plan(spec, relations, turn_model: str = "alternate", *, cost: str = "t
             describe=alternate_states(graph, dag),
             interchangeable=classes,
         )
-    from asp.concurrent import concurrent_model, robustness
+    from asp.concurrent.model import concurrent_model
+    from asp.concurrent.robustness import robustness
 
     curve = robustness(concurrent_model(graph.spec, graph, step=1.0), max_k=2)
     return plan_document(

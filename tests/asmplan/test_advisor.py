@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from asmplan.advisor import Advisor, ObservationError, placed_parts
-from asp.dag import HUMAN, ROBOT
+from asp.game.dag import HUMAN, ROBOT
 from tests.asmplan.plans import cell_game, cell_plan
 
 PLANS = {cost: cell_plan(cost) for cost in ("time", "steps")}

@@ -17,8 +17,8 @@ from hypothesis import strategies as st
 from asmplan.advisor import Advisor, ObservationError
 from asmplan.planfile import validate_plan
 from tests.asmplan.plans import alike_plan
+from tests.asp.graph.test_symmetry import pinned_disc
 from tests.asp.helpers_assembly import pin_roller_ring
-from tests.asp.test_symmetry import pinned_disc
 
 SPECS = {"disc": pinned_disc(3, 2), "ring": pin_roller_ring(3)}
 TURN_MODELS = ("alternate", "concurrent")

@@ -13,8 +13,8 @@ import random
 import pytest
 
 from asmplan.advisor import Advisor, ConcurrentAdvisor, ObservationError
-from asp.concurrent import commit_description, move_starts, state_description
-from asp.dag import ROBOT
+from asp.concurrent.describe import commit_description, move_starts, state_description
+from asp.game.dag import ROBOT
 from tests.asmplan.plans import CELL, CHOICES, concurrent_cell, concurrent_plan, with_ranges
 from tests.conftest import REPO
 

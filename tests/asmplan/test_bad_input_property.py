@@ -21,7 +21,7 @@ from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from asmplan.cli import app
-from asp.io import save_dag
+from asp.game.io import save_dag
 from tests.asp.figures import figure4
 from tests.conftest import REPO
 

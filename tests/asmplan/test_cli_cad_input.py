@@ -96,7 +96,7 @@ def test_a_bom_beside_the_scene_overrides_and_adds_parts(tmp_path):
     pytest.importorskip("cascadio")
     import shutil
 
-    from asp.generate import generated_spec
+    from asp.fromcad.generate import generated_spec
 
     shutil.copy(STEP, tmp_path / "frame.step")
     shapes.box_between((40, 40, 76.2), (60, 60, 86.2)).export(tmp_path / "knob.stl")
@@ -116,7 +116,7 @@ def test_a_bom_beside_the_scene_overrides_and_adds_parts(tmp_path):
 
 def test_the_cad_hierarchy_of_a_spec(tmp_path):
     pytest.importorskip("cascadio")
-    from asp.generate import generated_spec, spec_hierarchy
+    from asp.fromcad.generate import generated_spec, spec_hierarchy
 
     spec = generated_spec(STEP)
     assert spec_hierarchy(spec) == (

@@ -6,7 +6,7 @@ import sys
 
 import pytest
 
-from asp.io import save_dag
+from asp.game.io import save_dag
 from tests.asp.figures import SOLVE_KEYS, figure4
 
 REQUIRED = SOLVE_KEYS

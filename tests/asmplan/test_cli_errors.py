@@ -7,7 +7,7 @@ import pytest
 import asmplan.errors
 from asmplan.cli import main
 from asmplan.errors import AsmplanError
-from asp.io import save_dag
+from asp.game.io import save_dag
 from tests.asp.figures import figure4
 
 
@@ -112,15 +112,15 @@ def test_help_still_works(capsys):
 def test_library_warnings_are_one_line(capsys, graph, monkeypatch):
     import warnings
 
-    import asp.io
+    import asp.game.io
 
-    real = asp.io.load_dag
+    real = asp.game.io.load_dag
 
     def load_with_a_warning(path):
         warnings.warn("part X is not watertight:\nvolume may be wrong", stacklevel=2)
         return real(path)
 
-    monkeypatch.setattr(asp.io, "load_dag", load_with_a_warning)
+    monkeypatch.setattr(asp.game.io, "load_dag", load_with_a_warning)
     code, err = run(capsys, "solve", graph, "--games", "10")
     assert code == 0
     assert err == "asmplan: warning: part X is not watertight: volume may be wrong\n"
@@ -131,7 +131,7 @@ def test_cli_choices_are_the_domain_names():
     from asmplan.cli.experiment import ConfigChoice, TableChoice
     from asmplan.cli.options import CostModel
     from asmplan.experiments.tasks import EXPERIMENT_KEYS
-    from asp.rules import COST_MODELS
+    from asp.game.rules import COST_MODELS
 
     assert tuple(ConfigChoice) == tuple(CONFIGS)
     assert tuple(TableChoice) == tuple(EXPERIMENT_KEYS)

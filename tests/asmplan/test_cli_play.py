@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 
 import asmplan.cli.play  # noqa: F401  registers the command
 from asmplan.cli.app import app, main
-from asp.io import save_dag
+from asp.game.io import save_dag
 from tests.asp.figures import figure4
 
 PUMP = Path(__file__).resolve().parents[2] / "examples" / "vacuum_pump"
@@ -89,7 +89,7 @@ def test_fast_greedy_robot(fig4):
 
 
 def test_passes_are_announced(tmp_path):
-    from asp.dag import HUMAN, ROBOT, from_edges
+    from asp.game.dag import HUMAN, ROBOT, from_edges
 
     dag = from_edges(
         ["a", "b", "c"], [("a", "b"), ("b", "c")], sides=[HUMAN, ROBOT], operations=["o1", "o2"]
@@ -148,7 +148,7 @@ def test_pump_as_robot_steps_cost():
 
 def test_robot_from_a_trained_run(fig4, tmp_path):
     from arl import get_config, train
-    from asp.io import load_dag
+    from asp.game.io import load_dag
 
     tiny = get_config("fast").replace(
         name="tiny", n_envs=16, n_steps=16, phase_steps=256, max_cycles=2
@@ -168,9 +168,9 @@ def test_an_alike_part_may_be_typed_by_its_id(monkeypatch, tmp_path):
     """An assembly's game knows one order of its alike pins: the moves show the physical
     ones with those as good, and typing any of them plays the plan's move."""
     from asmplan import pipeline
-    from asp.game import game_dag
-    from asp.symmetry import reduced_state_graph
-    from tests.asp.test_symmetry import pinned_disc
+    from asp.graph.game_dag import game_dag
+    from asp.graph.symmetry import reduced_state_graph
+    from tests.asp.graph.test_symmetry import pinned_disc
 
     spec, rel = pinned_disc(3, 2)
     graph = reduced_state_graph(spec, rel)

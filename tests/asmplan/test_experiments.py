@@ -231,7 +231,7 @@ def test_ray_backend_matches_local(ray_instance, serial_sweep, tmp_path):
 
 def fake_train(dag, config="paper", seed=0, **_):
     """A stand-in for arl.train: first-edge policies, deterministic reward curves."""
-    from asp.solve import certified_worst_case, play
+    from asp.game.solve import certified_worst_case, play
 
     first = np.where(np.diff(dag.indptr) > 0, dag.indptr[:-1], -1).astype(np.int64)
     _, wcpl = play(dag, first, first)

@@ -14,13 +14,13 @@ import functools
 import pytest
 
 from asmplan import pipeline
-from asp.game import game_dag
-from asp.generate import gravity_choice
-from asp.solve import solve
+from asp.fromcad.generate import gravity_choice
+from asp.game.solve import solve
+from asp.graph.game_dag import game_dag
+from asp.graph.state_graph import build_state_graph
+from asp.graph.symmetry import interchangeable_blocks
 from asp.spec import with_subassemblies
-from asp.state_graph import build_state_graph
-from asp.symmetry import interchangeable_blocks
-from asp.units import prepared_units
+from asp.subassemblies import prepared_units
 from cad import DIRECTIONS, Assembly, compute_relations
 from tests.asmplan.checked import plan_and_check
 from tests.cad import products

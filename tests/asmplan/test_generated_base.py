@@ -14,9 +14,9 @@ from pathlib import Path
 import pytest
 
 from asmplan import pipeline
-from asp.checker import check_line, plan_operations
-from asp.generate import spec_text, workable_base
-from asp.symmetry import infeasibility
+from asp.fromcad.generate import spec_text, workable_base
+from asp.graph.checker import check_line, plan_operations
+from asp.graph.symmetry import infeasibility
 from tests.cad.real_shapes import box
 
 

@@ -20,8 +20,8 @@ from typer.testing import CliRunner
 import cad
 from asmplan import pipeline
 from asmplan.cli import app
-from asp.generate import gravity_choice
-from asp.gravity import base_index, one_sequence
+from asp.fromcad.generate import gravity_choice
+from asp.fromcad.gravity import base_index, one_sequence
 from cad.assembly import prepare_part
 from tests.asmplan.checked import plan_and_check
 from tests.cad.real_shapes import bolted_bracket, box
@@ -127,7 +127,7 @@ def test_a_y_up_export_plans_with_gravity_minus_y(tmp_path):
     assert result.exit_code == 0, result.output
     assert "gravity -y: not the default -z" in result.stderr
     text = out.read_text()
-    assert "gravity: -y" in text and "likely Y up (asp/gravity.py)" in text
+    assert "gravity: -y" in text and "likely Y up (asp/fromcad/gravity.py)" in text
     assert yaml.safe_load(text)["gravity"] == "-y"
 
 

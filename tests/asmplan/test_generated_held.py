@@ -16,8 +16,8 @@ from typer.testing import CliRunner
 
 from asmplan import pipeline
 from asmplan.cli import app
-from asp.checker import PlanCheckError, check_line, plan_operations
-from asp.generate import generated_spec, hold_unsupported
+from asp.fromcad.generate import generated_spec, hold_unsupported
+from asp.graph.checker import PlanCheckError, check_line, plan_operations
 from asp.spec import load_spec
 from tests.asmplan.checked import plan_and_check
 from tests.cad.real_shapes import box, cylinder, difference

@@ -20,7 +20,7 @@ TORCH_STACK = ("torch", "stable_baselines3", "sb3_contrib", "tensorboard")
 
 
 def module_name(path: Path) -> str:
-    """``asp/readers/in2.py`` -> ``asp.readers.in2``."""
+    """``asp/salbp.py`` -> ``asp.readers.in2``."""
     parts = path.relative_to(REPO).with_suffix("").parts
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 
@@ -103,3 +103,70 @@ def test_no_import_cycles():
     g = nx.DiGraph([(a, b) for a, bs in module_graph().items() for b in bs])
     cycles = [c for c in nx.simple_cycles(g) if frozenset(c) not in KNOWN_CYCLES]
     assert not cycles, f"import cycles (function-level imports included): {cycles}"
+
+
+ASP_FLOORS = (
+    ("errors", "numbers", "atomic", "heap"),
+    ("game",),
+    ("salbp",),
+    ("spec",),
+    ("graph",),
+    ("schedule", "fromcad"),
+    ("concurrent", "subassemblies"),
+)
+"""The rooms of ``asp`` from the ground up (a room: a sub-package or a top-level module). A
+module imports its own room and the rooms of lower floors; two rooms of one floor never
+import each other."""
+
+
+def asp_room(module: str) -> str:
+    """``asp.graph.symmetry`` -> ``graph``; ``asp.spec`` -> ``spec``."""
+    return module.split(".")[1]
+
+
+def floor(room: str) -> int:
+    return next(k for k, rooms in enumerate(ASP_FLOORS) if room in rooms)
+
+
+def test_every_asp_module_has_a_room():
+    rooms = {room for rooms in ASP_FLOORS for room in rooms}
+    homeless = [
+        str(path.relative_to(REPO))
+        for path in sources("asp")
+        if module_name(path) != "asp" and asp_room(module_name(path)) not in rooms
+    ]
+    assert not homeless, f"place these in a room of ASP_FLOORS: {homeless}"
+
+
+def test_asp_rooms_import_down():
+    wrong = []
+    for path in sources("asp"):
+        name = module_name(path)
+        if name == "asp":
+            continue  # the package's face names what the rooms define
+        room = asp_room(name)
+        for line, module in imports(path):
+            if module.split(".")[0] != "asp" or module == "asp":
+                continue
+            other = asp_room(module)
+            if other != room and floor(other) >= floor(room):
+                wrong.append(f"{path.relative_to(REPO)}:{line} ({room}) imports {module}")
+    assert not wrong, f"asp's rooms import their own and lower floors only: {wrong}"
+
+
+def test_no_module_imports_private_names():
+    wrong = []
+    for pkg in ("asp", "arl", "asmplan"):
+        for path in sources(pkg):
+            tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+            for node in ast.walk(tree):
+                if not isinstance(node, ast.ImportFrom) or node.level or not node.module:
+                    continue
+                if node.module.split(".")[0] not in LAYERS:
+                    continue
+                wrong += [
+                    f"{path.relative_to(REPO)}:{node.lineno} imports {node.module}.{a.name}"
+                    for a in node.names
+                    if a.name.startswith("_")
+                ]
+    assert not wrong, f"a private name stays in its module: {wrong}"

@@ -9,7 +9,7 @@ from typer.testing import CliRunner
 
 from asmplan import pipeline
 from asmplan.cli import app
-from asp.io import save_dag
+from asp.game.io import save_dag
 from tests.asp.figures import figure4
 from tests.cad import shapes
 from tests.cad.test_loading import write_folder

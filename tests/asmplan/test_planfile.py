@@ -15,9 +15,9 @@ from asmplan.planfile import (
     validate_plan,
     write_plan,
 )
-from asp.checker import check_line, plan_operations
-from asp.dag import HUMAN, ROBOT
-from asp.solve import evaluate_policy
+from asp.game.dag import HUMAN, ROBOT
+from asp.game.solve import evaluate_policy
+from asp.graph.checker import check_line, plan_operations
 from tests.asmplan.plans import CELL, cell_game, cell_plan, concurrent_cell, concurrent_plan
 
 

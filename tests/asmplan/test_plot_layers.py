@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 import asmplan.report.plot as plot
-from asp.synth import synthetic_dag
+from asp.game.synth import synthetic_dag
 
 
 def test_large_dag_is_drawn_by_layers(tmp_path, monkeypatch):

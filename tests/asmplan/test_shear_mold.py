@@ -17,8 +17,8 @@ from typer.testing import CliRunner
 
 from asmplan import pipeline
 from asmplan.cli import app
-from asp.checker import PlanCheckError, check_line, plan_operations
-from asp.orientation import opposite, orient_units, unit_orientation
+from asp.fromcad.orientation import opposite, orient_units, unit_orientation
+from asp.graph.checker import PlanCheckError, check_line, plan_operations
 from asp.spec import with_subassemblies
 from tests.asmplan.checked import plan_and_check
 from tests.asmplan.mesh_replay import replayed

@@ -8,13 +8,14 @@ from __future__ import annotations
 import pytest
 
 from asmplan import pipeline
-from asp.concurrent import concurrent_model, robustness
-from asp.game import game_dag
-from asp.solve import solve
+from asp.concurrent.model import concurrent_model
+from asp.concurrent.robustness import robustness
+from asp.game.solve import solve
+from asp.graph.game_dag import game_dag
+from asp.graph.state_graph import build_state_graph
+from asp.graph.symmetry import interchangeable_blocks
 from asp.spec import with_subassemblies
-from asp.state_graph import build_state_graph
-from asp.symmetry import interchangeable_blocks
-from asp.units import prepared_units
+from asp.subassemblies import prepared_units
 
 
 @pytest.fixture(scope="module")

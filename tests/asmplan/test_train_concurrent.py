@@ -11,8 +11,10 @@ from arl.pettingzoo_env import GameAEC
 from arl.trainer import load_policies
 from asmplan import pipeline
 from asmplan.cli.app import main
-from asp.concurrent import build_game, certified_worst_case, concurrent_model, robustness
-from asp.io import save_dag
+from asp.concurrent.build import build_game
+from asp.concurrent.model import concurrent_model
+from asp.concurrent.robustness import certified_worst_case, robustness
+from asp.game.io import save_dag
 from tests.conftest import REPO
 
 PUMP = REPO / "examples" / "vacuum_pump"

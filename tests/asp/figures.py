@@ -1,6 +1,6 @@
 """Graphs from the paper, built in code."""
 
-from asp.dag import GameDAG, from_edges
+from asp.game.dag import GameDAG, from_edges
 
 FIGURE4_EDGES = [
     (1, 2),

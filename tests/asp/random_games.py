@@ -3,7 +3,7 @@ costs."""
 
 import numpy as np
 
-from asp.dag import ANY, HUMAN, ROBOT, GameDAG, from_arrays
+from asp.game.dag import ANY, HUMAN, ROBOT, GameDAG, from_arrays
 
 FRACTIONAL_COSTS = (0.1, 0.2, 0.5, 1.0, 1.25, 2.5, 3.0)
 

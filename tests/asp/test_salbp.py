@@ -6,11 +6,11 @@ import json
 
 import pytest
 
-from asp.game import game_dag
-from asp.readers.in2 import read_in2
-from asp.solve import solve
+from asp.game.solve import solve
+from asp.graph.game_dag import game_dag
+from asp.graph.state_graph import build_state_graph
+from asp.salbp import read_in2
 from asp.spec import load_spec
-from asp.state_graph import build_state_graph
 from tests.asp.helpers_assembly import brute_force_downsets, brute_force_sequences
 
 # name: tasks, precedence pairs, states, transitions

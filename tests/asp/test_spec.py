@@ -162,7 +162,7 @@ def test_spec_and_bom_accept_the_same_parts(tmp_path):
 
 
 def test_a_part_without_a_mesh_is_named_when_geometry_is_needed(tmp_path):
-    from asp.generate import spec_geometry
+    from asp.fromcad.generate import spec_geometry
 
     spec = spec_from_dict(variant(("parts",), ["A", {"id": "B", "file": "b.stl"}]), "x.yaml")
     with pytest.raises(ValueError, match="part 'A' has no mesh file"):

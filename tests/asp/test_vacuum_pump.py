@@ -9,14 +9,16 @@ import pytest
 from typer.testing import CliRunner
 
 from asmplan.cli import app, main
-from asp.baseline import assembly_schedule, min_cost_path, min_makespan
-from asp.checker import check_line, plan_operations
-from asp.feasibility import load_relations
-from asp.game import game_dag
-from asp.plan import play_steps, relations_summary
-from asp.solve import certified_worst_case, solve
+from asp.game.plan import play_steps, relations_summary
+from asp.game.solve import certified_worst_case, solve
+from asp.graph.checker import check_line, plan_operations
+from asp.graph.feasibility import load_relations
+from asp.graph.game_dag import game_dag
+from asp.graph.state_graph import build_state_graph
+from asp.schedule.assembly import assembly_schedule
+from asp.schedule.makespan import min_makespan
+from asp.schedule.path import min_cost_path
 from asp.spec import load_spec
-from asp.state_graph import build_state_graph
 
 PUMP = Path(__file__).resolve().parents[2] / "examples" / "vacuum_pump"
 
@@ -128,7 +130,7 @@ def test_graph_command(tmp_path, shared_data):
     assert out.exit_code == 0, out.output
     data = json.loads(out.output)
     assert {"states", "transitions", "sequences", "game_nodes", "game_edges"} <= set(data)
-    from asp.io import load_dag
+    from asp.game.io import load_dag
 
     dag = load_dag(target)
     assert dag.n_nodes == data["game_nodes"] and dag.operations is not None

@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 import trimesh
 
-from asp.checker import check_line
+from asp.graph.checker import check_line
+from asp.graph.state_graph import build_state_graph
 from asp.spec import spec_from_dict
-from asp.state_graph import build_state_graph
 from cad import DIRECTIONS, Assembly, compute_relations
 from tests.cad.real_shapes import box, cylinder, difference, revolve
 

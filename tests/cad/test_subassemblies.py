@@ -6,12 +6,12 @@ import re
 
 import pytest
 
-from asp.checker import check_line
-from asp.game import game_dag
-from asp.solve import solve
+from asp.game.solve import solve
+from asp.graph.checker import check_line
+from asp.graph.game_dag import game_dag
+from asp.graph.state_graph import build_state_graph
 from asp.spec import spec_from_dict
-from asp.state_graph import build_state_graph
-from asp.units import build_with_units
+from asp.subassemblies import build_with_units
 from cad import Assembly, compute_relations
 from tests.cad.real_shapes import annulus, box, cylinder, difference, union
 
@@ -82,13 +82,13 @@ def test_a_proof_stands_for_a_graph_too_large_to_find_the_stuck_parts(tower, mon
     to ``PROVED_ROUND_STATES`` states only (``None``: the default, the tower fits); beyond,
     the holder the proof names is grouped with its bearings without any graph of a spec
     that has no complete sequence. Every way finds the same units and plan."""
-    import asp.state_graph
-    import asp.units
+    import asp.graph.state_graph
+    import asp.subassemblies
 
     if cap is not None:
-        monkeypatch.setattr(asp.units, "PROVED_ROUND_STATES", cap)
+        monkeypatch.setattr(asp.subassemblies, "PROVED_ROUND_STATES", cap)
     built = []
-    real = asp.state_graph.build_state_graph
+    real = asp.graph.state_graph.build_state_graph
 
     def spy(spec, *args, **kwargs):
         try:
@@ -99,7 +99,7 @@ def test_a_proof_stands_for_a_graph_too_large_to_find_the_stuck_parts(tower, mon
         built.append((spec.subassemblies, kwargs.get("check", True), graph.n_states))
         return graph
 
-    monkeypatch.setattr(asp.state_graph, "build_state_graph", spy)
+    monkeypatch.setattr(asp.graph.state_graph, "build_state_graph", spy)
     lines = []
     graph = build_with_units(tower_spec(tower), tower, reduce=True, on_unit=lines.append)
     assert sorted(map(sorted, dict(graph.spec.subassemblies).values())) == [
@@ -150,7 +150,7 @@ def test_bad_subassemblies_are_one_line_errors(tower, units, message):
 
 def test_plan_file_shows_the_hierarchy(tower):
     from asmplan import pipeline
-    from asp.checker import plan_operations
+    from asp.graph.checker import plan_operations
 
     result = pipeline.plan(pipeline.Assembly(tower_spec(tower), tower), time_limit=5)
     doc = result.to_dict()
@@ -257,7 +257,7 @@ def test_walls_enter_with_their_gussets(gusset_box):
 
 def test_gusseted_box_plans_with_defaults(gusset_box):
     from asmplan import pipeline
-    from asp.checker import plan_operations
+    from asp.graph.checker import plan_operations
 
     result = pipeline.plan(pipeline.Assembly(box_spec(gusset_box), gusset_box), time_limit=5)
     doc = result.to_dict()
@@ -309,7 +309,7 @@ TOWER_TREE = {
 
 def test_the_files_sub_assemblies_become_units(tmp_path):
     from asmplan import pipeline
-    from asp.checker import plan_operations
+    from asp.graph.checker import plan_operations
 
     write_glb(tmp_path / "tower.glb", rod_tower(), TOWER_TREE)
     lines = []
@@ -352,8 +352,8 @@ def test_a_sub_assembly_that_leaves_no_sequence_is_given_up(tmp_path):
     then the corner's gusset can go in with neither wall: the plan gives the corner up and
     finds the walls with their gussets instead."""
     from asmplan import pipeline
-    from asp.checker import plan_operations
-    from asp.units import GIVEN_UP
+    from asp.graph.checker import plan_operations
+    from asp.subassemblies import GIVEN_UP
 
     parts = gusseted_box()
     others = [p for p in parts if p not in ("front", "left")]
@@ -388,7 +388,7 @@ def pairs_spec(n_units: int, generated: bool = False):
 
 
 def test_many_units_are_built_one_after_another():
-    from asp.units import MAX_WORKSPACE_PRODUCT, built_in_turn
+    from asp.subassemblies import MAX_WORKSPACE_PRODUCT, built_in_turn
 
     few = pairs_spec(2)
     assert MAX_WORKSPACE_PRODUCT >= 3**2 and built_in_turn(few) is few
@@ -408,7 +408,7 @@ def test_a_generated_spec_holds_a_unit_nothing_outside_holds_up():
 
     import numpy as np
 
-    from asp.units import hold_unsupported_units
+    from asp.subassemblies import hold_unsupported_units
 
     spec = pairs_spec(2, generated=True)
     parts = list(spec.part_ids)
@@ -439,8 +439,8 @@ def test_a_unit_the_derived_precedences_refute_is_given_up_before_building(tmp_p
     shut the ring out, which can rest on nothing but the shaft. The derived precedences
     prove it without a state graph; the unit is given up, with the proof on stderr."""
     from asmplan import pipeline
-    from asp.checker import plan_operations
-    from asp.units import GIVEN_UP, refuted_units
+    from asp.graph.checker import plan_operations
+    from asp.subassemblies import GIVEN_UP, refuted_units
 
     write_glb(
         tmp_path / "shaft.glb",

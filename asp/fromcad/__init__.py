@@ -1,0 +1,6 @@
+"""A first assembly spec from a CAD file alone, and the choices it makes from the geometry.
+
+:mod:`~asp.fromcad.generate` (the generated spec and ``asmplan init``'s commented file),
+:mod:`~asp.fromcad.gravity` (which way is down), :mod:`~asp.fromcad.framing` (the build
+frame) and :mod:`~asp.fromcad.orientation` (which way up a unit is built).
+"""

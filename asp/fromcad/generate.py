@@ -1,0 +1,697 @@
+"""Specs generated from CAD: a first plan from a CAD file alone, and the geometry of a spec.
+
+:func:`generated_spec` turns a CAD file (STEP, glTF/GLB, 3MF, 3DXML, a mesh) or a folder
+of part meshes into a valid :class:`~asp.spec.AssemblySpec`; :func:`spec_text` writes the
+same spec as a commented ``assembly.yaml`` for the user to edit (``asmplan init``). The
+rule, fixed so that a generated spec plans the same as the file it writes:
+
+- parts: one per mesh node of the file (ids and names from the file, :mod:`cad.scene`),
+  or per mesh file of the folder (a ``bom.csv``/``bom.yaml`` in the folder still names
+  them); ``shape`` is the shape class (identical parts share it, :mod:`cad.identical`);
+- frame: the file's own, unless some pair of parts can never be assembled in it (each
+  blocks the other along every axis direction, :func:`cad.frame.interlocked`: the Fabrica
+  duct's pins lie 30 degrees off ``z``); then a few frames turning a part axis the parts
+  share onto a coordinate axis are tried (:mod:`asp.framing`), the first that leaves every
+  part a way in taken; ``frame:`` in the spec, said on stderr;
+- gravity: the format's own down (``-y`` for glTF/GLB, whose specification makes ``+y``
+  up; ``-z`` for the others) unless another axis direction is clearly better for the
+  parts' relations (:mod:`asp.gravity`: a Y-up STEP export gets ``-y``);
+  :func:`orient_generated` applies it once the relations are computed, and says why;
+- the base part, placed first: the lowest of the large parts along gravity (those whose
+  footprint, the bounding box's area across gravity, is at least half the largest);
+- agents: one human ``H`` and one robot ``R1``;
+- one placement operation per part, ids ``"1"``, ``"2"``, ... in the order base first,
+  then the others from the lowest to the highest (against gravity), open to both agents;
+- durations (:func:`placement_durations`): the human takes 3 s plus 1 s per 25 mm of
+  the part's bounding-box diagonal, at most 60 s, in whole seconds; the robot takes 1.5
+  times as long (rounded to whole seconds); the cost model is ``time``;
+- every gripper approach direction, every constraint on; the units are
+  those the files declare (STEP, glTF, 3MF), ``units: mm`` for the others;
+- ``held: true`` on the placement of every part (the base aside) that no other part can
+  stop falling along gravity (:func:`unsupported_parts`: its row of the support relation
+  ``SP_g`` is empty, e.g. a dowel in a through hole or a shaft in a bore with clearance):
+  an agent holds it until a later operation fixes it. It needs the part relations, so
+  :func:`hold_unsupported` applies it once they are computed (``asmplan.pipeline.load``),
+  and :func:`spec_text` computes them to write it;
+- subassemblies: the file's sub-assemblies that can be built on their own and inserted
+  as one unit (:func:`asp.units.cad_units`: not holding the base part, buildable in their
+  own workspace, free from the base part along some direction) are units; the others are
+  written commented with the reason. The state graph of a generated spec gives up a unit
+  that leaves no complete sequence (:func:`asp.units.build_with_units`).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections import Counter
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from asp.errors import SpecError
+from asp.numbers import json_number
+from asp.spec import SPEC_FILE, AssemblySpec, load_spec, spec_from_dict, with_subassemblies
+
+HUMAN_BASE_S = 3.0
+HUMAN_S_PER_MM = 1.0 / 25.0
+MAX_DURATION_S = 60.0
+ROBOT_FACTOR = 1.5
+
+
+def placement_durations(diagonal_mm: float) -> tuple[float, float]:
+    """``(human, robot)`` seconds to place a part of bounding-box diagonal ``diagonal_mm``."""
+    human = min(MAX_DURATION_S, float(round(HUMAN_BASE_S + HUMAN_S_PER_MM * diagonal_mm)))
+    return human, float(round(ROBOT_FACTOR * human))
+
+
+HELD_REASON = "nothing below can stop it falling; an agent holds it until a later part fixes it"
+"""Why a generated spec marks an operation ``held`` (the comment ``asmplan init`` writes)."""
+
+
+def unsupported_parts(relations, gravity: str, base: str | None = None) -> tuple[str, ...]:
+    """Parts that no other part can keep from falling along ``gravity``.
+
+    Part ``i`` is unsupported when ``sp[i, j, g]`` is false for every ``j`` (no drop onto
+    any part, threaded on none), so every insertion of it fails the stability test unless
+    an agent holds it. The base part (placed first, never tested) is left out; relations
+    without a support table (built by hand) give none.
+
+    Parameters
+    ----------
+    relations : cad.relations.Relations
+        ``parts`` and ``sp`` ``(n, n, 6)`` bool (or None).
+    gravity : str
+        The spec's gravity direction, e.g. ``"-z"``.
+    base : str, optional
+        The base part id.
+
+    Returns
+    -------
+    tuple of str
+        Part ids, in the order of ``relations.parts``.
+    """
+    from cad.directions import DIRECTIONS
+
+    if getattr(relations, "sp", None) is None:
+        return ()
+    rows = np.asarray(relations.sp, dtype=bool)[:, :, DIRECTIONS.index(gravity)].any(axis=1)
+    return tuple(
+        str(p) for p, ok in zip(relations.parts, rows, strict=True) if not ok and p != base
+    )
+
+
+def hold_unsupported(spec: AssemblySpec, relations) -> tuple[AssemblySpec, tuple[str, ...]]:
+    """A generated spec with ``held: true`` on the placement of each unsupported part.
+
+    Only for a generated spec (``spec.generated``) with the stability constraint on; a
+    user's spec is returned unchanged. Returns the spec and the parts now held (in the
+    order of the operations).
+    """
+    if not spec.generated or not spec.constraints.stability or relations is None:
+        return spec, ()
+    loose = set(unsupported_parts(relations, spec.gravity, spec.base_part))
+    ops = [replace(op, held=True) if set(op.parts) & loose else op for op in spec.operations]
+    held = tuple(p for op in spec.operations for p in op.parts if p in loose)
+    return (replace(spec, operations=tuple(ops)) if held else spec), held
+
+
+def workable_base(spec: AssemblySpec, relations) -> tuple[AssemblySpec, str]:
+    """A generated spec on a base part from which the assembly is not ruled out.
+
+    The geometric rule (:func:`base_index`) looks at bounding boxes only; when the derived
+    precedences (:func:`asp.symmetry.infeasibility`) prove that no complete sequence starts
+    from that base (with gravity as given, e.g. a drive drawn upside down whose lowest large
+    part rests on parts that need the parts above it), the other parts are tried, those
+    touching the most parts first (then in operation order), and the first not ruled out
+    becomes the base; its placement moves to the front. ``held`` is set as
+    :func:`hold_unsupported` does. A user's spec, or one no other base helps, is unchanged.
+
+    Returns
+    -------
+    (AssemblySpec, str)
+        The spec (``held`` applied) and a note naming the new base and why ("" if kept).
+    """
+    from dataclasses import replace
+
+    from asp.graph.symmetry import infeasibility
+
+    held, _ = hold_unsupported(spec, relations)
+    if not spec.generated or relations is None or not spec.base_part:
+        return held, ""
+    why = infeasibility(held, relations)
+    if not why:
+        return held, ""
+    ids = [str(p) for p in relations.parts]
+    degree = np.asarray(relations.tc, dtype=bool).any(axis=2).sum(axis=1)
+    placed = [op.parts[0] for op in spec.operations if len(op.parts) == 1]
+    order = sorted(
+        (p for p in placed if p in ids and p != spec.base_part),
+        key=lambda p: (-int(degree[ids.index(p)]), placed.index(p)),
+    )
+    for part in order:
+        ops = sorted(spec.operations, key=lambda op: op.parts != (part,))
+        candidate, _ = hold_unsupported(
+            replace(spec, base_part=part, operations=tuple(ops)), relations
+        )
+        if not infeasibility(candidate, relations):
+            note = (
+                f"generated spec: base part {part} instead of {spec.base_part} (no complete "
+                f"sequence can start from {spec.base_part}: {why})"
+            )
+            return candidate, note
+    return held, ""
+
+
+def spec_geometry(spec: AssemblySpec):
+    """The meshes of ``spec``'s parts as a ``cad.Assembly`` (files relative to the spec).
+
+    Raises
+    ------
+    SpecError
+        The spec names no parts, or a part has no mesh file (named).
+    """
+    from cad.loading import load_parts
+
+    if not spec.parts:
+        raise SpecError(f"{spec.source}: the spec names no parts (a 'parts:' list with files)")
+    return load_parts(spec.parts, spec.folder, spec.units, frame=spec.frame)
+
+
+def spec_hierarchy(spec: AssemblySpec) -> tuple[tuple[str, tuple[str, ...]], ...]:
+    """The CAD file's hierarchy over ``spec``'s parts: group id -> the spec's part ids.
+
+    Parts named ``scene#node`` are looked up in their scene's tree (:mod:`cad.scene`);
+    groups keep the spec's parts among their members and count when two or more remain.
+    Outermost groups first; empty when no part comes from a scene with a hierarchy.
+    """
+    from cad.scene import read_scene
+
+    by_file: dict[str, dict[str, str]] = {}  # scene file -> scene part id -> spec part id
+    for part in spec.parts:
+        name, _, node = str(part.file or "").partition("#")
+        if node:
+            scene = read_scene(spec.folder / name)
+            k = scene.find(node)
+            if k is not None:
+                by_file.setdefault(name, {})[scene.ids[k]] = part.id
+    out = []
+    for name, spec_id in by_file.items():
+        for gid, members in read_scene(spec.folder / name).groups:
+            mapped = tuple(spec_id[m] for m in members if m in spec_id)
+            if len(mapped) >= 2:
+                out.append((gid, mapped))
+    return tuple(out)
+
+
+def cad_assembly(path: str | Path):
+    """The geometry of a CAD file or a folder of part meshes (``cad.load_assembly``).
+
+    A ``bom.csv``/``bom.yaml`` beside a scene file adds or overrides part data
+    (:func:`cad.loading.apply_bom`); in a folder of meshes it names the parts.
+    """
+    from cad.bom import read_bom
+    from cad.loading import BOM_NAMES, apply_bom, load_assembly
+
+    path = Path(path)
+    assembly = load_assembly(path)
+    bom = next((path.parent / n for n in BOM_NAMES if (path.parent / n).is_file()), None)
+    if path.is_file() and bom is not None:
+        assembly = apply_bom(assembly, read_bom(bom), path.parent)
+    return assembly
+
+
+def spec_data(
+    path: str | Path,
+    spec_folder: str | Path | None = None,
+    gravity: str | None = None,
+    frame=None,
+) -> tuple[dict, object]:
+    """The generated spec of a CAD file or folder, as the YAML mapping, and its geometry.
+
+    Part files are written relative to ``spec_folder`` (default: the CAD file's folder,
+    or the folder of meshes itself); ``gravity`` defaults to the format's own down
+    (:func:`asp.gravity.default_down`); ``frame`` (a rotation, :mod:`cad.frame`; None: the
+    file's own) is the build frame the parts are turned into, and written as ``frame:``.
+
+    Returns
+    -------
+    (dict, cad.Assembly)
+        The mapping :func:`asp.spec.spec_from_dict` reads, and the parts it was made from
+        (in the build frame).
+    """
+    from asp.fromcad.gravity import base_index, default_down
+    from cad.frame import frame_record, rotated
+    from cad.identical import shape_classes
+
+    path = Path(path)
+    gravity = gravity or default_down(path)
+    assembly = rotated(cad_assembly(path), frame)
+    shapes = shape_classes(assembly.parts)
+    counts = Counter(shapes)
+    if spec_folder is None:
+        spec_folder = path if path.is_dir() else path.parent
+    parts = []
+    for part, shape in zip(assembly.parts, shapes, strict=True):
+        source, _, node = part.source.partition("#")
+        file = Path(os.path.relpath(Path(source).resolve(), Path(spec_folder).resolve()))
+        record = {"id": part.id, "name": part.name}
+        record["file"] = f"{file.as_posix()}#{node}" if node else file.as_posix()
+        if part.quantity != 1:
+            record["quantity"] = part.quantity
+        if part.type:
+            record["type"] = part.type
+        if counts[shape] > 1:
+            record["shape"] = shape
+        parts.append(record)
+    bounds = np.array([p.bounds for p in assembly.parts])  # (n, 2, 3) in mm
+    extents = bounds[:, 1] - bounds[:, 0]
+    base = base_index(bounds, gravity)
+    axis, sign = "xyz".index(gravity[1]), (1.0 if gravity[0] == "-" else -1.0)
+    low, high = (0, 1) if sign > 0 else (1, 0)  # the bottom and top faces along gravity
+    order = [base] + sorted(
+        (k for k in range(len(assembly.parts)) if k != base),
+        key=lambda k: (sign * bounds[k, low, axis], sign * bounds[k, high, axis], k),
+    )
+    operations = []
+    for number, k in enumerate(order, start=1):
+        part = assembly.parts[k]
+        human, robot = placement_durations(float(np.linalg.norm(extents[k])))
+        operations.append(
+            {
+                "id": str(number),
+                "description": f"place {part.id}"
+                + (f" ({part.name})" if part.name != part.id else ""),
+                "agents": {"H": json_number(human), "R1": json_number(robot)},
+                "part": part.id,
+            }
+        )
+    data = {
+        "name": path.stem if path.is_file() else path.name,
+        "units": "mm",  # for files without a declared unit (the generated ones are read so)
+        "parts": parts,
+        "agents": {
+            "H": {"side": "human", "description": "operator"},
+            "R1": {"side": "robot", "description": "robot arm with a gripper"},
+        },
+        "base_part": assembly.parts[base].id,
+        "gravity": gravity,
+        **({"frame": frame_record(frame)} if frame is not None else {}),
+        "gripper_approach": ["+x", "-x", "+y", "-y", "+z", "-z"],
+        "constraints": {"topological": True, "stability": True, "functional": True},
+        "turn_model": "alternate",
+        "cost": "time",
+        "operations": operations,
+    }
+    return data, assembly
+
+
+def is_cad_input(path: str | os.PathLike[str]) -> bool:
+    """True for a CAD scene file or a folder of part meshes without an ``assembly.yaml``."""
+    from cad.loading import MESH_SUFFIXES
+
+    path = Path(path)
+    if path.is_dir():
+        return not (path / SPEC_FILE).is_file() and any(
+            f.suffix.lower() in MESH_SUFFIXES for f in path.iterdir() if f.is_file()
+        )
+    return path.is_file() and path.suffix.lower() in MESH_SUFFIXES
+
+
+def load_any(path: str | os.PathLike[str]) -> AssemblySpec:
+    """The spec of ``path``: generated for a CAD file or a folder of part meshes without an
+    ``assembly.yaml`` (:func:`generated_spec`), else read (:func:`asp.spec.load_spec`)."""
+    return generated_spec(path) if is_cad_input(path) else load_spec(path)
+
+
+def generated_spec(path: str | Path, gravity: str | None = None, frame=None) -> AssemblySpec:
+    """The spec generated from a CAD file or a folder of part meshes (``generated=True``).
+
+    Its ``source`` is the spec file it stands for (``assembly.yaml`` beside the CAD file,
+    which need not exist), so that part files resolve as in the written spec. ``gravity``
+    and ``frame``: as :func:`spec_data` takes them.
+    """
+    path = Path(path)
+    data, _ = spec_data(path, gravity=gravity, frame=frame)
+    folder = path if path.is_dir() else path.parent
+    spec = spec_from_dict(data, source=str(folder / SPEC_FILE))
+    return replace(spec, generated=True, source=str(path))
+
+
+def gravity_choice(relations, geometry, default: str):
+    """:func:`asp.gravity.choose_gravity` for parts ``geometry`` (a ``cad.Assembly``)."""
+    from asp.fromcad.gravity import choose_gravity
+
+    box = {p.id: p.bounds for p in geometry.parts}
+    bounds = np.array([box[str(pid)] for pid in relations.parts], dtype=float)
+    return choose_gravity(relations, bounds, default)
+
+
+def orient_generated(spec: AssemblySpec, relations, geometry, turn=None):
+    """A generated spec with the gravity :mod:`asp.gravity` chooses, and the choice.
+
+    When the choice differs from the spec's (the format's own down), the spec is
+    generated again along it (base part and operation order follow gravity) by
+    ``turn(gravity, frame)`` (default: :func:`generated_spec` of the spec's source), in the
+    spec's build frame. A user's spec, or one without relations, is returned unchanged
+    with None.
+    """
+    import warnings
+
+    if not spec.generated or relations is None or getattr(relations, "sp", None) is None:
+        return spec, None
+    choice = gravity_choice(relations, geometry, spec.gravity)
+    if choice.gravity == spec.gravity:
+        return spec, choice
+    with warnings.catch_warnings():  # the same files again: their warnings were given
+        warnings.simplefilter("ignore")
+        turned = (turn or _regenerate(spec))(choice.gravity, spec.frame)
+    tolerances = {"contact_tol": spec.contact_tol, "penetration_tol": spec.penetration_tol}
+    return replace(turned, **tolerances), choice
+
+
+def _regenerate(spec: AssemblySpec):
+    """``turn(gravity, frame)``: ``spec``'s source generated again along another gravity
+    or in another build frame (tolerances are kept by the callers)."""
+    return lambda gravity, frame: generated_spec(spec.source, gravity=gravity, frame=frame)
+
+
+@dataclass(frozen=True)
+class Decisions:
+    """What a generated spec decides once its part relations are known.
+
+    Attributes
+    ----------
+    spec : AssemblySpec
+        The spec in the chosen build frame, along the chosen gravity, on a workable base,
+        ``held`` applied.
+    gravity : asp.gravity.GravityChoice or None
+        The gravity choice and its reason (None: a user's spec, or no support table).
+    rebased : str
+        Why another base part was taken ("" when the lowest large part was kept).
+    relations : cad.relations.Relations or None
+        The part relations in the spec's build frame (those given, unless another frame
+        was chosen).
+    geometry : cad.Assembly or None
+        The parts in the spec's build frame.
+    frame : asp.framing.FrameChoice or None
+        Why another build frame was taken, or why none helped (None: the file's frame
+        leaves every pair of parts a way in, or a user's spec).
+    """
+
+    spec: AssemblySpec
+    gravity: object | None
+    rebased: str
+    relations: object | None = None
+    geometry: object | None = None
+    frame: object | None = None
+
+    @property
+    def held(self) -> tuple[str, ...]:
+        """The parts whose placement is ``held`` (in operation order)."""
+        return tuple(p for op in self.spec.operations if op.held for p in op.parts)
+
+    def notes(self) -> list[str]:
+        """One line per decision, as a person reads them."""
+        out = []
+        if self.frame is not None:
+            out.append(f"generated spec: frame: {self.frame.text}")
+        if self.gravity is not None:
+            out.append(f"generated spec: gravity {self.gravity.gravity}: {self.gravity.reason}")
+        if self.rebased:
+            out.append(self.rebased)
+        if self.held and self.spec.generated:
+            out.append(f"generated spec: held: true for {', '.join(self.held)} ({HELD_REASON})")
+        return out
+
+
+def decide_generated(
+    spec: AssemblySpec, relations, geometry, turn=None, *, say=None, progress: bool = False
+) -> Decisions:
+    """The decisions of a generated spec that need its relations, in this order: the build
+    frame (:func:`asp.framing.choose_frame`: only when some pair of parts can never be
+    assembled in the file's frame), gravity (:func:`orient_generated`), then the base part
+    and ``held`` (:func:`workable_base`).
+
+    ``asmplan plan`` (:func:`asmplan.pipeline.load`) and ``asmplan init``
+    (:func:`spec_text`) both take them here, so the file written plans as the file read.
+    A user's spec comes back unchanged. ``turn(gravity, frame)``: the spec generated again
+    along another gravity or in another frame (default: from the spec's source). Use the
+    returned ``relations`` (in the chosen frame) from then on. ``say`` is called with a line
+    before each candidate frame's relations are computed (``progress``: their bars).
+    """
+    from asp.fromcad.framing import choose_frame
+
+    turn = turn or _regenerate(spec)
+    decided = _decide_in_frame(spec, relations, geometry, turn)
+
+    def in_frame(rotation) -> Decisions:
+        """The decisions in another build frame (its relations computed afresh)."""
+        import cad
+        from cad.frame import frame_text, rotated
+
+        geo = rotated(geometry, rotation)
+        if say is not None:
+            say(f"trying another build frame ({frame_text(rotation)}): part relations ...")
+        rel = cad.compute_relations(
+            geo,
+            contact_tol=spec.contact_tol,
+            penetration_tol=spec.penetration_tol,
+            progress=progress,
+        )
+        tolerances = {"contact_tol": spec.contact_tol, "penetration_tol": spec.penetration_tol}
+        framed = replace(turn(None, rotation), **tolerances)
+        return _decide_in_frame(framed, rel, geo, turn)
+
+    choice, chosen = choose_frame(decided, geometry, in_frame)
+    return replace(chosen or decided, frame=choice)
+
+
+def _decide_in_frame(spec: AssemblySpec, relations, geometry, turn) -> Decisions:
+    """Gravity, base part and ``held`` of a generated spec, its frame as given."""
+    oriented, choice = orient_generated(spec, relations, geometry, turn)
+    decided, rebased = workable_base(oriented, relations)
+    return Decisions(decided, choice, rebased, relations, geometry)
+
+
+def spec_text(
+    path: str | Path,
+    spec_folder: str | Path | None = None,
+    *,
+    contact_tol: float | None = None,
+    penetration_tol: float | None = None,
+    on_note=None,
+    decide_units=None,
+) -> str:
+    """The generated spec of a CAD file or folder as a commented ``assembly.yaml``.
+
+    Part files are relative to ``spec_folder``, where the file will be written. Tolerances
+    given (mm) are written as the spec's ``contact_tol`` / ``penetration_tol`` and used for
+    the ``held`` marks; else both keys are written commented out. ``on_note`` (optional) is
+    called with a line for each decision of :func:`decide_generated` (build frame,
+    gravity, base part, ``held``). ``decide_units(spec,
+    relations)`` (:func:`asp.units.cad_units`, given by the caller: it sits above this
+    module) decides which of the file's sub-assemblies are written as ``subassemblies:``;
+    without it they are all written commented.
+    """
+    from dataclasses import replace
+
+    import cad
+
+    data, assembly = spec_data(path, spec_folder)
+    relations = cad.compute_relations(
+        assembly, contact_tol=contact_tol, penetration_tol=penetration_tol
+    )
+    turned: dict = {(data["gravity"], None): (data, assembly)}
+
+    def turn(gravity: str | None, frame) -> AssemblySpec:
+        """The spec along another gravity or in another frame, keeping its records."""
+        records = spec_data(path, spec_folder, gravity=gravity, frame=frame)
+        turned[(records[0]["gravity"], frame)] = records
+        return replace(spec_from_dict(records[0], source=str(path)), generated=True)
+
+    tolerances = {"contact_tol": contact_tol, "penetration_tol": penetration_tol}
+    generated = replace(spec_from_dict(data, source=str(path)), generated=True, **tolerances)
+    decided = decide_generated(generated, relations, assembly, turn)
+    spec, relations = decided.spec, decided.relations
+    # the records along the chosen gravity, in the chosen frame
+    data, assembly = turned.get((spec.gravity, spec.frame), (data, assembly))
+    if on_note is not None:
+        for line in decided.notes():
+            on_note(line)
+    data["base_part"] = spec.base_part
+    first = [op for op in data["operations"] if op["part"] == spec.base_part]
+    data["operations"] = first + [op for op in data["operations"] if op not in first]
+    reason = decided.gravity.reason if decided.gravity is not None else "the format's own down"
+    path = Path(path)
+    lines = [
+        f"# Assembly spec generated by `asmplan init` from {path.name}: edit it, then run",
+        "#   asmplan plan assembly.yaml -o plan/",
+        "# Format: see asp/spec.py. Every key below may be changed; what usually needs a look:",
+        "#   - part names (ids are used in operations: rename both together);",
+        "#   - durations in seconds, generated from part size: human "
+        f"{HUMAN_BASE_S:g} s + 1 s per {1 / HUMAN_S_PER_MM:g} mm",
+        f"#     of bounding-box diagonal (at most {MAX_DURATION_S:g} s), robot x{ROBOT_FACTOR:g};",
+        "#   - which agent may do what (remove H or R1 from an operation), tool changes;",
+        "#   - `held: true` for a part an agent must hold until a later part fixes it;",
+        "#   - `after:` for precedences the geometry cannot see (glue, screws to tighten).",
+        f"name: {_scalar(data['name'])}",
+        f"units: {data['units']}   # of mesh files that declare none (STL, OBJ, PLY); "
+        "STEP, glTF, 3MF declare their own",
+        "",
+        "parts:   # id: used in operations; file: the mesh (file#part: one part of a scene);",
+        "         # shape: shared by identical parts (the same shape up to a rigid motion)",
+    ]
+    counts = Counter(r["shape"] for r in data["parts"] if "shape" in r)
+    for record in data["parts"]:
+        fields = ", ".join(f"{k}: {_scalar(v)}" for k, v in record.items())
+        lines.append(f"  - {{{fields}}}")
+    if counts:
+        lines.append(
+            "# identical parts: " + ", ".join(f"{n} x {s}" for s, n in sorted(counts.items()))
+        )
+    folder = spec_folder or (path if path.is_dir() else path.parent)
+    lines += _hierarchy_lines(data, assembly, relations, folder, decide_units)
+    lines += [
+        "",
+        "agents:   # name -> side (human, robot); add R2, H2, ... as the cell has them",
+        "  H: {side: human, description: operator}",
+        "  R1: {side: robot, description: robot arm with a gripper}",
+        "",
+        f"base_part: {data['base_part']}      # placed first: "
+        + (
+            f"no complete sequence starts from {generated.base_part}, the lowest large part"
+            if decided.rebased
+            else "the lowest of the large parts"
+        ),
+        *_frame_lines(decided),
+        f"gravity: {data['gravity']}                # direction of gravity in the build frame:",
+        f"#   {reason} (asp/fromcad/gravity.py)",
+        "gripper_approach: [+x, -x, +y, -y, +z, -z]   # directions a part may be inserted from",
+        "constraints: {topological: true, stability: true, functional: true}",
+        "turn_model: alternate",
+        "cost: time                 # or steps (1 per operation)",
+        _tolerance_line("contact_tol", contact_tol, "largest gap that counts as touching"),
+        _tolerance_line("penetration_tol", penetration_tol, "largest overlap that still touches"),
+        "",
+        "operations:   # one placement per part: base first, then from the lowest part up",
+    ]
+    for op in spec.operations:
+        agents = ", ".join(f"{a}: {json_number(d)}" for a, d in op.durations)
+        if op.held:
+            lines.append(f"    # held: {HELD_REASON}")
+        lines.append(
+            f"  - {{id: {_scalar(op.id)}, description: {_scalar(op.description)}, "
+            f"agents: {{{agents}}}, part: {op.parts[0]}" + (", held: true}" if op.held else "}")
+        )
+    return "\n".join(lines) + "\n"
+
+
+def _hierarchy_lines(data: dict, assembly, relations, spec_folder, decide) -> list[str]:
+    """The ``subassemblies:`` of a written spec: the file's sub-assemblies that ``decide``
+    accepts, and the others commented with the reason."""
+    if not assembly.groups:
+        return []
+    if decide is None:
+        lines = [
+            "# The file's sub-assemblies: uncomment to build each on its own",
+            "# subassemblies:",
+        ]
+        return lines + [f"#   {gid}: [{', '.join(ms)}]" for gid, ms in assembly.groups]
+    folder = os.path.abspath(spec_folder)  # it may not exist yet: join the paths as text
+    parts = []
+    for record in data["parts"]:
+        file, hash_, node = record["file"].partition("#")
+        parts.append(
+            {**record, "file": os.path.normpath(os.path.join(folder, file)) + hash_ + node}
+        )
+    spec = spec_from_dict({**data, "parts": parts}, source=os.path.join(folder, SPEC_FILE))
+    spec, _ = hold_unsupported(replace(spec, generated=True), relations)
+    choices = decide(spec, relations)
+    used = [u for u in choices if u.used]
+    lines = [
+        "# The file's sub-assemblies (asp/subassemblies.py): each one listed is built on its",
+        "# own and inserted as one unit; delete a line to place its parts one by one. Commented:",
+        "# the ones that cannot be units, and why.",
+        "subassemblies:" if used else "# subassemblies:",
+    ]
+    turned, loose = _unit_ways(spec, relations, used)
+    for u in choices:
+        entry = f"{u.id}: [{', '.join(u.members)}]"
+        if u.id in turned or u.id in loose:
+            more = f", gravity: {turned[u.id]}" if u.id in turned else ""
+            more += ", held: true" if u.id in loose else ""
+            entry = f"{u.id}: {{parts: [{', '.join(u.members)}]{more}}}"
+            if u.id in turned:
+                entry += "   # built upside down, then turned over and inserted"
+            if u.id in loose:
+                entry += "   # held: nothing outside it keeps it from falling"
+        lines.append(f"  {entry}" if u.used else f"#   {entry}   # not used: {u.reason}")
+    return lines
+
+
+def _unit_ways(spec, relations, used) -> tuple[dict[str, str], set[str]]:
+    """For the used units: those built upside down (unit id -> the gravity of its
+    workspace) and those held while inserted (:func:`asp.orientation.loose_units`), as the
+    planner decides them."""
+    from asp.fromcad.orientation import loose_units, unit_orientation
+
+    if relations is None or getattr(relations, "sp", None) is None or not used:
+        return {}, set()
+    try:
+        with_units = with_subassemblies(spec, [(u.id, u.members) for u in used])
+    except ValueError:
+        return {}, set()
+    turned = {}
+    for u in used:
+        o = unit_orientation(with_units, relations, u.id)
+        if o.upside_down:
+            turned[u.id] = o.gravity
+    return turned, loose_units(with_units, relations)
+
+
+def _frame_lines(decided: Decisions) -> list[str]:
+    """The ``frame:`` of a written spec (commented out when it is the file's own)."""
+    from cad.frame import frame_record
+
+    record = frame_record(decided.spec.frame)
+    if record is None:
+        lines = [
+            "# frame: file   # the build frame (the product as fixtured): the file's own, or",
+            "#   {axis: [x, y, z], degrees: a} turns it (cad/frame.py)",
+        ]
+        if decided.frame is not None:
+            lines.append(f"#   {decided.frame.text}")
+        return lines
+    axis = ", ".join(str(json_number(x)) for x in record["axis"])
+    return [
+        f"frame: {{axis: [{axis}], degrees: {json_number(record['degrees'])}}}"
+        "   # the build frame: the product as fixtured (cad/frame.py)",
+        f"#   {decided.frame.text} (asp/fromcad/framing.py)",
+    ]
+
+
+def _tolerance_line(key: str, value: float | None, meaning: str) -> str:
+    """``key: value`` with a comment, or commented out when the default rule applies."""
+    if value is None:
+        return f"# {key}: 0.1   # mm, {meaning} (default: per part, cad/tolerances.py)"
+    return f"{key}: {json_number(float(value))}   # mm, {meaning}, every pair"
+
+
+def _scalar(value) -> str:
+    """A YAML flow scalar: plain when safe, else double-quoted."""
+    import json
+
+    text = str(value)
+    plain = (
+        text
+        and text[0].isalpha()
+        and all(c.isalnum() or c in " _-./()#" for c in text)
+        and text.lower() not in ("yes", "no", "true", "false", "null", "on", "off", "y", "n")
+        and not text.endswith(" ")
+        and " #" not in text
+    )
+    if isinstance(value, int | float) and not isinstance(value, bool):
+        return str(value) if not math.isnan(value) else json.dumps(text)
+    return text if plain else json.dumps(text)

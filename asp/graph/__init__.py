@@ -1,0 +1,10 @@
+"""The assembly state graph: which operations are feasible from which states.
+
+:mod:`~asp.graph.feasibility` (the insertion oracle and the state-key codec),
+:mod:`~asp.graph.enabled_kernel` (its numba inner loops), :mod:`~asp.graph.state_graph`
+(the graph, built layer by layer), :mod:`~asp.graph.symmetry` (derived precedences,
+infeasibility proofs and the interchangeable-part reduction), :mod:`~asp.graph.fixed_order`
+(that reduction undone for schedules), :mod:`~asp.graph.together` (which operations may run
+at once, one rule), :mod:`~asp.graph.game_dag` (from the state graph to the game DAG) and
+:mod:`~asp.graph.checker` (an independent plan checker that shares no code with the rest).
+"""

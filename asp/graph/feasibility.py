@@ -1,0 +1,853 @@
+"""Feasible insertions and enabled operations, as a few integer operations per (state, op).
+
+Geometry (``../shared/DESIGN.md``, "Directions and relations"): a part ``p`` placed into the
+assembled set ``S`` (not empty) is feasible iff
+
+- RTC: ``p`` touches some ``j`` in ``S`` (any direction), or comes to rest on it: a part that
+  a short fall brings onto ``j`` (support, below, e.g. a shaft lying in a bore across its
+  clearance) touches it once settled;
+- RTT: some direction ``d`` is free, ``TT_d(p, j)`` for every ``j`` in ``S`` (``p`` is inserted
+  along ``-d``);
+
+and the enabled optimisation constraints hold (switches in the spec):
+
+- topological: the base part is placed first (every other part needs it in ``S``), and
+  the explicit ``after`` predecessors are done;
+- stability (support): ``p`` cannot fall, ``SP_g(p, j)`` for some ``j`` in ``S`` with ``g`` the
+  gravity direction (in a unit's workspace, the unit's build gravity ``spec.unit_gravity``,
+  e.g. ``+z`` for a die set's upper half built upside down): a short move along ``g`` would
+  drive it into ``j``, or it is threaded on ``j`` (:mod:`cad.support`; skipped for
+  operations marked ``held``: an agent holds the part).
+  Relations without a support table (built by hand) fall back to contact along gravity,
+  ``TC_g(p, j)``;
+- functional: the free direction must be one the gripper approaches from
+  (``gripper_approach``).
+
+Everything is precomputed as per-part bitmasks over the spec's parts (bit ``j`` = part ``j``):
+``contact[p]`` (parts ``p`` touches), ``blocked[p, d]`` (parts that block ``p`` along ``d``),
+``support[p]`` (parts that keep ``p`` from falling). With ``S`` a uint64 bitset the checks are
+``S & contact != 0``, ``OR_d (S & blocked[d] == 0)`` and ``S & support != 0``.
+
+An assembly state packs the done operations (bit ``i`` = operation ``i``) and the tool
+values (a small field per tool above the operation bits) into a key of ``W = ceil(bits / 64)``
+uint64 words (one word, the fast path, up to 64 bits; see :class:`OperationModel`).
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from asp.errors import SpecError
+from asp.spec import DIRECTIONS, AssemblySpec, tool_values
+
+WORD_BITS = 64
+"""Bits per word of a state key (a state key is ``W`` uint64 words)."""
+MAX_OPS = 32767
+"""Operations that fit the int16 operation index of the transitions."""
+
+
+@dataclass(frozen=True, eq=False)
+class InsertionOracle:
+    """Per-part bitmasks of the geometric insertion test.
+
+    A set of parts is a row of ``PW = ceil(n / 64)`` uint64 words (bit ``j % 64`` of word
+    ``j // 64`` is part ``j``); a batch of ``k`` sets is a ``(k, PW)`` array (``(k,)`` is
+    accepted when ``PW == 1``). Any number of parts fits.
+
+    Attributes
+    ----------
+    parts : tuple of str, length n
+        Part ids (bit ``j`` is part ``parts[j]``).
+    contact : (n, PW) uint64
+        Parts each part touches in some direction (or comes to rest on, see support).
+    blocked : (n, 6, PW) uint64
+        Parts that block each part's motion along each direction.
+    support : (n, PW) uint64
+        Parts that keep each part from falling (support along gravity).
+    directions : (6,) bool
+        Directions a part may be inserted from (all six unless functional is on).
+    base : int
+        Index of the base part, or -1.
+    geometric, topological, stability : bool
+        Which checks apply (geometric: relations were given).
+    """
+
+    parts: tuple[str, ...]
+    contact: np.ndarray
+    blocked: np.ndarray
+    support: np.ndarray
+    directions: np.ndarray
+    base: int
+    geometric: bool
+    topological: bool
+    stability: bool
+
+    @property
+    def n_words(self) -> int:
+        """``PW``: uint64 words per part set."""
+        return int(self.contact.shape[1])
+
+    def index(self, part: str) -> int:
+        try:
+            return self.parts.index(part)
+        except ValueError:
+            raise SpecError(f"unknown part {part!r}") from None
+
+    def sets(self, assembled) -> np.ndarray:
+        """(k, PW) uint64 part sets from ``(k, PW)``, ``(k,)`` (one word) or Python ints."""
+        s = np.asarray(assembled)
+        if s.dtype == object or (s.ndim == 1 and self.n_words > 1):
+            return pack_words([int(x) for x in s.reshape(-1)], self.n_words)
+        s = s.astype(np.uint64, copy=False)
+        return s.reshape(-1, 1) if s.ndim == 1 else s
+
+    def bit(self, p: int) -> np.ndarray:
+        """(PW,) uint64: the set holding part ``p`` alone."""
+        return pack_words([1 << int(p)], self.n_words)[0]
+
+    def feasible(
+        self, p: int, assembled, held: bool = False, workspace: bool = False
+    ) -> np.ndarray:
+        """Whether part ``p`` may be inserted into each set.
+
+        Parameters
+        ----------
+        p : int
+            Part index.
+        assembled : (k, PW) or (k,) uint64
+            Sets of assembled parts.
+        held : bool
+            Skip the stability check.
+        workspace : bool
+            The sets are a subassembly's own workspace (no base part there).
+
+        Returns
+        -------
+        (k,) bool
+        """
+        s = self.sets(assembled)
+        ok = np.ones(s.shape[0], dtype=bool)
+        if self.topological and self.base >= 0 and p != self.base and not workspace:
+            ok &= _meets(s, self.bit(self.base))
+        if self.geometric:
+            geo = _meets(s, self.contact[p])
+            free = np.zeros(s.shape[0], dtype=bool)
+            for d in np.flatnonzero(self.directions):
+                free |= ~_meets(s, self.blocked[p, d])
+            geo &= free
+            if self.stability and not held:
+                geo &= _meets(s, self.support[p])
+            ok &= geo | ~s.any(axis=1)
+        return ok
+
+    def mask(self, row) -> int:
+        """A (PW,) mask row as a Python int."""
+        return unpack_words(row)
+
+    def blockers(self, p: int, assembled: int) -> dict[str, list[str]]:
+        """For each direction, the parts of ``assembled`` that block ``p`` moving along it."""
+        s = int(assembled)
+        out = {}
+        for d, name in enumerate(DIRECTIONS):
+            m = s & self.mask(self.blocked[p, d])
+            out[name] = [self.parts[j] for j in range(len(self.parts)) if m >> j & 1]
+        return out
+
+    def reasons(
+        self, p: int, assembled: int, held: bool = False, workspace: bool = False
+    ) -> list[str]:
+        """Why part ``p`` cannot be inserted into the set ``assembled`` (empty if it can)."""
+        s = int(assembled)
+        out = []
+        base_missing = self.base >= 0 and p != self.base and not s >> self.base & 1
+        if self.topological and base_missing and not workspace:
+            out.append(f"the base part {self.parts[self.base]} is not placed yet")
+        if not self.geometric or s == 0:
+            return out
+        if not s & self.mask(self.contact[p]):
+            out.append("no contact with the assembled parts")
+        by = self.blockers(p, s)
+        free = [d for d in DIRECTIONS if not by[d]]
+        allowed = [d for d in free if self.directions[DIRECTIONS.index(d)]]
+        if not free:
+            out.append("no free direction")
+        elif not allowed:
+            out.append(f"free only along {', '.join(free)}, which the gripper cannot approach")
+        if self.stability and not held and not s & self.mask(self.support[p]):
+            out.append("nothing to rest on below it")
+        return out
+
+
+def blocked_text(by: dict[str, list[str]], limit: int = 3) -> str:
+    """``"along +x by a, b; along -x by c; ..."`` for the directions that are blocked."""
+    parts = []
+    for d, names in by.items():
+        if names:
+            more = f" and {len(names) - limit} more" if len(names) > limit else ""
+            parts.append(f"along {d} by {', '.join(names[:limit])}{more}")
+    return "; ".join(parts)
+
+
+def _meets(sets: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """(k,) bool: whether each (PW,) row of ``sets`` shares a bit with ``mask``."""
+    if sets.shape[1] == 1:
+        return (sets[:, 0] & mask[0]) != np.uint64(0)
+    return ((sets & mask) != np.uint64(0)).any(axis=1)
+
+
+def pack_words(values: list[int], n_words: int) -> np.ndarray:
+    """(k, n_words) uint64 rows of the Python ints ``values`` (least significant word first)."""
+    rows = [_split(int(v), n_words) for v in values]
+    return np.array(rows, dtype=np.uint64).reshape(len(values), n_words)
+
+
+def bool_words(table: np.ndarray, n_words: int) -> np.ndarray:
+    """(k, n_words) uint64 rows of the (k, m) bool table (column ``j`` is bit ``j``)."""
+    k, m = table.shape
+    padded = np.zeros((k, n_words * WORD_BITS), dtype=bool)
+    padded[:, :m] = table
+    packed = np.packbits(padded, axis=1, bitorder="little")
+    return packed.view("<u8").astype(np.uint64).reshape(k, n_words)
+
+
+def unpack_words(row) -> int:
+    """The Python int of a row of uint64 words (or of an int)."""
+    if isinstance(row, int | np.integer):
+        return int(row)
+    return sum(int(w) << (WORD_BITS * k) for k, w in enumerate(np.asarray(row).reshape(-1)))
+
+
+def insertion_oracle(spec: AssemblySpec, relations=None) -> InsertionOracle:
+    """Precompute the per-part masks of ``spec`` from cad relations (or none: topology only).
+
+    Parameters
+    ----------
+    relations : cad Relations, optional
+        ``.parts`` (ids), ``.tc`` and ``.tt`` bool arrays ``(n, n, 6)``, and ``.sp``
+        (support, same shape; contact along gravity when absent). Its parts must include
+        every part an operation places and the base part.
+    """
+    real = spec.part_ids or tuple(dict.fromkeys(spec.placed_parts))
+    parts = real + tuple(u for u, _ in spec.subassemblies)
+    n = len(parts)
+    n_words = max(1, math.ceil(n / WORD_BITS))
+    contact = np.zeros((n, n), dtype=bool)
+    blocked = np.zeros((n, 6, n), dtype=bool)
+    support = np.zeros((n, n), dtype=bool)
+    directions = np.ones(6, dtype=bool)
+    c = spec.constraints
+    if c.functional:
+        directions[:] = [d in spec.gripper_approach for d in DIRECTIONS]
+    geometric = relations is not None
+    if geometric:
+        rel_ids = tuple(str(x) for x in relations.parts)
+        tc = np.asarray(relations.tc, dtype=bool)
+        tt = np.asarray(relations.tt, dtype=bool)
+        sp = getattr(relations, "sp", None)
+        sp = tc if sp is None else np.asarray(sp, dtype=bool)
+        m = len(rel_ids)
+        if tc.shape != (m, m, 6) or tt.shape != (m, m, 6) or sp.shape != (m, m, 6):
+            raise SpecError(
+                f"relations: expected tc, tt and sp of shape ({m}, {m}, 6), got {tc.shape}, "
+                f"{tt.shape} and {sp.shape}"
+            )
+        needed = set(spec.placed_parts) | ({spec.base_part} if spec.base_part else set())
+        missing = sorted(needed - set(rel_ids))
+        if missing:
+            raise SpecError(
+                f"{spec.source}: parts: no geometry (relations) for part {missing[0]!r}"
+            )
+        g = DIRECTIONS.index(spec.gravity)
+        where = {pid: k for k, pid in enumerate(rel_ids)}
+        known = np.array([k for k, pid in enumerate(parts) if pid in where], dtype=np.int64)
+        r = np.array([where[parts[k]] for k in known], dtype=np.int64)
+        ix = np.ix_(known, known)
+        support[ix] = sp[np.ix_(r, r)][:, :, g]
+        contact[ix] = tc[np.ix_(r, r)].any(axis=2) | support[ix]
+        blocked[np.ix_(known, range(6), known)] = ~tt[np.ix_(r, r)].transpose(0, 2, 1)
+        diagonal = np.arange(n)
+        for table in (contact, support):
+            table[diagonal, diagonal] = False
+        blocked[diagonal, :, diagonal] = False
+    for k, (_, members) in enumerate(spec.subassemblies):
+        # a unit is one rigid body: the pairwise relations ORed over its members
+        u, idx = len(real) + k, [parts.index(m) for m in members]
+        for table in (contact, support, blocked):
+            table[u] = table[idx].any(axis=0)
+            table[u, ..., idx] = False
+    if geometric and spec.unit_gravity:
+        # a unit built in another orientation: its members rest along its own gravity
+        # (their rows serve its workspace only; the unit's row above keeps the product's)
+        for uid, down in spec.unit_gravity:
+            idx = [parts.index(m) for m in dict(spec.subassemblies)[uid] if m in where]
+            rows = np.array([where[parts[k]] for k in idx], dtype=np.int64)
+            turned = sp[np.ix_(rows, r)][:, :, DIRECTIONS.index(down)]
+            support[np.ix_(idx, known)] = turned
+            contact[np.ix_(idx, known)] = tc[np.ix_(rows, r)].any(axis=2) | turned
+            support[idx, idx] = contact[idx, idx] = False
+    base = parts.index(spec.base_part) if spec.base_part in parts else -1
+    return InsertionOracle(
+        parts=parts,
+        contact=bool_words(contact, n_words),
+        blocked=bool_words(blocked.reshape(6 * n, n), n_words).reshape(n, 6, n_words),
+        support=bool_words(support, n_words),
+        directions=directions,
+        base=base,
+        geometric=geometric,
+        topological=c.topological,
+        stability=c.stability,
+    )
+
+
+@dataclass(frozen=True, eq=False)
+class OperationModel:
+    """The spec compiled to bit operations: which operations are enabled in which states.
+
+    State key layout: ``W = n_words`` uint64 words, ``ceil(n_bits / 64)``; key bit ``b`` is
+    bit ``b % 64`` of word ``b // 64``. A set of ``k`` states is a ``(k, W)`` uint64 array (one
+    row per state); :meth:`pack` and :meth:`unpack` convert to and from Python ints. Bit ``i``
+    (``i < n_ops``) is operation ``i`` done; tool ``t`` keeps its value index (into
+    ``tool_values[t]``) in ``tool_bits[t]`` bits at key bit ``tool_shift[t]`` (a tool field
+    never straddles two words). With ``W == 1`` every method runs on the single word column.
+
+    Attributes
+    ----------
+    op_bits : (n_ops, W) uint64
+        Operation ``i``'s own bit.
+    pred_masks : (n_ops, W) uint64
+        Explicit predecessors of each operation (zero when topological is off).
+    op_parts : (n_ops, PW) uint64
+        Parts each operation places (part sets, see :class:`InsertionOracle`).
+    requires_mask, requires_value : (n_ops, W) uint64
+        Tool fields an operation reads and the values they must hold.
+    sets_mask, sets_value : (n_ops, W) uint64
+        Tool fields an operation writes and the values it writes.
+    start_key : int
+        Nothing done, every tool at its initial value.
+    initial_parts : int
+        The base part when no operation places it (it is on the fixture from the start).
+    n_bits : int
+        Key bits used (operations, tool fields and the padding that keeps fields in one word).
+    op_workspace : tuple of int
+        Per operation, the subassembly whose workspace it builds in (index into
+        ``spec.subassemblies``), or -1 for the main assembly.
+    unit_ops : tuple of int
+        Per subassembly, the operation that inserts it.
+    unit_masks : (U, PW) uint64
+        Per subassembly, its member parts.
+    symmetric : tuple of classes of blocks of operation indices
+        Interchangeable blocks: of equal blocks only the first moves (:mod:`asp.symmetry`).
+    loose : tuple of (int, tuple of int)
+        Classes of interchangeable operations, each with its slack ``m``: an operation of a
+        class may be done only while at most ``m`` of the ones listed before it are not
+        (:meth:`_loose_order`; ``m = 0`` is a fixed order).
+    interchangeable : tuple of classes of blocks of operation ids
+        Every class of interchangeable blocks the reduction of the spec used (chained in
+        ``spec``, ``symmetric`` or ``loose``): each transposition of two blocks of a class
+        (position by position) is a symmetry of the game. Recorded for the runtime
+        (``plan.json``'s ``interchangeable``); the model's moves do not read it.
+    fixed : tuple of classes of blocks of operation indices
+        Interchangeable blocks the spec puts in a fixed order: at every position ``i``, the
+        ``i``-th operations of the blocks are chained in block order by ``after``
+        (:func:`asp.symmetry.symmetry_reduction`). Only read by the schedule stage, which
+        undoes that order (:mod:`asp.fixed_order`).
+    """
+
+    spec: AssemblySpec
+    oracle: InsertionOracle
+    op_bits: np.ndarray
+    pred_masks: np.ndarray
+    op_parts: np.ndarray
+    part_lists: tuple[tuple[int, ...], ...]
+    requires_mask: np.ndarray
+    requires_value: np.ndarray
+    sets_mask: np.ndarray
+    sets_value: np.ndarray
+    tool_names: tuple[str, ...]
+    tool_values: tuple[tuple[str, ...], ...]
+    tool_shift: tuple[int, ...]
+    tool_bits: tuple[int, ...]
+    start_key: int
+    initial_parts: int
+    n_bits: int
+    op_workspace: tuple[int, ...] = ()
+    unit_ops: tuple[int, ...] = ()
+    unit_masks: np.ndarray | None = None
+    symmetric: tuple[tuple[tuple[int, ...], ...], ...] = ()
+    loose: tuple[tuple[int, tuple[int, ...]], ...] = ()
+    interchangeable: tuple[tuple[tuple[str, ...], ...], ...] = ()
+    fixed: tuple[tuple[tuple[int, ...], ...], ...] = ()
+
+    @property
+    def n_ops(self) -> int:
+        return len(self.spec.operations)
+
+    @property
+    def n_words(self) -> int:
+        """``W``: uint64 words per state key."""
+        return int(self.op_bits.shape[1])
+
+    @property
+    def done_mask(self) -> int:
+        return (1 << self.n_ops) - 1
+
+    # ------------------------------------------------------------------ keys
+    def pack(self, values) -> np.ndarray:
+        """(k, W) uint64 keys of the Python ints ``values``."""
+        rows = [_split(int(v), self.n_words) for v in values]
+        return np.array(rows, dtype=np.uint64).reshape(-1, self.n_words)
+
+    def unpack(self, key) -> int:
+        """The Python int of a key: a (W,) row of words, or already an int."""
+        if isinstance(key, int | np.integer):
+            return int(key)
+        return sum(int(w) << (WORD_BITS * k) for k, w in enumerate(np.asarray(key).reshape(-1)))
+
+    def _keys(self, keys) -> np.ndarray:
+        keys = np.asarray(keys, dtype=np.uint64)
+        if keys.ndim == 1:
+            if self.n_words != 1:
+                raise SpecError(f"expected (k, {self.n_words}) state keys, got {keys.shape}")
+            keys = keys[:, None]
+        if keys.ndim != 2 or keys.shape[1] != self.n_words:
+            raise SpecError(f"expected (k, {self.n_words}) state keys, got {keys.shape}")
+        return keys
+
+    def has_op(self, keys: np.ndarray, i: int) -> np.ndarray:
+        """(k,) bool: whether operation ``i`` is done in each state."""
+        keys = self._keys(keys)
+        word, bit = divmod(int(i), WORD_BITS)
+        return (keys[:, word] & np.uint64(1 << bit)) != np.uint64(0)
+
+    def done_matrix(self, keys: np.ndarray) -> np.ndarray:
+        """(k, n_ops) bool: which operations are done in each state."""
+        keys = self._keys(keys)
+        as_bytes = np.ascontiguousarray(keys).astype("<u8", copy=False).view(np.uint8)
+        bits = np.unpackbits(as_bytes, axis=1, bitorder="little")
+        return bits[:, : self.n_ops].astype(bool)
+
+    def is_complete(self, keys: np.ndarray) -> np.ndarray:
+        """(k,) bool: states with every operation done."""
+        keys = self._keys(keys)
+        ok = np.ones(keys.shape[0], dtype=bool)
+        for w, m in enumerate(_split(self.done_mask, self.n_words)):
+            if m:
+                ok &= (keys[:, w] & np.uint64(m)) == np.uint64(m)
+        return ok
+
+    def ready(self, keys: np.ndarray, i: int) -> np.ndarray:
+        """(k,) bool: operation ``i`` not done, its predecessors done and its tools ready."""
+        keys = self._keys(keys)
+        ok = ~self.has_op(keys, i)
+        for w in range(self.n_words):
+            pm, rm, rv = self.pred_masks[i, w], self.requires_mask[i, w], self.requires_value[i, w]
+            if pm:
+                ok &= (keys[:, w] & pm) == pm
+            if rm:
+                ok &= (keys[:, w] & rm) == rv
+        return ok
+
+    # ------------------------------------------------------------------ transitions
+    def enabled(self, keys: np.ndarray, parts: np.ndarray) -> np.ndarray:
+        """Which operations may be done next in each state.
+
+        Parameters
+        ----------
+        keys : (k, W) uint64
+            State keys (``(k,)`` is accepted when ``W == 1``).
+        parts : (k, PW) uint64
+            Assembled-part sets of those states (``(k,)`` when ``PW == 1``).
+
+        Returns
+        -------
+        (k, n_ops) bool
+        """
+        keys = self._keys(keys)
+        if self._kernel_args is not None:  # compiled: one pass over the states
+            from asp.graph.enabled_kernel import enabled_single
+
+            ok = np.empty((keys.shape[0], self.n_ops), dtype=bool)
+            sets = np.ascontiguousarray(self.oracle.sets(parts))
+            enabled_single(np.ascontiguousarray(keys), sets, *self._kernel_args, ok)
+            self._symmetries(keys, ok)
+            return ok
+        zero = np.uint64(0)
+        if self.n_words == 1:  # the fast path: one broadcast test per mask
+            col = keys[:, :1]
+            ok = (col & self.op_bits[:, 0]) == zero
+            pred = self.pred_masks[:, 0]
+            if pred.any():
+                ok &= (col & pred) == pred
+            if self.tool_names:
+                ok &= (col & self.requires_mask[:, 0]) == self.requires_value[:, 0]
+        else:
+            ok = np.empty((keys.shape[0], self.n_ops), dtype=bool)
+            for w in range(self.n_words):
+                lo, hi = w * WORD_BITS, min(self.n_ops, (w + 1) * WORD_BITS)
+                if lo < hi:
+                    ok[:, lo:hi] = (keys[:, w : w + 1] & self.op_bits[lo:hi, w]) == zero
+            checks = [(self.pred_masks, self.pred_masks)]
+            if self.tool_names:
+                checks.append((self.requires_mask, self.requires_value))
+            for w in range(self.n_words):
+                col = keys[:, w : w + 1]
+                for masks, values in checks:
+                    cols = np.flatnonzero(masks[:, w])
+                    if cols.size == 0:
+                        continue
+                    if cols.size == self.n_ops:
+                        ok &= (col & masks[:, w]) == values[:, w]
+                    else:
+                        ok[:, cols] &= (col & masks[cols, w]) == values[cols, w]
+        parts = self.oracle.sets(parts)
+        pending = self.pending_units(keys)
+        for i, plist in enumerate(self.part_lists):
+            if not plist:
+                continue
+            column = ok[:, i]
+            rows = np.flatnonzero(column)
+            if rows.size == 0:
+                continue
+            s, workspace = self.assembled_for(i, parts[rows], pending, rows)
+            good = np.ones(rows.size, dtype=bool)
+            held = self.spec.operations[i].held
+            for p in plist:
+                good &= self.oracle.feasible(p, s, held=held, workspace=workspace)
+                s = s | self.oracle.bit(p)
+            column[rows] = good
+        self._symmetries(keys, ok)
+        return ok
+
+    def stuck(self, keys: np.ndarray, parts: np.ndarray, parents=None) -> np.ndarray:
+        """(k,) bool: some operation not done places a part (or unit) that the parts already
+        in the set it is tested against block along every allowed direction, so it can never
+        be done (a dead end). Always False for specs off the compiled path (an operation
+        placing several parts).
+
+        ``parents`` (optional): the keys and parts of a state each of ``keys`` is reached
+        from by one operation, none of them stuck; then only the operations whose part the
+        parts new to its set could block are tested (:func:`asp.enabled_kernel.stuck`,
+        the same result).
+        """
+        keys = self._keys(keys)
+        if self._kernel_args is None:
+            return np.zeros(keys.shape[0], dtype=bool)
+        from asp.graph.enabled_kernel import stuck
+
+        a = self._kernel_args
+        keys = np.ascontiguousarray(keys)
+        sets = np.ascontiguousarray(self.oracle.sets(parts))
+        before = (keys, sets)  # not read without parents
+        if parents is not None:
+            before = (
+                np.ascontiguousarray(self._keys(parents[0])),
+                np.ascontiguousarray(self.oracle.sets(parents[1])),
+            )
+        tables = (a[0], a[1], a[5], a[9], a[11], a[16], a[17], a[18])
+        return stuck(keys, sets, *before, parents is not None, *tables)
+
+    @functools.cached_property
+    def _kernel_args(self) -> tuple | None:
+        """The arrays of :func:`asp.enabled_kernel.enabled_single`, or None when an
+        operation places several parts (the numpy path)."""
+        if any(len(p) > 1 for p in self.part_lists):
+            return None
+        o = self.oracle
+        n_ops = self.n_ops
+        part_of = np.array([p[0] if p else -1 for p in self.part_lists], dtype=np.int64)
+        workspace = np.array(self.op_workspace or [-1] * n_ops, dtype=np.int64)
+        needs_base = (part_of >= 0) & (part_of != o.base) & bool(o.topological and o.base >= 0)
+        needs_base &= workspace < 0
+        base = max(o.base, 0)
+        return (
+            np.arange(n_ops, dtype=np.int64) // WORD_BITS,
+            np.array([1 << (i % WORD_BITS) for i in range(n_ops)], dtype=np.uint64),
+            np.ascontiguousarray(self.pred_masks),
+            np.ascontiguousarray(self.requires_mask),
+            np.ascontiguousarray(self.requires_value),
+            part_of,
+            needs_base,
+            np.array([op.held for op in self.spec.operations], dtype=bool),
+            np.ascontiguousarray(o.contact),
+            np.ascontiguousarray(o.blocked),
+            np.ascontiguousarray(o.support),
+            np.asarray(o.directions, dtype=bool),
+            base // WORD_BITS,
+            np.uint64(1 << (base % WORD_BITS)),
+            bool(o.geometric),
+            bool(o.stability),
+            workspace,
+            np.array(self.unit_ops, dtype=np.int64),
+            np.ascontiguousarray(
+                self.unit_masks
+                if self.unit_masks is not None and len(self.unit_ops)
+                else np.zeros((0, o.n_words), dtype=np.uint64)
+            ),
+        )
+
+    def _symmetries(self, keys: np.ndarray, ok: np.ndarray) -> None:
+        """Keep only the moves the reduction of interchangeable operations keeps."""
+        if self.symmetric:
+            self._first_of_equals(keys, ok)
+        if self.loose:
+            self._loose_order(keys, ok)
+
+    def _loose_order(self, keys: np.ndarray, ok: np.ndarray) -> None:
+        """Of each class of interchangeable operations ``(m, ops)`` (:mod:`asp.symmetry`),
+        keep ``ops[j]`` only where at most ``m`` of ``ops[:j]`` are not done.
+
+        Any of them may be done next, so doing the first one not done is the same move up to
+        a symmetry fixing the state: ``m = 0`` keeps that move alone (a fixed order). With
+        ``m`` one less than the workers who may do them, ``m`` of them may still be running
+        when another one starts, so the concurrent game keeps its moves too (the first not
+        running), and since the count only falls as operations are done, an operation kept
+        when it starts is kept whichever finishes first.
+        """
+        for slack, ops in self.loose:
+            missing = np.zeros(keys.shape[0], dtype=np.int64)
+            for j, i in enumerate(ops):
+                if j > slack:
+                    ok[:, i] &= missing <= slack
+                missing += ~self.has_op(keys, i)
+
+    def _first_of_equals(self, keys: np.ndarray, ok: np.ndarray) -> None:
+        """Keep, of interchangeable blocks in the same state, only the first one's moves.
+
+        ``symmetric`` holds classes of blocks (tuples of operation indices, position by
+        position alike): every transposition of two blocks of a class is a symmetry of the
+        game (:mod:`asp.symmetry`). Two blocks with the same operations done (position by
+        position) are swapped by a symmetry that fixes the state, so a move in the later one
+        has the same cost and an isomorphic future as the same move in the earlier one: only
+        the earlier one's is kept. TCT and W* do not change.
+        """
+        for blocks in self.symmetric:
+            codes = np.zeros((keys.shape[0], len(blocks)), dtype=np.int64)
+            for j, block in enumerate(blocks):
+                for pos, i in enumerate(block):
+                    codes[:, j] |= self.has_op(keys, i).astype(np.int64) << pos
+            for j in range(1, len(blocks)):
+                twin = (codes[:, :j] == codes[:, j : j + 1]).any(axis=1)
+                ok[:, list(blocks[j])] &= ~twin[:, None]
+
+    def parts_of(self, keys: np.ndarray) -> np.ndarray:
+        """(k, PW) uint64: the parts placed in each state, every workspace (the base part
+        when on the fixture from the start, and the parts of every done operation)."""
+        keys = self._keys(keys)
+        parts = np.empty((keys.shape[0], self.oracle.n_words), dtype=np.uint64)
+        parts[:] = pack_words([self.initial_parts], self.oracle.n_words)
+        for i in range(self.n_ops):
+            if self.op_parts[i].any():
+                parts[self.has_op(keys, i)] |= self.op_parts[i]
+        return parts
+
+    def pending_units(self, keys: np.ndarray) -> np.ndarray | None:
+        """(k, PW) uint64: members of the subassemblies not yet inserted, per state."""
+        if not self.unit_ops:
+            return None
+        keys = self._keys(keys)
+        pending = np.zeros((keys.shape[0], self.oracle.n_words), dtype=np.uint64)
+        for u, i in enumerate(self.unit_ops):
+            pending[~self.has_op(keys, i)] |= self.unit_masks[u]
+        return pending
+
+    def assembled_for(self, i: int, parts: np.ndarray, pending, rows=None):
+        """The parts operation ``i`` is tested against, and whether that is a unit's workspace.
+
+        ``parts`` are the placed parts of the states (every workspace); a unit's member
+        operation sees the members placed in its workspace, any other operation the main
+        assembly (``pending``, from :meth:`pending_units`, removed; ``rows`` selects its rows).
+        """
+        parts = self.oracle.sets(parts)
+        w = self.op_workspace[i] if self.op_workspace else -1
+        if w >= 0:
+            return parts & self.unit_masks[w], True
+        if pending is None:
+            return parts, False
+        return parts & ~(pending if rows is None else pending[rows]), False
+
+    def successor_keys(self, keys: np.ndarray, ops: np.ndarray) -> np.ndarray:
+        """(k, W) uint64: the state after doing operation ``ops[k]`` in state ``keys[k]``."""
+        keys = self._keys(keys)
+        ops = np.asarray(ops)
+        if self.n_words == 1:
+            out = keys[:, 0] | self.op_bits[ops, 0]
+            if self.tool_names:
+                out &= ~self.sets_mask[ops, 0]
+                out |= self.sets_value[ops, 0]
+            return out[:, None]
+        out = keys | self.op_bits[ops]
+        if self.tool_names:
+            out &= ~self.sets_mask[ops]
+            out |= self.sets_value[ops]
+        return out
+
+    def tool_changes(self, keys: np.ndarray, ops: np.ndarray) -> np.ndarray:
+        """(k, n_tools) bool: whether operation ``ops[k]`` changes each tool's value."""
+        keys = self._keys(keys)
+        ops = np.asarray(ops)
+        out = np.zeros((keys.shape[0], len(self.tool_names)), dtype=bool)
+        for t, (shift, bits) in enumerate(zip(self.tool_shift, self.tool_bits, strict=True)):
+            w, local = divmod(shift, WORD_BITS)
+            field = np.uint64(((1 << bits) - 1) << local)
+            writes = (self.sets_mask[ops, w] & field) != np.uint64(0)
+            out[:, t] = writes & ((keys[:, w] & field) != (self.sets_value[ops, w] & field))
+        return out
+
+    def tool_state(self, key) -> dict[str, str]:
+        """Tool values of the state ``key`` (an int or a (W,) row)."""
+        key = self.unpack(key)
+        return {
+            name: vals[(key >> shift) & ((1 << bits) - 1)]
+            for name, vals, shift, bits in zip(
+                self.tool_names, self.tool_values, self.tool_shift, self.tool_bits, strict=True
+            )
+        }
+
+    def done_ops(self, key) -> list[str]:
+        """Ids of the operations done in the state ``key`` (an int or a (W,) row), in order."""
+        key = self.unpack(key)
+        return [op.id for i, op in enumerate(self.spec.operations) if key >> i & 1]
+
+
+def _split(value: int, n_words: int) -> list[int]:
+    """The ``n_words`` 64-bit words of ``value``, least significant first."""
+    mask = (1 << WORD_BITS) - 1
+    return [(value >> (WORD_BITS * k)) & mask for k in range(n_words)]
+
+
+def operation_model(
+    spec: AssemblySpec,
+    relations=None,
+    *,
+    _min_words: int = 1,
+    symmetric=(),
+    loose=(),
+    interchangeable=(),
+    fixed=(),
+) -> OperationModel:
+    """Compile ``spec`` (and the cad relations, if any) into an :class:`OperationModel`.
+
+    The state key takes as many 64-bit words as the operations and tool fields need
+    (``_min_words`` forces more, for tests of the multi-word path). ``symmetric``: classes of
+    interchangeable blocks of operation ids (:func:`asp.symmetry.interchangeable_blocks`),
+    of which only the first of equal blocks moves (:meth:`OperationModel.enabled`);
+    ``loose``: classes of interchangeable operation ids with their slack, ``(m, ids)``
+    (:attr:`OperationModel.loose`); ``interchangeable``: the classes of blocks the
+    reduction used (:attr:`OperationModel.interchangeable`); ``fixed``: classes of blocks
+    of operation ids the spec puts in a fixed order (:attr:`OperationModel.fixed`).
+
+    Raises
+    ------
+    ValueError
+        More operations than the transition table's int16 operation index holds.
+    """
+    ops = spec.operations
+    n_ops = len(ops)
+    if n_ops > MAX_OPS:
+        raise SpecError(
+            f"{spec.source}: operations: {n_ops} operations, at most {MAX_OPS:,} are supported; "
+            f"split the assembly into subassemblies"
+        )
+    values = tool_values(spec)
+    names = tuple(values)
+    bits = tuple(max(1, math.ceil(math.log2(len(values[t])))) for t in names)
+    shifts, pos = [], n_ops
+    for b in bits:
+        if pos // WORD_BITS != (pos + b - 1) // WORD_BITS:  # keep each field in one word
+            pos = (pos // WORD_BITS + 1) * WORD_BITS
+        shifts.append(pos)
+        pos += b
+    n_words = max(1, math.ceil(pos / WORD_BITS), int(_min_words))
+    oracle = insertion_oracle(spec, relations)
+    index = {op.id: i for i, op in enumerate(ops)}
+    pidx = {p: k for k, p in enumerate(oracle.parts)}
+    topo = spec.constraints.topological
+    pred = [sum(1 << index[a] for a in op.after) if topo else 0 for op in ops]
+    part_lists = tuple(
+        (pidx[op.unit],) if op.unit else tuple(pidx[p] for p in op.parts) for op in ops
+    )
+    units = [u for u, _ in spec.subassemblies]
+    owner = {m: k for k, (_, ms) in enumerate(spec.subassemblies) for m in ms}
+    op_workspace = tuple(
+        owner[op.parts[0]] if op.parts and op.parts[0] in owner else -1 for op in ops
+    )
+    unit_masks = pack_words(
+        [sum(1 << pidx[m] for m in ms) for _, ms in spec.subassemblies], oracle.n_words
+    )
+    req_m, req_v, set_m, set_v = [], [], [], []
+    tindex = {t: k for k, t in enumerate(names)}
+    for op in ops:
+        for pairs, mlist, vlist in ((op.requires, req_m, req_v), (op.sets, set_m, set_v)):
+            m = v = 0
+            for t, val in pairs:
+                k = tindex[t]
+                m |= ((1 << bits[k]) - 1) << shifts[k]
+                v |= values[t].index(val) << shifts[k]
+            mlist.append(m)
+            vlist.append(v)
+    placed = set(spec.placed_parts)
+    initial_parts = 0
+    if oracle.base >= 0 and spec.base_part not in placed:
+        initial_parts = 1 << oracle.base
+
+    def table(ints: list[int]) -> np.ndarray:
+        rows = [_split(x, n_words) for x in ints]
+        return np.array(rows, dtype=np.uint64).reshape(len(ints), n_words)
+
+    return OperationModel(
+        spec=spec,
+        oracle=oracle,
+        op_bits=table([1 << i for i in range(n_ops)]),
+        pred_masks=table(pred),
+        op_parts=pack_words([sum(1 << pidx[p] for p in op.parts) for op in ops], oracle.n_words),
+        part_lists=part_lists,
+        requires_mask=table(req_m),
+        requires_value=table(req_v),
+        sets_mask=table(set_m),
+        sets_value=table(set_v),
+        tool_names=names,
+        tool_values=tuple(values[t] for t in names),
+        tool_shift=tuple(shifts),
+        tool_bits=bits,
+        start_key=0,
+        initial_parts=initial_parts,
+        n_bits=pos,
+        op_workspace=op_workspace,
+        unit_ops=tuple(index[u] for u in units),
+        unit_masks=unit_masks,
+        symmetric=tuple(
+            tuple(tuple(index[o] for o in block) for block in cls) for cls in symmetric
+        ),
+        loose=tuple((int(m), tuple(index[o] for o in ids)) for m, ids in loose),
+        interchangeable=tuple(
+            tuple(tuple(str(o) for o in block) for block in cls) for cls in interchangeable
+        ),
+        fixed=tuple(tuple(tuple(index[o] for o in block) for block in cls) for cls in fixed),
+    )
+
+
+def load_relations(spec: AssemblySpec, *, progress: bool = False, geometry=None):
+    """Compute the cad relations of ``spec``'s parts (``None`` when it has no geometry).
+
+    Reads the meshes of the spec's parts (:func:`asp.generate.spec_geometry`: in the
+    spec's build frame) unless ``geometry`` (that ``cad.Assembly``, already read) is given,
+    with the spec's
+    ``contact_tol`` and ``penetration_tol`` (None: the per-part rule).
+    """
+    if not spec.has_geometry:
+        return None
+    import cad
+    from cad.loading import load_parts
+
+    return cad.compute_relations(
+        load_parts(spec.parts, spec.folder, spec.units, frame=spec.frame)
+        if geometry is None
+        else geometry,
+        contact_tol=spec.contact_tol,
+        penetration_tol=spec.penetration_tol,
+        progress=progress,
+    )
