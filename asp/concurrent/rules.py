@@ -1,9 +1,9 @@
 """The concurrent game's rules, one position at a time (the game played on the fly).
 
-:mod:`asp.concurrent` compiles the whole concurrent game into a DAG before solving it; its
+:mod:`asp.concurrent.build` compiles the whole concurrent game into a DAG before solving it; its
 size is the product of assembly states, running-operation remainders and budgets. This
 module states the same rules (``../shared/DESIGN.md``, "The concurrent game") move by move,
-so that a search (:mod:`asp.concurrent_search`), a learner or a runtime can walk the game
+so that a search (:mod:`asp.concurrent.search`), a learner or a runtime can walk the game
 from a position without building it:
 
 - a :class:`Position` is a state with the robot side on turn: the assembly state (a node of
@@ -70,10 +70,11 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
-from asp.concurrent import WAIT, Commit, ConcurrentModel, Reply, concurrent_model
-from asp.dag import HUMAN, ROBOT
-from asp.fixed_order import FixedOrder
-from asp.together import OK, LiveSteps, edge, together_as
+from asp.concurrent.build import Commit, Reply
+from asp.concurrent.model import WAIT, ConcurrentModel, concurrent_model
+from asp.game.dag import HUMAN, ROBOT
+from asp.graph.fixed_order import FixedOrder
+from asp.graph.together import OK, LiveSteps, edge, together_as
 
 NONE = -2
 """A worker that takes no part in a move (busy, or no decision of this side)."""
@@ -226,7 +227,7 @@ class Rules:
 
     def key(self, pos: Position) -> tuple[int, ...]:
         """The canonical key of a position (equal for positions the symmetry identifies)."""
-        return tuple(int(x) for x in _key(self.tables, pos.row()))
+        return tuple(int(x) for x in key_of(self.tables, pos.row()))
 
     def commits(self, pos: Position) -> list[Commit]:
         """Every commitment of the robot side at ``pos`` (``Commit.ops[w]``: an operation or
@@ -234,7 +235,7 @@ class Rules:
         worker)."""
         if self.is_end(pos):
             return []
-        out = _commits(self.tables, pos.row())
+        out = commit_rows(self.tables, pos.row())
         return [Commit(ops=tuple(None if o == NONE else int(o) for o in c)) for c in out]
 
     def replies(self, pos: Position, commit: Commit) -> list[tuple[Reply, Position]]:
@@ -246,7 +247,7 @@ class Rules:
         lead to the same position at the same cost are given once.
         """
         c = np.array([NONE if o is None else o for o in commit.ops], dtype=np.int64)
-        ops, durs, dev, delta, rows = _replies(self.tables, pos.row(), c)
+        ops, durs, dev, delta, rows = reply_rows(self.tables, pos.row(), c)
         out = []
         for i in range(ops.shape[0]):
             reply = Reply(
@@ -262,11 +263,11 @@ class Rules:
         """The robots' starts of ``commit`` applied (their operations running), for display."""
         row = pos.row()
         c = np.array([NONE if o is None else o for o in commit.ops], dtype=np.int64)
-        return Position.of_row(_committed(self.tables, row, c)[0])
+        return Position.of_row(committed_row(self.tables, row, c)[0])
 
     def lower_bound(self, pos: Position) -> float:
         """An admissible lower bound on the time still needed from ``pos`` (spec units)."""
-        return _lower_bound(self.tables, pos.row()) / self.scale
+        return lower_bound_of(self.tables, pos.row()) / self.scale
 
     def features(self, pos: Position) -> np.ndarray:
         """(2 n + W + 1,) float32 features of a position for a learner: per operation done
@@ -291,7 +292,7 @@ class Rules:
 
     def budget_cap(self, pos: Position) -> int:
         """``R``: the deviations still possible from ``pos`` (module docstring)."""
-        return int(_cap(self.tables, pos.row()))
+        return int(budget_cap_of(self.tables, pos.row()))
 
 
 # --------------------------------------------------------------------------- building
@@ -314,8 +315,8 @@ def concurrent_rules(spec, graph, *, step: float | None = 1.0, fixed_order: bool
         As :func:`asp.concurrent.concurrent_model`, or a cell of more than
         :data:`MAX_WORKERS` workers.
     """
-    from asp.baseline import implied_predecessors
     from asp.errors import SpecError
+    from asp.schedule.assembly import implied_predecessors
 
     model = concurrent_model(spec, graph, step=step)
     nw = len(model.workers)
@@ -444,7 +445,7 @@ def _topological(preds: list[list[int]]) -> list[int]:
 
 
 @numba.njit(cache=True)
-def _is_done(T, s, o):  # pragma: no cover - compiled
+def is_done(T, s, o):  # pragma: no cover - compiled
     return (T.keys[s, o >> 6] >> np.uint64(o & 63)) & np.uint64(1) != np.uint64(0)
 
 
@@ -455,7 +456,7 @@ def _label(T, o):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _cap(T, row):  # pragma: no cover - compiled
+def budget_cap_of(T, row):  # pragma: no cover - compiled
     """The budget cap: the humans times the operations not done and not running that some
     human may do (module docstring)."""
     s = row[0]
@@ -465,7 +466,7 @@ def _cap(T, row):  # pragma: no cover - compiled
     n = T.label.shape[0]
     r = 0
     for o in range(n):
-        if T.human_op[o] and not _is_done(T, s, o):
+        if T.human_op[o] and not is_done(T, s, o):
             r += 1
     for w in range(nw):
         o = row[2 + w]
@@ -481,13 +482,13 @@ def _start_row(T, budget):  # pragma: no cover - compiled
     row[0] = 0
     for w in range(nw):
         row[2 + w] = -1
-    cap = _cap(T, row)
+    cap = budget_cap_of(T, row)
     row[1] = cap if budget < 0 or budget > cap else budget
     return row
 
 
 @numba.njit(cache=True)
-def _key(T, row):  # pragma: no cover - compiled
+def key_of(T, row):  # pragma: no cover - compiled
     """The canonical key of a (canonical) position row: its fields packed into int64 words."""
     nw = T.side.shape[0]
     out = np.zeros(T.kword[-1] + 1, np.int64)
@@ -525,7 +526,7 @@ def _resolve(T, s, labels, m, taken, nt, out):  # pragma: no cover - compiled
         found = -1
         for p in range(T.chain_len[c]):
             o = T.chains[c, p]
-            if _is_done(T, s, o):
+            if is_done(T, s, o):
                 continue
             used = False
             for j in range(nt):
@@ -664,7 +665,7 @@ def _next_digit(digit, n_opts, nd):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _commits(T, row):  # pragma: no cover - compiled
+def commit_rows(T, row):  # pragma: no cover - compiled
     """(M, W) int64: every commitment at the position ``row`` (:meth:`Rules.commits`): per
     worker its operation or WAIT (a free robot), its instruction (a free human), NONE (busy).
 
@@ -696,7 +697,7 @@ def _commits(T, row):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _committed(T, row, commit):  # pragma: no cover - compiled
+def committed_row(T, row, commit):  # pragma: no cover - compiled
     """The row after the robots of ``commit`` start (durations with tool change), and the
     instructions per worker (NONE where there is none)."""
     nw = T.side.shape[0]
@@ -753,20 +754,20 @@ def _advance(T, cur):  # pragma: no cover - compiled
         if o >= 0 and T.chain_of[o] >= 0:
             c = T.chain_of[o]
             nxt = 0
-            while _is_done(T, s, T.chains[c, nxt]):
+            while is_done(T, s, T.chains[c, nxt]):
                 nxt += 1
             for v in range(w):
                 if cur[2 + v] >= 0 and T.chain_of[cur[2 + v]] == c:
                     nxt += 1
             cur[2 + w] = T.chains[c, nxt]
-    cap = _cap(T, cur)
+    cap = budget_cap_of(T, cur)
     if cur[1] > cap:
         cur[1] = cap
     return delta
 
 
 @numba.njit(cache=True)
-def _replies(T, row, commit):  # pragma: no cover - compiled
+def reply_rows(T, row, commit):  # pragma: no cover - compiled
     """Every reply to ``commit`` at ``row`` (:meth:`Rules.replies`): per reply the free
     humans' operations and durations (NONE elsewhere), its deviations, the time until the
     next event, and the row after it."""
@@ -774,7 +775,7 @@ def _replies(T, row, commit):  # pragma: no cover - compiled
     width_row = 2 + 2 * nw
     s = row[0]
     budget = row[1]
-    cur, told = _committed(T, row, commit)
+    cur, told = committed_row(T, row, commit)
     busy, nb = _busy(T, cur)
     deciders, nd, opts, n_opts, _ = _deciders(T, cur, 1, busy, nb)
     cap = 16
@@ -877,7 +878,7 @@ def _grow(a, size, fill):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _lower_bound(T, row):  # pragma: no cover - compiled
+def lower_bound_of(T, row):  # pragma: no cover - compiled
     """An admissible lower bound (scaled) on the time still needed from ``row``.
 
     Against the person who follows every instruction and takes the longest duration its
@@ -912,7 +913,7 @@ def _lower_bound(T, row):  # pragma: no cover - compiled
     forced = np.zeros(2, np.int64)
     for i in range(n):
         o = T.topo[i]
-        if ef[o] >= 0 or _is_done(T, s, o):
+        if ef[o] >= 0 or is_done(T, s, o):
             continue
         todo[o] = True
         e = 0
@@ -944,7 +945,7 @@ def _lower_bound(T, row):  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def _fits(T, t, rems, forced, todo):  # pragma: no cover - compiled
-    """Whether the remaining work fits both sides by time ``t`` (:func:`_lower_bound`)."""
+    """Whether the remaining work fits both sides by time ``t`` (:func:`lower_bound_of`)."""
     nw = T.side.shape[0]
     cap = np.zeros(2, np.int64)
     for w in range(nw):

@@ -1,6 +1,6 @@
 """The concurrent game solved on the fly: ``W*(k)`` without building the game.
 
-The game is walked from its start by the rules of :mod:`asp.concurrent_rules`; only the
+The game is walked from its start by the rules of :mod:`asp.concurrent.rules`; only the
 positions the search needs are ever made. Two compiled kernels (numba, ``cache=True``) do
 the work: a minimax search for values and a builder of the *policy game* (the states one
 robot policy can reach against every human, with all their replies), whose exact solution
@@ -10,8 +10,9 @@ The search
 ----------
 Depth-first minimax, alpha-beta with fail-soft bounds, over positions (the robot side on
 turn); a human node (a position and one commitment) is the max over its replies, searched
-inside its position's call, and is not stored. A transposition table keyed on the positions' canonical keys
-(:meth:`asp.concurrent_rules.Rules.key`: alike operations and budgets that no longer bind
+inside its position's frame, and is not stored. A transposition table keyed on the positions'
+canonical keys
+(:meth:`asp.concurrent.rules.Rules.key`: alike operations and budgets that no longer bind
 identified, both exact) keeps for each position a proven interval ``[lo, hi]`` of its value
 and the commitment that proved ``hi``. Depth-first was chosen over best-first (AO*) for
 memory: the only memory is the table (sized before the search, see *Limits*), and the
@@ -25,7 +26,7 @@ Every rule that cuts the search, with its proof:
    fail-soft invariant, by induction over the calls). A stored interval narrows the window
    or answers at once; the commitment stored with ``hi`` achieves ``hi`` (its returned
    value is an upper bound of its true one).
-2. *Admissible lower bounds.* ``lo`` starts at :meth:`~asp.concurrent_rules.Rules.lower_bound`
+2. *Admissible lower bounds.* ``lo`` starts at :meth:`~asp.concurrent.rules.Rules.lower_bound`
    (critical path and per-side load against a person who follows and is slow, one human
    strategy: the value is at least the robot's best against it). A commitment's human node
    is at least the bound of the position with the commitment's starts and instructions
@@ -37,7 +38,7 @@ Every rule that cuts the search, with its proof:
    position one budget lower and ``hi`` from one budget higher when the table has them. At
    the root, the search for ``k`` runs in the window ``(W*(k - 1) - 1, W*(inf) + 1)``.
 4. *Instructions that cannot bind.* With the budget at its cap (every deviation affordable,
-   :mod:`asp.concurrent_rules`) the person may do anything at no cost, and the child's budget
+   :mod:`asp.concurrent.rules`) the person may do anything at no cost, and the child's budget
    is its own cap whatever the instruction (a reply with ``d`` starting deviations has at
    most ``H * d`` in all, and starts at least ``d`` of the operations the cap counts). So
    the replies to two commitments with the same robot starts depend only on which free
@@ -57,7 +58,7 @@ The plan's policy is built as a policy game: at each position it reaches, the se
 run to the exact value and its stored commitment taken (so the policy is optimal at every
 state it reaches, after any human move, not only on the principal line); every human reply
 is followed. Solving that small DAG gives each state's bound, and it is an ordinary
-:class:`asp.concurrent.ConcurrentGame`: the plan file, the timelines and the runtime
+:class:`asp.concurrent.build.ConcurrentGame`: the plan file, the timelines and the runtime
 advisor read it as they read the compiled game. A fixed policy is certified the same way
 (an exact best response of the human side against it: the policy game of the CP-SAT
 schedule run as a plan, of a greedy adaptive policy, or of the table's moves where the
@@ -88,30 +89,36 @@ import numba
 import numpy as np
 from numba.typed import List
 
-from asp.concurrent import UNBOUNDED, ConcurrentGame, _ActionRows, _NodeRows
-from asp.concurrent_rules import (
+from asp.concurrent.build import ActionRows, ConcurrentGame, NodeRows, game_of
+from asp.concurrent.kernel import grow, grow_rows
+from asp.concurrent.model import UNBOUNDED
+from asp.concurrent.rules import (
     NONE,
     Rules,
-    _cap,
-    _commits,
-    _committed,
-    _key,
-    _lower_bound,
-    _replies,
+    budget_cap_of,
+    commit_rows,
+    committed_row,
+    is_done,
+    key_of,
+    lower_bound_of,
+    reply_rows,
 )
-from asp.dag import from_arrays
-from asp.together import edge
+from asp.graph.together import edge
 
 INF = 1 << 60
 """A value above every makespan (scaled)."""
 ROBUST, SCHEDULE, GREEDY, HYBRID = 0, 1, 2, 3
-"""Robot policies of a policy game: the search's (exact), the CP-SAT schedule run as a plan
-(:func:`asp.concurrent.schedule_rule`'s rule), greedy (least bound of rule 2), and the
-table's moves where it has them, else greedy."""
+"""Robot policies of a policy game: the search's (exact, per budget), the CP-SAT schedule run
+as a plan (:func:`asp.concurrent.robustness.schedule_rule`'s rule), greedy (least bound of
+rule 2), and the table's moves where it has them (of the state at the highest budget the
+table holds), else greedy. The last three choose by the state alone, not the budget: fixed
+policies, whose certified worst case never falls as ``k`` grows."""
 DEFAULT_MEMORY = 1 << 30
 """Bytes for the search table and the policy games by default (1 GiB)."""
 DEFAULT_MAX_NODES = 50_000_000
 """Positions the search expands at most by default."""
+GENERATOR = "asmplan.concurrent.search/1"
+"""The ``generator`` of a policy game's DAG."""
 TICK = (1 << 15) - 1
 """The clock and the progress line are looked at every ``TICK + 1`` positions."""
 
@@ -141,6 +148,8 @@ ENTRY_BYTES = 3 * 8
 """Bytes of one table entry besides its key words (``lo``, ``hi``, ``move``)."""
 LOAD = 0.7
 """Largest share of a table's slots in use."""
+MIN_ENTRIES = 1024
+"""The least search table worth starting."""
 
 
 def table_entries(memory: int, key_words: int) -> int:
@@ -201,25 +210,25 @@ def _entry(T, H, row, st, lb):  # pragma: no cover - compiled
     """The slot of the position ``row``, made when new: ``lo`` its lower bound (``lb`` when
     given, >= 0), raised to the same position's one budget lower and ``hi`` lowered to its
     one budget higher (rule 3). -1 (and the stop flag) when the table is full."""
-    key = _key(T, row)
+    key = key_of(T, row)
     i = _slot(H, key)
     if H.keys[i, 0] != 0:
         return i
     if st[ENTRIES] >= st[MAX_ENTRIES]:
         st[ABORT] = STOP_MEMORY
         return -1
-    lo = lb if lb >= 0 else _lower_bound(T, row)
+    lo = lb if lb >= 0 else lower_bound_of(T, row)
     hi = INF
     b = row[1]
     other = row.copy()
     if b > 0:
         other[1] = b - 1
-        j = _find(H, _key(T, other))
+        j = _find(H, key_of(T, other))
         if j >= 0 and H.lo[j] > lo:
             lo = H.lo[j]
-    if b < _cap(T, row):
+    if b < budget_cap_of(T, row):
         other[1] = b + 1
-        j = _find(H, _key(T, other))
+        j = _find(H, key_of(T, other))
         if j >= 0:
             hi = H.hi[j]
     i = _slot(H, key)  # (the probes above did not write)
@@ -239,7 +248,7 @@ def _estimate(T, row, commit):  # pragma: no cover - compiled
     """Rule 2's bound of a commitment: the lower bound of the position with the robots'
     starts and the instructed persons' operations running (a person's at its longest)."""
     nw = T.side.shape[0]
-    cur, told = _committed(T, row, commit)
+    cur, told = committed_row(T, row, commit)
     s = row[0]
     for w in range(nw):
         o = told[w]
@@ -248,7 +257,7 @@ def _estimate(T, row, commit):  # pragma: no cover - compiled
             cur[2 + nw + w] = (
                 T.dur[w, o, T.ndur[w, o] - 1] + T.change[edge(s, T.label[o], T.indptr, T.lab)]
             )
-    return _lower_bound(T, cur)
+    return lower_bound_of(T, cur)
 
 
 @numba.njit(cache=True)
@@ -256,7 +265,7 @@ def _dominant(T, row, commits, est):  # pragma: no cover - compiled
     """(M,) bool: the commitments rule 4 keeps (all when the budget is below its cap)."""
     m = commits.shape[0]
     keep = np.ones(m, np.bool_)
-    if row[1] < _cap(T, row):
+    if row[1] < budget_cap_of(T, row):
         return keep
     nw = T.side.shape[0]
     mask = np.zeros(m, np.int64)
@@ -281,10 +290,10 @@ def _dominant(T, row, commits, est):  # pragma: no cover - compiled
             hi += 1
         for i in range(lo, hi):  # one per set of waiting persons: the least bound
             for j in range(lo, hi):
-                if j != i and keep[j] and mask[j] == mask[i]:
-                    if est[j] < est[i] or (est[j] == est[i] and j < i):
-                        keep[i] = False
-                        break
+                better = est[j] < est[i] or (est[j] == est[i] and j < i)
+                if j != i and keep[j] and mask[j] == mask[i] and better:
+                    keep[i] = False
+                    break
         for i in range(lo, hi):  # none whose set has a strict subset kept
             if not keep[i]:
                 continue
@@ -404,7 +413,7 @@ def _search(T, H, root, alpha, beta, st):  # pragma: no cover - compiled
             slot[d] = s_
             a_[d] = max(win_a[d], lo)
             b_[d] = min(win_b[d], hi)
-            commits = _commits(T, row)
+            commits = commit_rows(T, row)
             m = commits.shape[0]
             est = np.empty(m, np.int64)
             for i in range(m):
@@ -475,7 +484,7 @@ def _search(T, H, root, alpha, beta, st):  # pragma: no cover - compiled
             # The human node of the chosen commitment: the max over its replies.
             ci[d] = chosen
             beta_h[d] = min(b_[d], best[d])
-            ops, durs, dev, delta, rws = _replies(T, rows[d], commits[chosen])
+            ops, durs, dev, delta, rws = reply_rows(T, rows[d], commits[chosen])
             n = delta.shape[0]
             lbs = np.empty(n, np.int64)
             key_r = np.empty(n, np.int64)
@@ -483,8 +492,8 @@ def _search(T, H, root, alpha, beta, st):  # pragma: no cover - compiled
                 if rws[r, 0] < 0:
                     lbs[r] = 0
                 else:
-                    jj = _find(H, _key(T, rws[r]))
-                    lbs[r] = H.lo[jj] if jj >= 0 else _lower_bound(T, rws[r])
+                    jj = _find(H, key_of(T, rws[r]))
+                    lbs[r] = H.lo[jj] if jj >= 0 else lower_bound_of(T, rws[r])
                 key_r[r] = -(delta[r] + lbs[r])
             rrows_l[d] = rws
             rdelta_l[d] = delta
@@ -544,17 +553,20 @@ def _choose(T, H, row, commits, kind, prefs, n_prefs, st):  # pragma: no cover -
         v = _search(T, H, row, -1, INF, st)
         if st[ABORT]:
             return -1
-        i = _find(H, _key(T, row))
+        i = _find(H, key_of(T, row))
         if H.move[i] < 0:  # exact by bounds alone (rule 3): search again for the move
             H.hi[i] = INF
             _search(T, H, row, v - 1, v + 1, st)
             if st[ABORT]:
                 return -1
         return H.move[i]
-    if kind == HYBRID:
-        i = _find(H, _key(T, row))
-        if i >= 0 and 0 <= H.move[i] < m:
-            return H.move[i]
+    if kind == HYBRID:  # the table's move of the same state at the highest budget it has
+        other = row.copy()
+        for b in range(budget_cap_of(T, row), -1, -1):
+            other[1] = b
+            i = _find(H, key_of(T, other))
+            if i >= 0 and 0 <= H.move[i] < m:
+                return H.move[i]
     if kind == SCHEDULE:
         return _schedule_choice(T, row, commits, prefs, n_prefs)
     best, best_i = INF, 0
@@ -589,12 +601,12 @@ def _schedule_choice(T, row, commits, prefs, n_prefs):  # pragma: no cover - com
                 left = 0
                 for p in range(T.chain_len[c]):
                     q = T.chains[c, p]
-                    if _done(T, s, q) or _running(row, nw, q):
+                    if is_done(T, s, q) or _running(row, nw, q):
                         left += 1
                 if rank >= left:
                     want[w] = T.label[o]
                     break
-            elif not _done(T, s, o) and not _running(row, nw, o):
+            elif not is_done(T, s, o) and not _running(row, nw, o):
                 want[w] = o
                 break
     best, best_score = 0, -1
@@ -618,11 +630,6 @@ def _schedule_choice(T, row, commits, prefs, n_prefs):  # pragma: no cover - com
 
 
 @numba.njit(cache=True)
-def _done(T, s, o):  # pragma: no cover - compiled
-    return (T.keys[s, o >> 6] >> np.uint64(o & 63)) & np.uint64(1) != np.uint64(0)
-
-
-@numba.njit(cache=True)
 def _running(row, nw, o):  # pragma: no cover - compiled
     for w in range(nw):  # noqa: SIM110 - numba has no generator expressions
         if row[2 + w] == o:
@@ -632,7 +639,7 @@ def _running(row, nw, o):  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def _node_row(row, kind, told, nw):  # pragma: no cover - compiled
-    """A position as :class:`asp.concurrent._NodeRows` reads a node:
+    """A position as :class:`asp.concurrent.NodeRows` reads a node:
     ``[kind, state, budget, ops, remains, instructions]``."""
     out = np.full(3 + 3 * nw, NONE, np.int64)
     out[0] = kind
@@ -671,45 +678,45 @@ def _policy_game(T, H, P, starts, kind, prefs, n_prefs, st, max_nodes):  # pragm
     start_ids = np.empty(starts.shape[0], np.int64)
     none = np.full(nw, NONE, np.int64)
     for b in range(starts.shape[0]):
-        slot = _slot(P, _key(T, starts[b]))
+        slot = _slot(P, key_of(T, starts[b]))
         if P.keys[slot, 0] != 0:
             start_ids[b] = P.lo[slot]
             continue
-        P.keys[slot] = _key(T, starts[b])
+        P.keys[slot] = key_of(T, starts[b])
         P.lo[slot] = n
         if n >= nodes.shape[0]:
-            nodes = _grow_rows(nodes, 2 * nodes.shape[0])
+            nodes = grow_rows(nodes, 2 * nodes.shape[0])
         nodes[n] = _node_row(starts[b], 0, none, nw)
         start_ids[b] = n
         n += 1
         if top >= stack.shape[0]:
-            stack = _grow_rows(stack, 2 * stack.shape[0])
+            stack = grow_rows(stack, 2 * stack.shape[0])
         stack[top] = starts[b]
         top += 1
     while top > 0:
         top -= 1
         row = stack[top].copy()
-        v = P.lo[_slot(P, _key(T, row))]
-        commits = _commits(T, row)
+        v = P.lo[_slot(P, key_of(T, row))]
+        commits = commit_rows(T, row)
         i = _choose(T, H, row, commits, kind, prefs, n_prefs, st)
         if i < 0 or n + 1 >= max_nodes:
             return False, nodes[:n], start_ids, e_src[:m], e_dst[:m], e_cost[:m], e_side[:m], \
                 e_ops[:m], e_dur[:m], e_dev[:m]  # fmt: skip
         commit = commits[i]
-        cur, told = _committed(T, row, commit)
+        cur, told = committed_row(T, row, commit)
         u = n
         if n >= nodes.shape[0]:
-            nodes = _grow_rows(nodes, 2 * nodes.shape[0])
+            nodes = grow_rows(nodes, 2 * nodes.shape[0])
         nodes[u] = _node_row(cur, 1, told, nw)
         n += 1
-        ops, durs, dev, delta, rows = _replies(T, row, commit)
+        ops, durs, dev, delta, rows = reply_rows(T, row, commit)
         need = m + 1 + delta.shape[0]
         if need > cap_e:
             while cap_e < need:
                 cap_e *= 2
-            e_src, e_dst, e_cost = _grow(e_src, cap_e), _grow(e_dst, cap_e), _grow(e_cost, cap_e)
-            e_side, e_dev = _grow(e_side, cap_e), _grow(e_dev, cap_e)
-            e_ops, e_dur = _grow_rows(e_ops, cap_e), _grow_rows(e_dur, cap_e)
+            e_src, e_dst, e_cost = grow(e_src, cap_e), grow(e_dst, cap_e), grow(e_cost, cap_e)
+            e_side, e_dev = grow(e_side, cap_e), grow(e_dev, cap_e)
+            e_ops, e_dur = grow_rows(e_ops, cap_e), grow_rows(e_dur, cap_e)
         e_src[m], e_dst[m], e_cost[m], e_side[m], e_dev[m] = v, u, 0, 0, 0
         e_ops[m] = commit
         e_dur[m] = NONE
@@ -717,7 +724,7 @@ def _policy_game(T, H, P, starts, kind, prefs, n_prefs, st, max_nodes):  # pragm
         for r in range(delta.shape[0]):
             t = 0
             if rows[r, 0] >= 0:
-                key = _key(T, rows[r])
+                key = key_of(T, rows[r])
                 slot = _slot(P, key)
                 if P.keys[slot, 0] != 0:
                     t = P.lo[slot]
@@ -729,11 +736,11 @@ def _policy_game(T, H, P, starts, kind, prefs, n_prefs, st, max_nodes):  # pragm
                     P.lo[slot] = n
                     t = n
                     if n >= nodes.shape[0]:
-                        nodes = _grow_rows(nodes, 2 * nodes.shape[0])
+                        nodes = grow_rows(nodes, 2 * nodes.shape[0])
                     nodes[n] = _node_row(rows[r], 0, none, nw)
                     n += 1
                     if top >= stack.shape[0]:
-                        stack = _grow_rows(stack, 2 * stack.shape[0])
+                        stack = grow_rows(stack, 2 * stack.shape[0])
                     stack[top] = rows[r]
                     top += 1
             e_src[m], e_dst[m], e_cost[m], e_side[m], e_dev[m] = u, t, delta[r], 1, dev[r]
@@ -742,20 +749,6 @@ def _policy_game(T, H, P, starts, kind, prefs, n_prefs, st, max_nodes):  # pragm
             m += 1
     return True, nodes[:n], start_ids, e_src[:m], e_dst[:m], e_cost[:m], e_side[:m], \
         e_ops[:m], e_dur[:m], e_dev[:m]  # fmt: skip
-
-
-@numba.njit(cache=True)
-def _grow(a, size):  # pragma: no cover - compiled
-    out = np.empty(size, a.dtype)
-    out[: a.shape[0]] = a
-    return out
-
-
-@numba.njit(cache=True)
-def _grow_rows(a, size):  # pragma: no cover - compiled
-    out = np.empty((size, a.shape[1]), a.dtype)
-    out[: a.shape[0]] = a
-    return out
 
 
 # --------------------------------------------------------------------------- Python side
@@ -785,6 +778,14 @@ class Search:
         # Half the memory for the search table, the rest for the policy games' tables
         # and node arrays.
         self.entries = table_entries(self.limits.memory // 2, kw)
+        if self.entries < MIN_ENTRIES:
+            from asp.errors import GameError
+
+            need = 2 * MIN_ENTRIES * (8 * kw + ENTRY_BYTES) / LOAD
+            raise GameError(
+                f"--max-memory: {self.limits.memory:,} bytes is too little for the concurrent "
+                f"search (at least {need:,.0f} bytes)"
+            )
         self.table = new_table(self.entries, kw)
         self.stats = np.zeros(N_STATS, dtype=np.int64)
         self.stats[MAX_ENTRIES] = self.entries
@@ -826,12 +827,20 @@ class Search:
                 return None
         return int(v)
 
+    def value_at(self, pos) -> int | None:
+        """The exact value (scaled) of any position (:class:`asp.concurrent.rules.Position`),
+        None when a limit stopped the search."""
+        if self.rules.is_end(pos):
+            return 0
+        v = _search(self.rules.tables, self.table, pos.row(), -1, INF, self.stats)
+        return None if self.stopped else int(v)
+
     def proven(self, budget: int | None) -> tuple[int, int]:
         """The interval the table proves for the start of ``budget`` (scaled)."""
         row = self.rules.start(budget).row()
-        i = _find(self.table, _key(self.rules.tables, row))
+        i = _find(self.table, key_of(self.rules.tables, row))
         if i < 0:
-            return int(_lower_bound(self.rules.tables, row)), INF
+            return int(lower_bound_of(self.rules.tables, row)), INF
         return int(self.table.lo[i]), int(self.table.hi[i])
 
     def policy_game(
@@ -892,43 +901,17 @@ def schedule_lists(rules: Rules, rows: list[dict]) -> tuple[np.ndarray, np.ndarr
 
 
 def _as_game(rules, budgets, rows, start_ids, edges, t0):
-    """A policy game's arrays as a :class:`asp.concurrent.ConcurrentGame`."""
+    """A policy game's arrays as a :class:`asp.concurrent.build.ConcurrentGame`."""
     model = rules.model
     src, dst, cost, side, e_ops, e_dur, e_dev = edges
     order = np.argsort(src, kind="stable")
     src, dst, cost, side = src[order], dst[order], cost[order], side[order]
-    e_ops, e_dur, e_dev = e_ops[order], e_dur[order], e_dev[order]
-    nodes = _NodeRows(rows.astype(np.int64), model.humans)
-    actions = _ActionRows(side.astype(np.int8), e_ops, e_dur, e_dev, cost)
+    nodes = NodeRows(rows.astype(np.int64), model.humans)
+    actions = ActionRows(side.astype(np.int8), e_ops[order], e_dur[order], e_dev[order], cost)
     levels = [UNBOUNDED if b is None else int(b) for b in budgets]
     starts = {b: int(start_ids[i]) for i, b in enumerate(levels)}
-    dag = from_arrays(
-        range(rows.shape[0]),
-        src,
-        dst,
-        cost.astype(np.float64) / model.scale,
-        side.astype(np.int8),
-        start=starts[levels[-1]],
-        end=0,
-        cost_model="time",
-        metadata={
-            "generator": "asmplan.concurrent_search/1",
-            "assembly": model.spec.name,
-            "source": model.spec.source,
-            "turn_model": "concurrent",
-            "budgets": [None if b == UNBOUNDED else b for b in levels],
-            "workers": {w.name: ("robot" if w.side == 0 else "human") for w in model.workers},
-        },
-    )
-    return ConcurrentGame(
-        model=model,
-        dag=dag,
-        budgets=tuple(levels),
-        starts=starts,
-        nodes=nodes,
-        actions=actions,
-        seconds=time.perf_counter() - t0,
-    )
+    edges = (src, dst, cost, side)
+    return game_of(model, levels, nodes, actions, starts, 0, edges, t0, GENERATOR)
 
 
 # --------------------------------------------------------------------------- the curve
@@ -941,21 +924,26 @@ class Curve:
     Attributes
     ----------
     lower, upper : tuple of float
-        ``L(k)`` and ``U(k)`` for ``k = 0..K`` (spec units): ``L(k) <= W*(k) <= U(k)``,
-        equal where exact; the last entry is ``k = inf``.
+        ``L(k)`` and ``U(k)`` for ``k = 0..K`` then ``k = inf`` (spec units):
+        ``L(k) <= W*(k) <= U(k)``, equal where exact; both never fall as ``k`` grows.
+    bounds : tuple of float
+        The certified worst case of the plan's policy for the same budgets (``upper`` at
+        ``K``; ``W*(k)`` where exact). At ``inf``: the policy's own when its game has that
+        start, else ``upper``.
     flat : bool
         ``W*(K) = W*(inf)`` is proven (the curve stops there), else ``max_k`` or a limit
         stopped it.
-    game : asp.concurrent.ConcurrentGame
-        The policy game of the plan's policy (budgets ``0..K``, the plan's ``K`` last;
-        with ``inf`` first when the policy is not the exact one), and ``solution`` its
-        exact solution: each state's bound is the policy's certified worst case from it.
+    game : asp.concurrent.build.ConcurrentGame
+        The policy game of the plan's policy (its starts: budgets ``0..K``, and ``inf``
+        unless the policy is the exact one; the plan's ``K`` is the DAG's start), and
+        ``solution`` its exact solution: each state's bound is the policy's certified worst
+        case from it.
     policy : str
-        ``"robust"`` (exact), ``"hybrid"``, ``"greedy"`` or ``"schedule"``: the one whose
-        certified worst case is ``upper`` at ``K``.
+        ``"robust"`` (exact), ``"hybrid"``, ``"greedy"`` or ``"schedule"``: the certified
+        policy of least worst case at ``K``.
     schedule_worst : list of {"k", "bound"}
         The CP-SAT schedule's certified worst case per ``k`` (``None`` for ``inf``), empty
-        without a schedule.
+        without a schedule or when its policy game was over the limits.
     stopped : str or None
         The limit that stopped the search (``"time limit"``, ...), None when exact.
     nodes, positions : int
@@ -965,6 +953,7 @@ class Curve:
 
     lower: tuple[float, ...]
     upper: tuple[float, ...]
+    bounds: tuple[float, ...]
     flat: bool
     game: ConcurrentGame
     solution: object
@@ -984,20 +973,26 @@ class Curve:
     def exact(self) -> tuple[bool, ...]:
         return tuple(lo == hi for lo, hi in zip(self.lower, self.upper, strict=True))
 
+    def gap(self, i: int) -> float:
+        """The gap of entry ``i`` in per cent of the upper bound."""
+        lo, hi = self.lower[i], self.upper[i]
+        return 0.0 if hi <= lo or hi <= 0 else 100.0 * (hi - lo) / hi
+
     def to_list(self) -> list[dict]:
         """``[{"k", "bound", "lower", "upper", "exact"}, ..., {"k": None, ...}]``: ``bound``
         is the certified worst case of the plan's policy (``W*(k)`` where exact)."""
         from asp.numbers import json_number
 
         out = []
-        for k, (lo, hi) in enumerate(zip(self.lower, self.upper, strict=True)):
+        n = len(self.lower)
+        for i in range(n):
             out.append(
                 {
-                    "k": None if k == len(self.lower) - 1 else k,
-                    "bound": json_number(hi, 6),
-                    "lower": json_number(lo, 6),
-                    "upper": json_number(hi, 6),
-                    "exact": lo == hi,
+                    "k": None if i == n - 1 else i,
+                    "bound": json_number(self.bounds[i], 6),
+                    "lower": json_number(self.lower[i], 6),
+                    "upper": json_number(self.upper[i], 6),
+                    "exact": self.lower[i] == self.upper[i],
                 }
             )
         return out
@@ -1021,24 +1016,34 @@ def solve_curve(
         The largest finite budget of the curve.
     min_k : int
         The curve goes at least this far (while ``<= max_k``), flat or not.
+    limits : Limits, optional
+        Memory, positions and seconds for the search (default :class:`Limits`).
     schedule : list of dict, optional
         A CP-SAT schedule (``{"task", "agent", "start"}`` rows), run as a plan: certified for
         every ``k``, and one more policy for ``U`` when the search stops.
     lower : float, optional
         A proven lower bound of ``W*(0)`` (the CP-SAT bound), spec units.
+    progress : bool
+        A line on stderr per value found and every second of search.
+
+    Raises
+    ------
+    asp.errors.GameError
+        The memory allowed holds no search table, or no policy could be certified in it.
     """
+    from asp.game.solve import solve
+
     t0 = time.perf_counter()
     search = Search(rules, limits, progress=progress)
     scale = rules.scale
     floor = int(np.ceil((lower or 0) * scale - 1e-9))
-    start_lb = int(_lower_bound(rules.tables, rules.start(0).row()))
-    floor = max(floor, start_lb)
+    floor = max(floor, int(lower_bound_of(rules.tables, rules.start(0).row())))
 
     def say(text: str) -> None:
         if progress:
             print(f"  {text} ({time.perf_counter() - t0:.1f} s)", file=sys.stderr, flush=True)
 
-    exact: dict = {}
+    exact: dict = {}  # budget (None: inf) -> W* (scaled)
     v0 = search.value(0, floor - 1)
     if v0 is not None:
         exact[0] = v0
@@ -1047,104 +1052,90 @@ def solve_curve(
         if top is not None:
             exact[None] = top
             say(f"W*(inf) = {top / scale:g}")
-    k, flat = 0, False
-    while None in exact and k < max_k:
-        if exact[k] == exact[None] and k >= min_k:
-            flat = True
-            break
+    k = 0
+    while None in exact and k < max_k and not (exact[k] == exact[None] and k >= min_k):
         if exact[k] == exact[None]:
-            exact[k + 1] = exact[None]  # the curve is flat from k on
+            v = exact[None]  # flat from k on (the curve never falls, never passes W*(inf))
         else:
             v = search.value(k + 1, exact[k] - 1, exact[None] + 1)
             if v is None:
                 break
-            exact[k + 1] = v
             say(f"W*({k + 1}) = {v / scale:g}")
+        exact[k + 1] = v
         k += 1
-    if None in exact and k == max_k and exact[k] == exact[None]:
-        flat = True
-    K = k if None in exact else max_k
+    finished = None in exact and (k == max_k or exact[k] == exact[None])
+    flat = None in exact and exact.get(k) == exact[None]
+    K = k if finished else min(max_k, max(min_k, k))  # stopped: the budgets reached so far
     budgets = list(range(K + 1))
-    stopped = search.stopped
-    game = None
-    name = "robust"
-    if stopped is None:
+    ks: list = [*budgets, None]
+    # The certified policies: the exact one when every value is known, else the others.
+    candidates = []
+    if finished:
         game = search.policy_game(budgets, ROBUST)
-        stopped = search.stopped
-    policies = []
-    if game is not None:
-        policies.append(("robust", game))
-    else:
-        for name_, kind in (("hybrid", HYBRID), ("greedy", GREEDY)):
-            g = search.policy_game([None, *budgets], kind)
-            if g is not None:
-                policies.append((name_, g))
+        if game is not None:
+            candidates.append(("robust", game))
+    if not candidates:
+        for name, kind in (("hybrid", HYBRID), ("greedy", GREEDY)):
+            game = search.policy_game([None, *budgets], kind)
+            if game is not None:
+                candidates.append((name, game))
     sched_game = None
     if schedule:
         sched_game = search.policy_game([None, *budgets], SCHEDULE, schedule)
-        if sched_game is not None and game is None:
-            policies.append(("schedule", sched_game))
-    from asp.solve import solve
+        if sched_game is not None and candidates and candidates[0][0] != "robust":
+            candidates.append(("schedule", sched_game))
+    if not candidates:
+        from asp.errors import GameError
 
-    solved = [(n, g, solve(g.dag)) for n, g in policies]
-    ks = [*budgets, UNBOUNDED]
-
-    def certified(g, sol, b):
-        v = g.starts.get(b)
-        return None if v is None else float(sol.value[v, 0])
-
-    # U(k): the least certified worst case of a policy at k or at any larger budget.
-    upper, chosen = [], []
-    for b in ks:
-        best, who = np.inf, None
-        for n, g, sol in solved:
-            for b2 in ks[ks.index(b) :]:
-                c = certified(g, sol, b2)
-                if c is not None and c < best:
-                    best, who = c, n
-        upper.append(best)
-        chosen.append(who)
-    # L(k): what is exact, else the best proven bound, never below L(k - 1).
-    lows = []
-    for b in ks:
-        key = None if b == UNBOUNDED else b
-        if key in exact:
-            lows.append(exact[key] / scale)
-        else:
-            lo, _ = search.proven(key)
-            lows.append(max(lo, floor) / scale)
-    lower_k = []
-    for i, lo in enumerate(lows):
-        lower_k.append(max([lo, *lower_k[-1:]]) if i < len(lows) - 1 else max(lo, *lower_k))
+        raise GameError(
+            f"--max-memory: {search.limits.memory:,} bytes certify no policy of this game "
+            "(each policy game was over the limit); allow more memory"
+        )
+    solved = []
+    for name, game in candidates:
+        sol = solve(game.dag)
+        values = {
+            (None if b == UNBOUNDED else b): float(sol.value[v, 0]) for b, v in game.starts.items()
+        }
+        solved.append((name, game, sol, values))
+    # U(k): the least certified worst case at k or at a larger budget (W* never falls);
+    # L(k): exact, else the best proven bound, never below L(k - 1).
+    upper, lows = [], []
     for i, b in enumerate(ks):
-        key = None if b == UNBOUNDED else b
-        if key in exact:
-            upper[i] = min(upper[i], exact[key] / scale) if game is not None else upper[i]
-    if game is None and solved:
-        plan_index = ks.index(K)
-        name = chosen[plan_index] or solved[0][0]
-        game = next(g for n, g, _ in solved if n == name)
-    elif game is None:
-        raise RuntimeError("no policy could be certified within the limits")
-    from asp.solve import solve as _solve
-
-    solution = _solve(game.dag)
+        later = ks[i:]
+        u = min((vals[c] for *_, vals in solved for c in later if c in vals), default=np.inf)
+        if b in exact:
+            u = min(u, exact[b] / scale)
+        upper.append(u)
+        lo = exact[b] if b in exact else max(search.proven(b)[0], floor)
+        lows.append(lo / scale)
+    lower_k = list(np.maximum.accumulate(lows))
+    upper_k = list(np.minimum.accumulate(upper[::-1])[::-1])
+    name, game, solution, values = min(solved, key=lambda x: (x[3][K], x[0] != "robust"))
+    bounds = [values.get(b, upper_k[i]) for i, b in enumerate(ks)]
     schedule_worst = []
     if sched_game is not None:
-        sol = _solve(sched_game.dag)
+        sol = solve(sched_game.dag)
         schedule_worst = [
-            {"k": None if b == UNBOUNDED else b, "bound": certified(sched_game, sol, b)}
-            for b in ks
+            {"k": None if b == UNBOUNDED else b, "bound": float(sol.value[v, 0])}
+            for b, v in sorted(sched_game.starts.items(), key=lambda x: (x[0] == UNBOUNDED, x[0]))
         ]
+    if progress and search.stopped:
+        worst = max(range(len(ks)), key=lambda i: upper_k[i] - lower_k[i])
+        say(
+            f"{search.stopped} reached: W*({K}) in [{lower_k[K]:g}, {upper_k[K]:g}], "
+            f"the largest gap {100 * (upper_k[worst] - lower_k[worst]) / upper_k[worst]:.1f} %"
+        )
     return Curve(
-        lower=tuple(lower_k),
-        upper=tuple(upper),
-        flat=flat,
+        lower=tuple(float(x) for x in lower_k),
+        upper=tuple(float(x) for x in upper_k),
+        bounds=tuple(float(x) for x in bounds),
+        flat=bool(flat),
         game=game,
         solution=solution,
         policy=name,
         schedule_worst=schedule_worst,
-        stopped=stopped,
+        stopped=search.stopped,
         nodes=search.nodes,
         positions=search.positions,
         seconds=time.perf_counter() - t0,

@@ -7,15 +7,17 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from asp.concurrent import WAIT, build_game, concurrent_model, value
-from asp.concurrent_rules import END_STATE, Position, concurrent_rules
+from asp.concurrent.build import build_game
+from asp.concurrent.model import WAIT, concurrent_model
+from asp.concurrent.robustness import value
+from asp.concurrent.rules import END_STATE, Position, concurrent_rules
 from asp.errors import SpecError
-from asp.fixed_order import FixedOrder
-from asp.solve import solve
-from asp.state_graph import build_state_graph
-from asp.symmetry import interchangeable_blocks, reduced_state_graph
-from tests.asp.test_concurrent import job as concurrent_job
-from tests.asp.test_symmetry_workspaces import GROUPINGS, random_alike_spec
+from asp.game.solve import solve
+from asp.graph.fixed_order import FixedOrder
+from asp.graph.state_graph import build_state_graph
+from asp.graph.symmetry import interchangeable_blocks, reduced_state_graph
+from tests.asp.concurrent.test_concurrent import job as concurrent_job
+from tests.asp.graph.test_symmetry_workspaces import GROUPINGS, random_alike_spec
 
 
 def job(ops: list[dict], agents: dict | None = None, tools: dict | None = None):
@@ -188,7 +190,7 @@ def alike_values(graph, top: int = 2) -> list[int]:
 def test_undone_fixed_order_of_alike_parts_gives_the_full_game():
     """The pinned disc: on the alternating game's graph (pins and screws in a fixed order)
     the rules run alike operations at once, and the curve is the full graph's."""
-    from tests.asp.test_symmetry import pinned_disc
+    from tests.asp.graph.test_symmetry import pinned_disc
 
     spec, rel = pinned_disc(3, 2)
     full = build_state_graph(spec, rel)
