@@ -1,6 +1,7 @@
 """The advisor service: a FastAPI application over plans and sessions.
 
-Routes (the OpenAPI document is at ``/openapi.json``, its browsable form at ``/docs``):
+Routes (the OpenAPI document is at ``/openapi.json``, its browsable form at ``/docs``, from
+installed files: :mod:`asmplan.serve.docs`):
 
 - ``GET /``: the page (play the person's side against the robots' policy).
 - ``GET /static/{name}``: the page's own files and plotly's JavaScript from the installed
@@ -14,6 +15,8 @@ Routes (the OpenAPI document is at ``/openapi.json``, its browsable form at ``/d
   malformed body.
 - ``GET /api/questionnaire``; ``POST /api/sessions/{session}/answers`` ``{"answers": {...}}``.
 - ``GET /api/export.csv``: every session, one row each.
+- ``GET /api/sessions/{session}/explain``, ``GET /api/plans/{plan}/explain``: the advice
+  that explains itself (:mod:`asmplan.serve.explain`).
 
 Request bodies are validated (pydantic, unknown keys refused) and limited to
 :data:`MAX_BODY` bytes (413 above).
@@ -31,6 +34,8 @@ from fastapi.responses import FileResponse, HTMLResponse, JSONResponse, Response
 from pydantic import BaseModel, ConfigDict, Field
 
 from asmplan.advisor import ObservationError
+from asmplan.serve.docs import add_docs
+from asmplan.serve.explain import add_explain_routes
 from asmplan.serve.meshes import base_parts, plan_meshes
 from asmplan.serve.sessions import SessionStore, UnknownSession
 
@@ -156,7 +161,11 @@ def create_app(
         description="The robust plan's policy for a cell: observe operations started and "
         "finished, get the robots' next operations, the person's instruction and the "
         "guaranteed bound. See README.md, 'The advisor service'.",
+        docs_url=None,
+        redoc_url=None,
     )
+    add_docs(app, "asmplan advisor")
+    add_explain_routes(app, store, by_id)
     app.state.store = store
 
     def _plan(pid: str) -> dict:
