@@ -35,6 +35,12 @@ the same physical operation (its finish after its start) map the same way. Obser
 history and advice are in physical operation ids; an instruction or option that names one
 of several alike operations lists in ``alike`` every one that is as good (and their parts
 in ``alike_parts``). The bound is the plan's: a symmetry keeps every cost.
+
+Advice that explains itself (both turn models): each option carries the robots' reply to it
+(``reply``), the worst line it leads to (``line``: every operation still to come, with its
+start and end, when the person then does the worst she can) and a sentence saying so
+(``why``); ``ahead`` is the line from now on when the person follows the instructions (the
+Gantt chart of the plan ahead). The lines are the plan file's own (:func:`line_moves`).
 """
 
 from __future__ import annotations
@@ -43,10 +49,41 @@ import math
 from dataclasses import asdict, dataclass, field, replace
 
 from asmplan.errors import GameError
-from asmplan.planfile import check_plan
+from asmplan.planfile import check_plan, line_moves, move_starts, worst_move
 from asp.game.alike import AlikeMap
 
 EVENT_KINDS = ("started", "finished")
+
+
+def quantity(x: float, cost: str | None) -> str:
+    """A cost with its unit: ``12 s``, or ``3 steps`` when the plan counts operations."""
+    if cost == "steps":
+        return f"{x:g} step" if x == 1 else f"{x:g} steps"
+    return f"{x:g} s"
+
+
+def option_why(option: dict, cost: str | None) -> str:
+    """The sentence that explains an option: what the robots do in reply and the worst that
+    can still happen (``If you do 2.2 now, R2 does 1.3; the worst that can still happen is
+    297 s.``)."""
+    concurrent = "durations" in option
+    reply = option.get("reply")
+    if reply is None:
+        then = "that completes the assembly"
+    elif not reply["robots"]:
+        then = f"at {quantity(reply['time'], cost)} " if concurrent else ""
+        then += "the robots wait" if concurrent else "the robots have nothing to do"
+    else:
+        verb = "starts" if concurrent else "does"
+        then = " and ".join(f"{r['agent']} {verb} {r['operation']}" for r in reply["robots"])
+        if concurrent:
+            then = f"at {quantity(reply['time'], cost)} {then}"
+    verb = "start" if concurrent else "do"
+    worst = quantity(option["worst"], cost)
+    return (
+        f"If you {verb} {option['operation']} now, {then}; the worst that can still happen is "
+        f"{worst}."
+    )
 
 
 def placed_parts(operations: dict[str, dict], done: list[str]) -> list[str]:
@@ -127,9 +164,14 @@ class Advice:
     options : list of dict
         At the person's turn, every operation the person may start with the worst case it
         leads to (``{"operation", "agent", "description", "cost", "worst", "alike",
-        "alike_parts"}``, ``worst`` the guaranteed total cost after it). Concurrent: also
-        ``durations`` (those the plan knows; ``cost`` the longest) and ``deviation`` (not the
-        instruction).
+        "alike_parts", "deviation", "reply", "line", "why"}``, ``worst`` the guaranteed total
+        cost after it, ``deviation`` not the instruction). ``reply``: what the robots do next
+        (``{"time", "robots": [{"operation", "agent", "description"}]}``, ``robots`` empty:
+        they wait; None: the option completes the assembly). ``line``: the worst line the
+        option leads to, every operation from the option on (``{"operation", "agent",
+        "description", "side", "start", "end", "deviation"}``, times since the start).
+        ``why``: a sentence saying both. Concurrent: also ``durations`` (those the plan
+        knows; ``cost`` the longest); the reply and line are the worst duration's.
     elapsed : float
         Cost so far.
     bound : float
@@ -150,6 +192,10 @@ class Advice:
         start something.
     budget : int or None
         Concurrent: deviations the person may still make (None: unbounded).
+    ahead : list of dict
+        The plan ahead: every operation still to start when the person follows the
+        instructions from now on (entries as an option's ``line``; concurrent: of a
+        person's duration range, the longest).
     """
 
     state: int
@@ -169,6 +215,7 @@ class Advice:
     instructions: list = field(default_factory=list)
     finishes: list = field(default_factory=list)
     budget: int | None = None
+    ahead: list = field(default_factory=list)
 
     @property
     def total_bound(self) -> float:
@@ -239,8 +286,61 @@ class Advisor:
         """The advice in the current state, in physical operation ids."""
         return self._physical(self._canonical_advice())
 
-    def _canonical_advice(self) -> Advice:
-        """The advice in the policy's (canonical) operation ids."""
+    def explain(self) -> Advice:
+        """:meth:`advice` that explains itself: each option with the robots' reply, the
+        worst line it leads to and the sentence saying both (:func:`option_why`), and the
+        plan ahead (``ahead``). Its cost grows with the options times the operations left,
+        so :meth:`observe` answers :meth:`advice` and a page asks for this one."""
+        advice = self._physical(self._canonical_advice(explain=True))
+        cost = self.plan.get("cost")
+        return replace(advice, options=[{**o, "why": option_why(o, cost)} for o in advice.options])
+
+    # ------------------------------------------------------------------ explanations
+    def _explained(self, i: int, j: int, elapsed: float) -> dict:
+        """An option's ``reply`` and ``line`` (:class:`Advice`): move ``j`` at state ``i``,
+        then the worst line."""
+        pairs = line_moves(self._policy, "worst", start=i, first=j)
+        reply = None
+        if len(pairs) > 1 and self._policy["states"]["turn"][pairs[1][0]] == "robot":
+            robots = move_starts(self._policy, pairs[1][1])
+            reply = {
+                "time": elapsed + self._policy["moves"]["cost"][j],
+                "robots": [self._op_dict(o, a) for o, a, _ in robots],
+            }
+        return {"reply": reply, "line": self._line(pairs, elapsed)}
+
+    def _line(self, pairs: list[tuple[int, int]], elapsed: float) -> list[dict]:
+        """The operations the moves ``pairs`` (:func:`line_moves`) start, from ``elapsed`` on,
+        each with its side, start, end and whether it deviates from the instruction."""
+        cost = self._policy["moves"]["cost"]
+        out, t = [], elapsed
+        for s, m in pairs:
+            told = self._instructed(s)
+            for o, a, d in move_starts(self._policy, m):
+                side = self._side(s, a)
+                entry = {**self._op_dict(o, a), "side": side, "start": t, "end": t + d}
+                entry["deviation"] = side == "human" and a in told and told[a] != o
+                out.append(entry)
+            t += cost[m]
+        return out
+
+    def _instructed(self, i: int) -> dict[int, int]:
+        """Agent index -> the operation index the person is asked to do at state ``i``
+        (``-1``: wait)."""
+        told = self._policy["states"]["instruction"][i]
+        if not told:
+            return {}
+        if isinstance(told[0], list):
+            return {a: o for o, a in told}
+        return {told[1]: told[0]}
+
+    def _side(self, i: int, a: int) -> str:
+        """The side of agent ``a`` moving at state ``i`` (the side on turn)."""
+        return self._policy["states"]["turn"][i]
+
+    def _canonical_advice(self, explain: bool = False) -> Advice:
+        """The advice in the policy's (canonical) operation ids (``explain``: with the
+        explanations of :meth:`explain`)."""
         c = self._cursor
         states, moves = self._policy["states"], self._policy["moves"]
         i = c.state
@@ -268,12 +368,17 @@ class Advisor:
             if states["instruction"][i] is not None:
                 instruction = self._person_dict(*states["instruction"][i])
             if states["turn"][i] == "human":
+                told = states["instruction"][i]
                 for j in self._moves(i):
                     if moves["operation"][j] < 0:
                         continue
-                    item = self._person_dict(moves["operation"][j], moves["agent"][j])
+                    move = [moves["operation"][j], moves["agent"][j]]
+                    item = self._person_dict(*move)
                     item["cost"] = moves["cost"][j]
                     item["worst"] = c.elapsed + moves["cost"][j] + states["bound"][moves["next"][j]]
+                    item["deviation"] = told is not None and move != told
+                    if explain:
+                        item.update(self._explained(i, j, c.elapsed))
                     options.append(item)
         return Advice(
             state=i,
@@ -289,6 +394,11 @@ class Advisor:
             bound=bound,
             finished=self.finished,
             deviations=c.deviations,
+            ahead=self._line(
+                line_moves(self._policy, "plan", start=i, first=_move(c.running)), c.elapsed
+            )
+            if explain
+            else [],
         )
 
     # ------------------------------------------------------------------ observing
@@ -383,6 +493,7 @@ class Advisor:
             options=_distinct([self._item(o) for o in advice.options]),
             instructions=[self._item(i) for i in advice.instructions],
             finishes=[self._item(f) for f in advice.finishes],
+            ahead=[self._item(e) for e in advice.ahead],
         )
 
     def _item(self, item: dict) -> dict:
@@ -400,6 +511,13 @@ class Advisor:
             alike = self._alike.alike(op, self._pattern)
             out["alike"] = alike
             out["alike_parts"] = placed_parts(self._operations, alike)
+        if "line" in item:
+            out["line"] = [self._item(e) for e in item["line"]]
+        if item.get("reply"):
+            out["reply"] = {
+                **item["reply"],
+                "robots": [self._item(r) for r in item["reply"]["robots"]],
+            }
         return out
 
     def _finish(self, j: int) -> None:
@@ -549,7 +667,7 @@ class ConcurrentAdvisor(Advisor):
         b = self._branches[0]
         return len(self._moves(b.state)) == 0 and not b.unreported
 
-    def _canonical_advice(self) -> Advice:
+    def _canonical_advice(self, explain: bool = False) -> Advice:
         states = self._policy["states"]
         b = self._branches[0]
         i = b.state
@@ -595,7 +713,7 @@ class ConcurrentAdvisor(Advisor):
                 {**self._op_dict(o, a), "confirmed": (o, a) in b.confirmed} for o, a in b.commit
             ],
             instruction=instruction,
-            options=self._options(told),
+            options=self._options(told, explain),
             elapsed=b.elapsed,
             bound=total - b.elapsed,
             finished=self.finished,
@@ -604,10 +722,29 @@ class ConcurrentAdvisor(Advisor):
             instructions=instructions,
             finishes=self._finishes(),
             budget=states["budget"][i],
+            ahead=self._ahead(b) if explain else [],
         )
 
-    def _options(self, told: dict) -> list[dict]:
-        """Every operation a free person may start now, with the worst case it leads to."""
+    def _ahead(self, b: _Branch) -> list[dict]:
+        """The plan ahead from branch ``b``: the people's starts so far, then the
+        instructions (of the moves with those starts, the fewest deviations, the worst)."""
+        first = None
+        if b.pending:
+            moves = self._consistent(b, set(b.pending))
+            if moves:
+                calm = min(self._policy["moves"]["deviations"][m] for m in moves)
+                first = worst_move(
+                    self._policy,
+                    [m for m in moves if self._policy["moves"]["deviations"][m] == calm],
+                )
+        return self._line(line_moves(self._policy, "plan", start=b.state, first=first), b.elapsed)
+
+    def _side(self, i: int, a: int) -> str:
+        return "robot" if self._robot[a] else "human"
+
+    def _options(self, told: dict, explain: bool = False) -> list[dict]:
+        """Every operation a free person may start now, with the worst case it leads to
+        (``explain``: and :meth:`Advisor._explained`)."""
         moves, states = self._policy["moves"], self._policy["states"]
         worst: dict = {}
         for br in self._branches:
@@ -618,10 +755,12 @@ class ConcurrentAdvisor(Advisor):
                 for o, a, d in moves["starts"][m]:
                     if (o, a) in pending or a in busy:
                         continue
-                    w, durations = worst.get((o, a), (-math.inf, set()))
-                    worst[(o, a)] = (max(w, after), durations | {d})
+                    w, durations, where = worst.get((o, a), (-math.inf, set(), None))
+                    if after > w:
+                        w, where = after, (br, m)
+                    worst[(o, a)] = (w, durations | {d}, where)
         out = []
-        for (o, a), (w, durations) in sorted(worst.items()):
+        for (o, a), (w, durations, (br, m)) in sorted(worst.items()):
             item = self._person_dict(o, a)
             item.update(
                 cost=max(durations),
@@ -629,6 +768,8 @@ class ConcurrentAdvisor(Advisor):
                 worst=w,
                 deviation=a in told and told[a] != o,
             )
+            if explain:
+                item.update(self._explained(br.state, m, br.elapsed))
             out.append(item)
         return out
 
@@ -857,6 +998,11 @@ class ConcurrentAdvisor(Advisor):
 
     def _description(self, o: int) -> str:
         return self._operations.get(self._ops[o], {}).get("description", "")
+
+
+def _move(j: int) -> int | None:
+    """A move index, or None for ``-1`` (no move)."""
+    return None if j < 0 else j
 
 
 def _replace(br: _Branch, **changes) -> _Branch:

@@ -621,8 +621,48 @@ def move_starts(policy: dict, j: int) -> list[list]:
     return [[moves["operation"][j], moves["agent"][j], moves["cost"][j]]]
 
 
+def worst_move(policy: dict, candidates) -> int:
+    """Of the moves ``candidates``, one that keeps the guaranteed bound highest (its cost plus
+    the bound after it; ties: the lower index)."""
+    states, moves = policy["states"], policy["moves"]
+    return max(candidates, key=lambda m: (moves["cost"][m] + states["bound"][moves["next"][m]], -m))
+
+
+def line_moves(
+    policy: dict, follow: str, *, start: int | None = None, first: int | None = None
+) -> list[tuple[int, int]]:
+    """A line through the policy as ``(state, move)`` pairs, to the end.
+
+    From state ``start`` (default the policy's start), taking move ``first`` there when
+    given. The robots take their planned move; the person, with ``follow="plan"``, the
+    instruction (in the concurrent game, of the moves without a deviation, the worst: the
+    longest durations a range allows), with ``follow="worst"`` a move that keeps the bound
+    highest (:func:`worst_move`).
+    """
+    states, moves = policy["states"], policy["moves"]
+    out: list[tuple[int, int]] = []
+    i = policy["start"] if start is None else start
+    while True:
+        lo, hi = moves["ptr"][i], moves["ptr"][i + 1]
+        if lo == hi:
+            return out
+        if first is not None:
+            j, first = first, None
+        elif states["turn"][i] == "robot" or hi - lo == 1:
+            j = lo
+        elif follow != "plan":
+            j = worst_move(policy, range(lo, hi))
+        elif "deviations" in moves:
+            calm = [m for m in range(lo, hi) if moves["deviations"][m] == 0]
+            j = worst_move(policy, calm or range(lo, hi))
+        else:
+            j = _instruction_move(policy, i)
+        out.append((i, j))
+        i = moves["next"][j]
+
+
 def line_steps(policy: dict, follow: str, operations: dict[str, dict]) -> list[dict]:
-    """A line through the policy from the start, as readable steps.
+    """A line through the policy from the start (:func:`line_moves`), as readable steps.
 
     ``follow="plan"``: the person follows the instruction (the principal line; in the
     concurrent game, of the durations its range allows, the worst); ``follow="worst"``: the
@@ -633,27 +673,10 @@ def line_steps(policy: dict, follow: str, operations: dict[str, dict]) -> list[d
     states, moves = policy["states"], policy["moves"]
     op_names, agent_names = policy["operations"], policy["agents"]
     steps: list[dict] = []
-    i, total = policy["start"], 0.0
-
-    def worst(candidates) -> int:
-        return max(
-            candidates,
-            key=lambda m: (moves["cost"][m] + states["bound"][moves["next"][m]], -m),
-        )
-
-    while True:
+    total = 0.0
+    for i, j in line_moves(policy, follow):
         lo, hi = moves["ptr"][i], moves["ptr"][i + 1]
-        if lo == hi:
-            return steps
         turn = states["turn"][i]
-        if turn == "robot" or hi - lo == 1:
-            j = lo
-        elif follow != "plan":
-            j = worst(range(lo, hi))
-        elif "deviations" in moves:
-            j = worst([m for m in range(lo, hi) if moves["deviations"][m] == 0] or range(lo, hi))
-        else:
-            j = _instruction_move(policy, i)
         started = [(op_names[o], agent_names[a], d) for o, a, d in move_starts(policy, j)]
         options = []
         if turn == "human":
@@ -692,7 +715,7 @@ def line_steps(policy: dict, follow: str, operations: dict[str, dict]) -> list[d
                 "node": states["node"][i],
             }
         )
-        i = moves["next"][j]
+    return steps
 
 
 def _where(info: dict) -> dict:

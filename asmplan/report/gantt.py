@@ -68,12 +68,32 @@ def plot_robustness(
         ax.axhline(schedule, color="#555555", lw=1, ls=":", label=f"CP-SAT makespan {schedule:g}")
     ax.set_xticks(xs, labels)
     ax.set_xlabel("deviations the person may make (k)")
-    ax.set_ylabel("guaranteed makespan")
+    ax.set_ylabel("guaranteed makespan (s)")
     ax.set_title(title or "price of robustness", fontsize=10)
     ax.legend(fontsize=8, frameon=False, loc="best")
     ax.grid(alpha=0.3)
     fig.tight_layout()
     return _save(fig, path)
+
+
+SHOWN_WIDTH = 11.5
+"""Inches a Gantt chart is drawn at: the report's width (1150 px at 100 px per inch), so
+its text is shown at the size it is set in."""
+GANTT_DPI = 200
+"""Pixels per inch of a Gantt PNG: twice the size shown, sharp on any screen."""
+LABEL_PT = 9.0
+"""Size of the operation ids in the bars and of the axes' text, points at the size shown."""
+AXES_SHARE = 0.86
+"""The part of the figure's width the time axis takes (the rest: agent names, margins)."""
+
+
+def label_fits(label: str, bar: float, span: float, *, width: float = SHOWN_WIDTH) -> bool:
+    """Whether ``label`` fits inside a bar ``bar`` long on a time axis ``span`` long drawn
+    :data:`AXES_SHARE` of ``width`` inches wide, at :data:`LABEL_PT` (a character is taken
+    as 0.62 em wide, with a quarter em of room on each side)."""
+    inches = bar / max(span, 1e-9) * width * AXES_SHARE
+    need = (0.62 * len(label) + 0.5) * LABEL_PT / 72
+    return inches >= need
 
 
 def plot_gantt(
@@ -82,13 +102,32 @@ def plot_gantt(
     *,
     makespan: float | None = None,
     title: str = "",
+    unit: str = "s",
 ) -> Path:
-    """Bars per agent on one time axis; deviations from the plan outlined in red and hatched.
+    """Bars per agent on one time axis, with a legend: each agent's colour, deviations from
+    the plan outlined in red and hatched, the makespan line.
+
+    The chart is drawn at the report's width (:data:`SHOWN_WIDTH`) at :data:`GANTT_DPI`, so
+    its text reads at :data:`LABEL_PT` where it is shown; an operation's id is written in
+    its bar when it fits there (:func:`label_fits`; the line tables name every operation).
 
     Parameters
     ----------
     bars : sequence of :class:`asp.concurrent.Bar`
+    unit : str
+        The time unit of the axis and the makespan (``s``).
     """
+    fig, ax = _figure((SHOWN_WIDTH, 1.7 + 0.55 * len({b.agent for b in bars})), GANTT_DPI)
+    draw_gantt(ax, bars, makespan=makespan, unit=unit)
+    ax.set_title(title, fontsize=LABEL_PT + 1)
+    fig.tight_layout()
+    return _save(fig, path)
+
+
+def draw_gantt(ax, bars: Sequence, *, makespan: float | None = None, unit: str = "s") -> dict:
+    """Draw the chart of :func:`plot_gantt` on the matplotlib axes ``ax``; returns what it
+    wrote: ``{"labels": [operation ids written in bars], "legend": [legend entries]}``."""
+    from matplotlib.lines import Line2D
     from matplotlib.patches import Patch
 
     agents = sorted({b.agent for b in bars}, key=lambda a: (not a.startswith("H"), a))
@@ -97,7 +136,8 @@ def plot_gantt(
     for a in agents:
         palette.setdefault(a, OTHER_COLOURS[len(palette) % len(OTHER_COLOURS)])
     end = max([makespan or 0.0, *(b.end for b in bars)])
-    fig, ax = _figure((max(7.0, min(18.0, 0.05 * end + 5)), 1.0 + 0.6 * len(agents)), 100)
+    written: list[str] = []
+    span = end * 1.02 if end else 1.0
     for b in bars:
         y = row[b.agent]
         ax.barh(
@@ -110,20 +150,42 @@ def plot_gantt(
             linewidth=2.0 if b.deviation else 0.6,
             hatch="//" if b.deviation else None,
         )
-        if b.end - b.start >= 0.03 * max(end, 1.0):
-            ax.text((b.start + b.end) / 2, y, b.operation, ha="center", va="center", fontsize=7)
+        if label_fits(b.operation, b.end - b.start, span):
+            written.append(b.operation)
+            ax.text(
+                (b.start + b.end) / 2,
+                y,
+                b.operation,
+                ha="center",
+                va="center",
+                fontsize=LABEL_PT,
+                bbox={"boxstyle": "round,pad=0.1", "fc": "white", "ec": "none", "alpha": 0.7},
+            )
+    handles = [Patch(facecolor=palette[a], edgecolor="black", label=a) for a in agents]
+    if any(b.deviation for b in bars):
+        handles.append(
+            Patch(facecolor="white", edgecolor=DEVIATION_COLOUR, hatch="//", label="deviation")
+        )
     if makespan is not None:
         ax.axvline(makespan, color="black", lw=1, ls="--")
-    ax.set_yticks(range(len(agents)), agents)
+        handles.append(
+            Line2D([], [], color="black", ls="--", label=f"makespan {makespan:g} {unit}")
+        )
+    ax.set_yticks(range(len(agents)), agents, fontsize=LABEL_PT)
+    ax.tick_params(axis="x", labelsize=LABEL_PT)
     ax.invert_yaxis()
-    ax.set_xlabel("time")
-    ax.set_xlim(0, end * 1.02 if end else 1)
-    handles = [Patch(facecolor="white", edgecolor=DEVIATION_COLOUR, hatch="//", label="deviation")]
-    if any(b.deviation for b in bars):
-        ax.legend(handles=handles, fontsize=8, frameon=False, loc="upper right")
-    ax.set_title(title, fontsize=10)
-    fig.tight_layout()
-    return _save(fig, path)
+    ax.set_xlabel(f"time ({unit})", fontsize=LABEL_PT)
+    ax.set_xlim(0, span)
+    ax.grid(axis="x", alpha=0.3)
+    ax.legend(
+        handles=handles,
+        fontsize=LABEL_PT,
+        frameon=False,
+        loc="upper center",
+        bbox_to_anchor=(0.5, -0.2 if len(agents) > 2 else -0.4),
+        ncol=len(handles),
+    )
+    return {"labels": written, "legend": [h.get_label() for h in handles]}
 
 
 def write_figures(plan: ConcurrentPlan, folder: str | os.PathLike[str] | Callable) -> list[Path]:
@@ -149,6 +211,6 @@ def write_figures(plan: ConcurrentPlan, folder: str | os.PathLike[str] | Callabl
         ("gantt_worst.png", plan.worst, "against the worst person"),
     )
     for file, (bars, makespan), who in lines:
-        title = f"{name}: robust plan (k = {k}), {who}: {makespan:g}"
+        title = f"{name}: robust plan (k = {k}), {who}: makespan {makespan:g} s"
         written.append(plot_gantt(bars, path_of(file), makespan=makespan, title=title))
     return written

@@ -3,105 +3,25 @@
 It shows the metrics, the price-of-robustness curve and the Gantt charts of the concurrent
 game (when it could be solved; drawn by :mod:`asmplan.report.gantt`), the CP-SAT schedule's Gantt
 chart, the relations table, the principal line as pictures of the assembly growing step by
-step (rendered from the part meshes, the parts of each step highlighted) and the game DAG
-picture.
+step (:mod:`asmplan.report.steps`: rendered from the part meshes, the parts of each step
+highlighted, an arrow for each way in) and the game DAG picture.
 """
 
 from __future__ import annotations
 
 import base64
 import html
-import io
 from pathlib import Path
 
-import numpy as np
+from asmplan.report.steps import assembly_steps
 
-from asmplan.report.meshes import base_parts, part_meshes
-
-NEW, PLACED, GHOST = "#f28c28", "#4f81bd", "#cccccc"
 REPORT_MAX_STATES = 5_000
 """Largest state graph whose concurrent game the report solves itself."""
-
-
-def _png(fig, *, tight: bool = True) -> str:
-    """A matplotlib Figure as a ``data:image/png;base64,...`` URI (laid out tight first)."""
-    if tight:
-        fig.tight_layout()
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=90)
-    return "data:image/png;base64," + base64.b64encode(buffer.getvalue()).decode("ascii")
 
 
 def _img(uri: str, alt: str, width: int | None = None) -> str:
     w = f' width="{width}"' if width else ""
     return f'<img src="{uri}" alt="{html.escape(alt)}"{w}>'
-
-
-# --------------------------------------------------------------------------- pictures
-
-PICTURE_FACES = 8_000
-"""Faces drawn in one step picture, in all (the part meshes are thinned to it)."""
-
-PART_FACES_MIN = 60
-"""Faces a part keeps in a step picture however many parts share the budget."""
-
-
-def assembly_steps(
-    plan: dict, *, max_pictures: int = 40, max_faces: int = PICTURE_FACES
-) -> list[tuple[dict, str]]:
-    """The principal line's steps that place parts, each with a picture (data URI).
-
-    The assembly is drawn from the part meshes: parts placed before the step in blue, the
-    step's parts in orange, the parts still to come as faint grey outlines. The meshes are
-    thinned to ``max_faces`` faces in all (shared out among the parts, at least
-    :data:`PART_FACES_MIN` each), which keeps a picture of a 70-part product quick to draw.
-    """
-    n_parts = max(1, len(plan.get("parts", [])))
-    meshes = part_meshes(plan, max_faces=max(PART_FACES_MIN, max_faces // n_parts))
-    if not meshes:
-        return []
-    from matplotlib.colors import to_rgba
-    from matplotlib.figure import Figure
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-
-    ids = list(meshes)
-    triangles = np.concatenate([v[f] for v, f in meshes.values()])  # (T, 3, 3)
-    owner = np.repeat(np.arange(len(ids)), [len(f) for _, f in meshes.values()])  # (T,)
-    colours = {
-        "new": to_rgba(NEW, 1.0),
-        "placed": to_rgba(PLACED, 1.0),
-        "ghost": to_rgba(GHOST, 0.06),
-    }
-    everything = np.concatenate([v for v, _ in meshes.values()])
-    lo, hi = everything.min(axis=0), everything.max(axis=0)
-    # one figure drawn again for each step: only the colours and the title change
-    fig = Figure(figsize=(3.2, 3.0))
-    fig.subplots_adjust(left=0.0, right=1.0, bottom=0.0, top=0.9)
-    ax = fig.add_subplot(projection="3d")
-    # one collection for every part: the faces are depth-sorted together
-    poly = Poly3DCollection(triangles, edgecolor="none")
-    ax.add_collection3d(poly)
-    ax.set_xlim(lo[0], hi[0])
-    ax.set_ylim(lo[1], hi[1])
-    ax.set_zlim(lo[2], hi[2])
-    ax.set_box_aspect(hi - lo + 1e-9)
-    ax.view_init(elev=22, azim=-60)
-    ax.set_axis_off()
-    placed = set(base_parts(plan))
-    out = []
-    for step in plan.get("robust_plan", []):
-        if not step.get("parts") or len(out) >= max_pictures:
-            continue
-        new = set(step["parts"])
-        kind = ["new" if p in new else "placed" if p in placed else "ghost" for p in ids]
-        part_colour = np.array([colours[k] for k in kind])  # (parts, 4)
-        poly.set_facecolor(part_colour[owner])
-        ax.set_title(
-            f"{step['operation']} ({step['agent']}): {', '.join(step['parts'])}", fontsize=8
-        )
-        out.append((step, _png(fig, tight=False)))
-        placed |= new
-    return out
 
 
 # --------------------------------------------------------------------------- figures
@@ -158,7 +78,7 @@ def report_figures(
                     bars,
                     folder / f"{name}.png",
                     makespan=makespan,
-                    title=f"concurrent: the person {who}, makespan {makespan:g}",
+                    title=f"concurrent: the person {who}, makespan {makespan:g} s",
                 ).read_bytes()
         rows = (doc.get("schedule") or {}).get("schedule") or []
         if rows:
@@ -170,7 +90,8 @@ def report_figures(
             out["gantt_schedule"] = plot_gantt(
                 bars,
                 folder / "s.png",
-                title=f"CP-SAT schedule: makespan {sched.get('objective')} ({sched.get('status')})",
+                title=f"CP-SAT schedule: makespan {sched.get('objective')} s "
+                f"({sched.get('status')})",
             ).read_bytes()
     return out
 
@@ -214,14 +135,17 @@ def report_html(plan: dict, figures: dict[str, bytes] | None = None) -> str:
     for r in plan.get("robustness") or []:
         k = "inf" if r["k"] is None else r["k"]
         rows.append(
-            (f"concurrent game: W*({k}), the person deviates at most {k} times", r["bound"])
+            (
+                f"concurrent game: W*({k}), the person deviates at most {k} times",
+                f"{r['bound']:g} s",
+            )
         )
     if sched:
         rows.append(
             (
                 "CP-SAT makespan (agents in parallel)",
                 f"{sched.get('objective')} s ({sched.get('status')}), lower bound "
-                f"{sched.get('lower_bound', '-')}",
+                f"{sched.get('lower_bound', '-')} s",
             )
         )
     body = [f"<h1>{esc(str(plan.get('assembly', 'plan')))}: the robust plan</h1>"]
@@ -296,7 +220,7 @@ def _line_table(steps: list[dict], unit: str) -> str:
         out.append(
             f"<tr><td>{s['step']}</td><td>{esc(s['player'])}</td><td>{esc(s['operation'])}</td>"
             f"<td>{esc(s['agent'])}</td><td>{esc(s['description'])}</td>"
-            f"<td>{esc(', '.join(s['parts']))}</td><td>{s['cost']:g}</td>"
+            f"<td>{esc(', '.join(s['parts']))}</td><td>{s['cost']:g}{unit}</td>"
             f"<td>{s['elapsed']:g}{unit}</td><td>{s['bound']:g}{unit}</td></tr>"
         )
     out.append("</table>")

@@ -15,6 +15,8 @@ installed files: :mod:`asmplan.serve.docs`):
   malformed body.
 - ``GET /api/questionnaire``; ``POST /api/sessions/{session}/answers`` ``{"answers": {...}}``.
 - ``GET /api/export.csv``: every session, one row each.
+- ``GET /api/sessions/{session}/explain``, ``GET /api/plans/{plan}/explain``: the advice
+  that explains itself (:mod:`asmplan.serve.explain`).
 
 Request bodies are validated (pydantic, unknown keys refused) and limited to
 :data:`MAX_BODY` bytes (413 above).
@@ -38,6 +40,7 @@ from pydantic import BaseModel, ConfigDict, Field
 from asmplan.advisor import Advisor, ObservationError
 from asmplan.serve.clock import clock_view
 from asmplan.serve.docs import add_docs
+from asmplan.serve.explain import add_explain_routes
 from asmplan.serve.meshes import base_parts, plan_meshes
 from asmplan.serve.sessions import (
     DEFAULT_MAX_SESSIONS,
@@ -247,6 +250,7 @@ def create_app(
         redoc_url=None,
     )
     add_docs(app, "asmplan advisor")
+    add_explain_routes(app, store, by_id)
     app.state.store = store
     _page_routes(app, by_id, store.plans)
     speed = study.speed if study is not None and realtime is None else realtime

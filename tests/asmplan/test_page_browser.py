@@ -80,9 +80,9 @@ def test_play_the_pump_to_the_end(browser, tmp_path):
         page.screenshot(path=str(tmp_path / "page-end.png"), full_page=True)
         robots = [
             (li.get_attribute("data-op"), li.get_attribute("data-agent"))
-            for li in page.locator("#robot-log li").all()
+            for li in page.locator("#robot-log li:not(.person)").all()
         ]
-        final = float(page.locator("#final-cost").inner_text())
+        final = float(page.locator("#final-cost").get_attribute("data-value"))
         answers = _answer_the_questionnaire(page)
         sid = page.evaluate("() => document.body.dataset.session")
         stored = httpx.get(f"{url}/api/sessions/{sid}").json()
@@ -111,15 +111,13 @@ def _answer_the_questionnaire(page) -> dict:
     """Fill every item (a scale: its top value; a text: a sentence) and send the answers."""
     page.wait_for_selector("#submit-answers", timeout=30_000)
     answers = {}
-    for item in page.locator("#questionnaire input").all():
-        name = item.get_attribute("name")
-        if item.get_attribute("type") == "range":
-            top = item.get_attribute("max")
-            item.evaluate("(e, v) => { e.value = v; }", top)
-            answers[name] = int(top)
-        else:
-            item.fill("the robots waited for me")
-            answers[name] = "the robots waited for me"
+    for scale in page.locator("#questionnaire fieldset[data-item]").all():
+        top = scale.locator("input[type=radio]").last
+        top.check()
+        answers[top.get_attribute("name")] = int(top.get_attribute("value"))
+    for item in page.locator("#questionnaire input[type=text]").all():
+        item.fill("the robots waited for me")
+        answers[item.get_attribute("name")] = "the robots waited for me"
     page.click("#submit-answers")
     page.wait_for_selector("#thanks:not([hidden])", timeout=30_000)
     return answers
@@ -171,10 +169,10 @@ def test_play_the_concurrent_pump_to_the_end(browser, tmp_path):
                 li.get_attribute("data-agent"),
                 li.get_attribute("data-time"),
             )
-            for li in page.locator("#robot-log li").all()
+            for li in page.locator("#robot-log li:not(.person)").all()
         ]
-        final = float(page.locator("#final-cost").inner_text())
-        shown_w0 = float(page.locator("#final-w0").inner_text())
+        final = float(page.locator("#final-cost").get_attribute("data-value"))
+        shown_w0 = float(page.locator("#final-w0").get_attribute("data-value"))
         assert errors == []
     # The same events through the advisor: the same robots' replies at the same times.
     advisor = Advisor(plan)

@@ -1,5 +1,7 @@
 // The page: a person plays the human side against the robots' policy (asmplan serve).
 // It talks to the JSON API only; the robots' replies are the advisor's, posted as they come.
+// Each option says what the robots do in reply and the worst case it leads to; the line
+// behind that worst case opens on request. After each move the focus goes to the next one.
 "use strict";
 
 const state = { plan: null, planInfo: null, meshes: {}, session: null, advice: null,
@@ -11,6 +13,9 @@ const PLOT_CONFIG = {
   displaylogo: false, responsive: true, showLink: false, showSendToCloud: false,
   plotlyServerURL: "", modeBarButtonsToRemove: ["sendChartToCloud", "sendDataToCloud"],
 };
+const SIDE_COLOUR = { robot: "#2e9d4a", human: "#6b7f99" };
+const AHEAD_COLOUR = { robot: "#cfe8d5", human: "#dde3ec" };
+const DEVIATION_COLOUR = "#b3261e";
 
 // Draw a plotly figure; its toolbar stays out of the Tab order (the moves come first).
 async function plot(id, traces, layout) {
@@ -28,6 +33,19 @@ function untab(gd) {
 
 function fmt(x) {
   return Number.isInteger(x) ? String(x) : Number(x).toFixed(2).replace(/\.?0+$/, "");
+}
+
+// A cost with its unit: seconds, or steps when the plan counts operations.
+function qty(x) {
+  if (state.planInfo && state.planInfo.cost === "steps") {
+    return `${fmt(x)} ${Number(x) === 1 ? "step" : "steps"}`;
+  }
+  return `${fmt(x)} s`;
+}
+
+function span(a, b) {
+  return state.planInfo && state.planInfo.cost === "steps"
+    ? `steps ${fmt(a)}-${fmt(b)}` : `${fmt(a)}-${fmt(b)} s`;
 }
 
 async function api(method, path, body) {
@@ -52,39 +70,73 @@ function el(tag, attrs, text) {
   return node;
 }
 
-async function start() {
+function setError(text) {
+  document.getElementById("error").textContent = text;
+}
+
+// The plans of this service in the picker; the one asked for in ?plan=, or the first.
+// An unknown ?plan= is an error naming the plans there are (no session is made).
+async function pickPlan() {
   const params = new URLSearchParams(location.search);
   const plans = await api("GET", "/api/plans");
   if (!plans.length) throw new Error("this service has no plan");
+  const pick = document.getElementById("plan-pick");
+  pick.replaceChildren(...plans.map((p) =>
+    el("option", { value: p.id }, `${p.assembly} (${p.turn_model}, ${p.id})`)));
   const wanted = params.get("plan");
-  state.plan = (plans.find((p) => p.id === wanted) || plans[0]).id;
+  const found = wanted === null ? plans[0] : plans.find((p) => p.id === wanted);
+  document.getElementById("plan-form").hidden = plans.length < 2 && found !== undefined;
+  if (found === undefined) {
+    document.getElementById("plan-form").hidden = false;
+    document.body.dataset.ready = "error";
+    throw new Error(`unknown plan "${wanted}": this service runs ` +
+      `${plans.map((p) => p.id).join(", ")}; pick one above`);
+  }
+  pick.value = found.id;
+  return found.id;
+}
+
+async function start() {
+  state.plan = await pickPlan();
   state.planInfo = await api("GET", `/api/plans/${encodeURIComponent(state.plan)}`);
   document.getElementById("title").textContent =
     `${state.planInfo.assembly}: you are the person, the robots follow the robust plan`;
-  const unit = state.planInfo.cost === "steps" ? "" : " s";
+  const steps = state.planInfo.cost === "steps";
+  document.querySelector("#numbers div dt").textContent = steps ? "cost so far" : "time so far";
   const rows = state.planInfo.robustness || [];
   const w0 = isConcurrent() && rows.length ? rows[0].bound : state.planInfo.metrics.w0;
-  document.getElementById("w0").textContent = fmt(w0) + unit;
-  document.getElementById("wstar").textContent = fmt(state.planInfo.minimax) + unit;
+  document.getElementById("w0").textContent = qty(w0);
+  document.getElementById("wstar").textContent = qty(state.planInfo.minimax);
   document.getElementById("concurrent-panel").hidden = !isConcurrent();
   document.getElementById("finishes-panel").hidden = !isConcurrent();
   state.meshes = await api("GET", `/api/plans/${encodeURIComponent(state.plan)}/meshes`);
   const session = await api("POST", "/api/sessions", { plan: state.plan });
   state.session = session.id;
   document.body.dataset.session = session.id;
-  await show(session.advice);
+  await show(await explained(session.advice));
+}
+
+// The advice with its explanation (each option's reply and worst line, the plan ahead),
+// asked for beside the event's plain advice; the robots' own turns need none.
+async function explained(advice) {
+  if (advice.finished || (!isConcurrent() && advice.turn === "robot")) return advice;
+  return api("GET", `/api/sessions/${state.session}/explain`);
 }
 
 function isConcurrent() {
   return state.planInfo && state.planInfo.turn_model === "concurrent";
 }
 
+function showNumbers(advice) {
+  document.getElementById("elapsed").textContent = qty(advice.elapsed);
+  document.getElementById("guarantee").textContent = qty(advice.total_bound);
+}
+
 // One step of the game: show the advice; on the robots' turn, play their reply.
 async function show(advice) {
   if (isConcurrent()) return showConcurrent(advice);
   state.advice = advice;
-  document.getElementById("elapsed").textContent = fmt(advice.elapsed);
-  document.getElementById("guarantee").textContent = fmt(advice.total_bound);
+  showNumbers(advice);
   drawView(advice);
   drawGantt();
   const options = document.getElementById("options");
@@ -93,33 +145,91 @@ async function show(advice) {
   if (advice.turn === "robot") {
     setStatus("the robots are working ...");
     const move = advice.robots[0];
-    const item = el("li", { "data-op": move.operation, "data-agent": move.agent },
-      `${move.operation} by ${move.agent}: ${move.description}`);
-    document.getElementById("robot-log").append(item);
+    logRobot({ "data-op": move.operation, "data-agent": move.agent },
+      `at ${qty(advice.elapsed)}: ${move.agent} does ${move.operation} (${move.description})`);
     await record(move, "robot");
     return;
   }
-  setStatus("your turn: choose what you do next (green: what the plan asks)");
-  document.body.dataset.ready = "1";
+  setStatus("your turn: choose what you do next (marked: what the plan asks)");
   for (const opt of advice.options) {
-    const asked = advice.instruction && advice.instruction.operation === opt.operation &&
+    const asked = advice.instruction !== null && advice.instruction.operation === opt.operation &&
       advice.instruction.agent === opt.agent;
-    const button = el("button", { "data-op": opt.operation, "data-agent": opt.agent,
-                                  "data-worst": opt.worst, class: asked ? "asked" : "" });
-    button.append(el("span", {}, `${opt.operation} ${opt.description} (${fmt(opt.cost)})`));
-    button.append(el("span", { class: "worst" }, `worst case ${fmt(opt.worst)}`));
-    const alike = alikePick(opt);
-    button.addEventListener("click", () =>
-      record({ ...opt, operation: alike ? alike.value : opt.operation }, "human"));
-    options.append(button);
-    if (alike) options.append(alike);
+    options.append(optionBlock(opt, asked, (op) => {
+      noteMove(opt, op, asked);
+      return record({ ...opt, operation: op }, "human");
+    }));
   }
+  ready();
+}
+
+// One option: its pickers (which alike part, how long), the move's button (what it is,
+// whether the plan asks it, the robots' reply and the worst case), and the line behind it.
+function optionBlock(opt, asked, act) {
+  const block = el("div", { class: "option" });
+  const pickers = el("div", { class: "pickers" });
+  const alike = alikePick(opt);
+  if (alike) pickers.append(labelled("part", alike));
+  let duration = null;
+  if (opt.durations && opt.durations.length > 1) {
+    duration = el("select", { "data-op": opt.operation, class: "duration",
+                              "aria-label": `how long you take for ${opt.operation}` });
+    for (const d of opt.durations) duration.append(el("option", { value: d }, qty(d)));
+    duration.value = String(opt.cost);
+    pickers.append(labelled("you take", duration));
+  }
+  if (pickers.childElementCount) block.append(pickers);
+  const deviation = !asked && opt.deviation === true;
+  const button = el("button", {
+    type: "button", class: `move${asked ? " asked" : deviation ? " deviation" : ""}`,
+    "data-kind": isConcurrent() ? "start" : "move", "data-op": opt.operation,
+    "data-agent": opt.agent, "data-worst": opt.worst, "data-deviation": deviation ? "1" : "0",
+    "data-duration": opt.cost,
+  });
+  const what = el("span", { class: "what" });
+  if (asked) what.append(el("span", { class: "tag asked" }, "the plan asks this"));
+  if (deviation) what.append(el("span", { class: "tag deviation" }, "deviation"));
+  const verb = isConcurrent() ? `${opt.agent} starts` : "do";
+  const took = duration ? "" : ` (${qty(opt.cost)})`;
+  what.append(document.createTextNode(`${verb} ${opt.operation} ${opt.description}${took}`));
+  what.append(el("span", { class: "worst" }, `worst case ${qty(opt.worst)}`));
+  button.append(what);
+  if (opt.why) button.append(el("span", { class: "why" }, opt.why));
+  button.addEventListener("click", () => {
+    const op = alike ? alike.value : opt.operation;
+    act(op, duration ? Number(duration.value) : opt.cost);
+  });
+  block.append(button);
+  if (opt.line && opt.line.length) block.append(lineDetails(opt));
+  return block;
+}
+
+function labelled(text, control) {
+  const label = el("label", {}, `${text} `);
+  label.append(control);
+  return label;
+}
+
+// The line behind an option's worst case, step by step (opened on request).
+function lineDetails(opt) {
+  const details = el("details", { class: "line", "data-op": opt.operation });
+  details.append(el("summary", {}, `why ${qty(opt.worst)}? the worst line after ${opt.operation}`));
+  const list = el("ol");
+  for (const s of opt.line) {
+    const who = s.side === "robot" ? s.agent : `${s.agent} (person)`;
+    const text = `${span(s.start, s.end)}: ${who} ${s.operation} ${s.description}` +
+      (s.deviation ? " (a deviation)" : "");
+    list.append(el("li", { class: s.deviation ? "deviation" : "" }, text));
+  }
+  list.append(el("li", {}, `the assembly is complete at ${qty(opt.worst)}`));
+  details.append(list);
+  return details;
 }
 
 // An option naming one of several alike parts (any of them is as good): a choice of which.
 function alikePick(opt) {
   if (!opt.alike || opt.alike.length < 2) return null;
   const pick = el("select", { class: "alike", "data-alike-for": opt.operation,
+                              "aria-label": `which alike part for ${opt.operation}`,
                               title: "alike parts: any of them is as good" });
   for (const op of opt.alike) {
     const info = (state.planInfo.operations || {})[op];
@@ -127,7 +237,6 @@ function alikePick(opt) {
     pick.append(el("option", { value: op }, `${op} (${parts})`));
   }
   pick.value = opt.operation;
-  pick.addEventListener("click", (ev) => ev.stopPropagation());
   return pick;
 }
 
@@ -135,11 +244,41 @@ function alikeNote(item) {
   return item.alike && item.alike.length > 1 ? ` (or alike: ${item.alike.slice(1).join(", ")})` : "";
 }
 
+// Say what the person just did, in words: following the plan or a deviation from it.
+function noteMove(opt, op, asked) {
+  const note = document.getElementById("last-move");
+  const told = state.advice.instruction;
+  const deviation = !asked && opt.deviation === true;
+  note.className = deviation ? "deviation" : "";
+  note.textContent = deviation
+    ? `You did ${op}: a deviation (the plan asked ${told ? told.operation : "otherwise"}).`
+    : `You did ${op}, as the plan asks.`;
+  logPerson(op, opt.agent, deviation);
+}
+
+function logRobot(attrs, text) {
+  logItem(el("li", attrs, text));
+}
+
+function logItem(item) {
+  const log = document.getElementById("robot-log");
+  log.append(item);
+  log.scrollTop = log.scrollHeight;
+}
+
+function logPerson(op, agent, deviation) {
+  const at = qty(state.advice.elapsed);
+  logItem(el("li", {
+    class: deviation ? "person deviation" : "person", "data-person": op,
+  }, `at ${at}: you (${agent}) ${op}${deviation ? ", a deviation" : ""}`));
+}
+
 async function record(move, who) {
   const before = state.advice;
   await post({ kind: "finished", operation: move.operation, agent: move.agent }, (advice) =>
     state.bars.push({ agent: move.agent, operation: move.operation, who,
-                      start: before.elapsed, end: advice.elapsed }));
+                      start: before.elapsed, end: advice.elapsed,
+                      deviation: who === "human" && move.deviation === true }));
 }
 
 // ---------------------------------------------------------------- the concurrent game
@@ -152,7 +291,6 @@ function sideOf(agent) {
 }
 
 function trackBars(advice) {
-  state.open = state.open || {};
   const running = new Set(advice.running.map((r) => r.operation));
   for (const r of advice.running) {
     if (!state.open[r.operation]) {
@@ -169,31 +307,28 @@ function trackBars(advice) {
 }
 
 async function showConcurrent(advice) {
-  state.deviated = state.deviated || new Set();
   const fresh = state.advice === null || state.advice.state !== advice.state ||
     state.advice.elapsed !== advice.elapsed;
   state.advice = advice;
   trackBars(advice);
-  document.getElementById("elapsed").textContent = fmt(advice.elapsed);
-  document.getElementById("clock").textContent = fmt(advice.elapsed);
-  document.getElementById("guarantee").textContent = fmt(advice.total_bound);
+  showNumbers(advice);
+  document.getElementById("clock").textContent = qty(advice.elapsed);
   drawView(advice);
   drawGantt();
   if (fresh && !advice.finished) {  // a new event: the robots' commitment
-    const log = document.getElementById("robot-log");
     if (!advice.robots.length) {
-      log.append(el("li", { "data-time": advice.elapsed, class: "wait" },
-        `t = ${fmt(advice.elapsed)}: the robots wait`));
+      logRobot({ "data-time": advice.elapsed, class: "wait" },
+        `t = ${qty(advice.elapsed)}: the robots wait`);
     }
     for (const r of advice.robots) {
-      log.append(el("li", { "data-op": r.operation, "data-agent": r.agent, "data-time": advice.elapsed },
-        `t = ${fmt(advice.elapsed)}: ${r.agent} starts ${r.operation} (${r.description})`));
+      logRobot({ "data-op": r.operation, "data-agent": r.agent, "data-time": advice.elapsed },
+        `t = ${qty(advice.elapsed)}: ${r.agent} starts ${r.operation} (${r.description})`);
     }
   }
   const running = document.getElementById("running");
   running.replaceChildren(...advice.running.map((r) =>
     el("li", { "data-op": r.operation, "data-agent": r.agent },
-      `${r.agent}: ${r.operation} ${describe(r.operation)} (${fmt(r.remaining)} left)`)));
+      `${r.agent}: ${r.operation} ${describe(r.operation)} (${qty(r.remaining)} left)`)));
   const told = advice.instructions.map((i) => i.operation === null
     ? `${i.agent}: wait` : `${i.agent}: ${i.operation} ${i.description}${alikeNote(i)}`);
   document.getElementById("instruction").textContent = told.length
@@ -209,39 +344,18 @@ async function showConcurrent(advice) {
   for (const opt of advice.options) {
     const asked = advice.instructions.some((i) => i.operation === opt.operation &&
       i.agent === opt.agent);
-    const button = el("button", { "data-kind": "start", "data-op": opt.operation,
-                                  "data-agent": opt.agent, "data-worst": opt.worst,
-                                  "data-deviation": opt.deviation ? "1" : "0",
-                                  "data-duration": opt.cost,
-                                  class: asked ? "asked" : opt.deviation ? "deviation" : "" });
-    button.append(el("span", {}, `${opt.agent} starts ${opt.operation} ${opt.description}`));
-    let pick = null;
-    if (opt.durations.length > 1) {
-      pick = el("select", { "data-op": opt.operation, title: "how long you will take" });
-      for (const d of opt.durations) pick.append(el("option", { value: d }, `${fmt(d)} s`));
-      pick.value = String(opt.cost);
-      pick.addEventListener("click", (ev) => ev.stopPropagation());
-    } else {
-      button.append(el("span", {}, ` (${fmt(opt.cost)} s)`));
-    }
-    button.append(el("span", { class: "worst" }, `worst case ${fmt(opt.worst)}`));
-    const alike = alikePick(opt);
-    button.addEventListener("click", () => {
-      const op = alike ? alike.value : opt.operation;
+    options.append(optionBlock(opt, asked, (op, duration) => {
       if (opt.deviation) state.deviated.add(op);
-      post({ kind: "started", operation: op, agent: opt.agent,
-             duration: pick ? Number(pick.value) : opt.cost });
-    });
-    options.append(button);
-    if (pick) options.append(pick);
-    if (alike) options.append(alike);
+      noteMove(opt, op, asked);
+      return post({ kind: "started", operation: op, agent: opt.agent, duration });
+    }));
   }
   for (const f of advice.finishes) {
-    const button = el("button", { "data-kind": "finish", "data-op": f.operation,
+    const button = el("button", { type: "button", "data-kind": "finish", "data-op": f.operation,
                                   "data-agent": f.agent, "data-time": f.time,
                                   "data-worst": f.worst });
-    button.append(el("span", {}, `${f.agent} finishes ${f.operation} at t = ${fmt(f.time)}`));
-    button.append(el("span", { class: "worst" }, `worst case ${fmt(f.worst)}`));
+    button.append(el("span", {}, `${f.agent} finishes ${f.operation} at ${qty(f.time)}: `));
+    button.append(el("span", { class: "worst" }, `worst case ${qty(f.worst)}`));
     button.addEventListener("click", () =>
       post({ kind: "finished", operation: f.operation, agent: f.agent, time: f.time }));
     finishes.append(button);
@@ -249,12 +363,23 @@ async function showConcurrent(advice) {
   setStatus(advice.finishes.length
     ? "start an operation, or let the cell run to its next completion"
     : "start an operation (you do not idle while you have something to do)");
-  document.body.dataset.ready = "1";
+  ready();
 }
 
 function describe(op) {
   const info = (state.planInfo.operations || {})[op];
   return info ? info.description : "";
+}
+
+// The advice is shown: mark the page ready and put the focus on the next move (the plan's
+// instruction if it is an option, else the first option, else the first completion); an
+// option's pickers (which part, how long) are one Shift+Tab before its button.
+function ready() {
+  document.body.dataset.ready = "1";
+  const target = document.querySelector("#options button.move.asked") ||
+    document.querySelector("#options button.move") ||
+    document.querySelector("#finishes button");
+  if (target) target.focus();
 }
 
 // Post an event; on success call `then(advice)` (if given) and show the new advice.
@@ -263,15 +388,16 @@ async function post(event, then) {
   state.busy = true;
   document.body.dataset.ready = "0";
   try {
-    const advice = await api("POST", `/api/sessions/${state.session}/events`, event);
-    if (then) then(advice);
-    document.getElementById("error").textContent = "";
+    const plain = await api("POST", `/api/sessions/${state.session}/events`, event);
+    if (then) then(plain);
+    const advice = await explained(plain);
+    setError("");
     state.busy = false;
     await show(advice);
   } catch (err) {
     state.busy = false;
     document.body.dataset.ready = "1";
-    document.getElementById("error").textContent = err.message;
+    setError(err.message);
   }
 }
 
@@ -304,80 +430,155 @@ function drawView(advice) {
                             yaxis: { visible: false }, zaxis: { visible: false } } };
   plot("view", traces, layout);
   note.textContent = `placed: ${[...present].join(", ") || "nothing yet"}` +
-    (fresh.size ? ` (just now: ${[...fresh].join(", ")})` : "");
+    (fresh.size ? ` (just now: ${[...fresh].join(", ")}, orange)` : "");
 }
 
+// The Gantt chart: what was done, what runs, and the plan ahead if the person follows it,
+// with a "now" line and a legend.
 function drawGantt() {
-  // Running operations are drawn to their planned end, faded.
+  const now = state.advice.elapsed;
   const left = Object.fromEntries((state.advice.running || []).map((r) => [r.operation, r.remaining]));
-  const open = Object.values(state.open || {}).map((b) =>
-    ({ ...b, end: state.advice.elapsed + (left[b.operation] || 0), running: true }));
-  const bars = [...state.bars, ...open].filter((b) => b.end > b.start);
-  const colour = { robot: "#2e9d4a", human: "#9e9e9e" };
-  const trace = {
-    type: "bar", orientation: "h", y: bars.map((b) => b.agent),
-    x: bars.map((b) => b.end - b.start), base: bars.map((b) => b.start),
-    text: bars.map((b) => b.operation), textposition: "inside",
-    marker: { color: bars.map((b) => colour[b.who]), opacity: bars.map((b) => b.running ? 0.45 : 1),
-              line: { color: bars.map((b) => b.deviation ? "#d62728" : "#ffffff"),
-                      width: bars.map((b) => b.deviation ? 3 : 0) } },
-    hoverinfo: "text+x",
+  const running = Object.values(state.open).map((b) =>
+    ({ ...b, end: now + (left[b.operation] || 0) }));
+  const ahead = (state.advice.ahead || []).map((s) =>
+    ({ agent: s.agent, operation: s.operation, start: s.start, end: s.end, who: s.side,
+       deviation: s.deviation, description: s.description }));
+  // [legend, bars, fill (per side when an object), text colour, pattern]
+  const groups = [
+    ["robots, done", state.bars.filter((b) => b.who === "robot"), SIDE_COLOUR, "white", ""],
+    ["you, done", state.bars.filter((b) => b.who !== "robot" && !b.deviation), SIDE_COLOUR,
+     "white", ""],
+    ["you, a deviation", state.bars.filter((b) => b.who !== "robot" && b.deviation), "#f6d5d2",
+     "#222", "/"],
+    ["running (to its planned end)", running, { robot: "#8cc79b", human: "#a9b6c8" }, "#222", ""],
+    ["the plan ahead (if you follow it)", ahead, AHEAD_COLOUR, "#333", ""],
+  ];
+  const agents = Object.keys(state.planInfo.agents || {}).sort((a, b) =>
+    (sideOf(a) === "human" ? 0 : 1) - (sideOf(b) === "human" ? 0 : 1) || a.localeCompare(b));
+  const end = Math.max(state.advice.total_bound || 0, now,
+    ...ahead.map((b) => b.end), ...running.map((b) => b.end), 1);
+  const roomy = (b) => b.end - b.start >= end / (document.getElementById("gantt").clientWidth / 28);
+  const traces = groups.map(([name, bars, fill, ink, pattern]) => {
+    const kept = bars.filter((b) => b.end > b.start);
+    const colour = typeof fill === "string" ? fill
+      : kept.map((b) => fill[b.who === "robot" ? "robot" : "human"]);
+    return {
+      type: "bar", orientation: "h", name, y: kept.map((b) => b.agent),
+      x: kept.map((b) => b.end - b.start), base: kept.map((b) => b.start),
+      text: kept.map((b) => roomy(b) ? b.operation : ""), textposition: "inside",
+      insidetextanchor: "middle", textangle: 0, textfont: { size: 12, color: ink },
+      constraintext: "none",
+      hovertext: kept.map((b) => `${b.agent} ${b.operation} ${describe(b.operation)}: ` +
+        span(b.start, b.end)),
+      hoverinfo: "text",
+      marker: { color: colour, line: { color: "#555", width: 0.6 },
+                pattern: { shape: pattern, fgcolor: DEVIATION_COLOUR, solidity: 0.25 } },
+      showlegend: true,
+    };
+  });
+  const unit = state.planInfo.cost === "steps" ? "steps" : "time (s)";
+  const layout = {
+    margin: { l: 48, r: 10, t: 30, b: 40 }, barmode: "overlay",
+    title: { text: "Gantt chart", font: { size: 13 }, x: 0.01, xanchor: "left" },
+    xaxis: { title: { text: unit }, range: [0, end * 1.02] },
+    yaxis: { type: "category", categoryorder: "array", categoryarray: agents.slice().reverse() },
+    legend: { orientation: "h", y: -0.28, font: { size: 11 } },
+    shapes: [{ type: "line", x0: now, x1: now, yref: "paper", y0: 0, y1: 1,
+               line: { color: DEVIATION_COLOUR, width: 2, dash: "dot" } }],
+    annotations: [{ x: now, y: 1, yref: "paper", yanchor: "bottom", text: `now ${qty(now)}`,
+                    showarrow: false, font: { size: 11, color: DEVIATION_COLOUR } }],
   };
-  const layout = { margin: { l: 50, r: 10, t: 30, b: 30 }, title: { text: "Gantt chart", font: { size: 13 } },
-                   xaxis: { title: { text: "time" }, rangemode: "tozero" },
-                   yaxis: { type: "category" } };
-  plot("gantt", [trace], layout);
+  plot("gantt", traces, layout);
+  const last = ahead.length ? Math.max(...ahead.map((b) => b.end)) : now;
+  document.getElementById("gantt-note").textContent =
+    `now: ${qty(now)}; if you follow the plan from here the assembly is done at ${qty(last)}; ` +
+    `the worst that can still happen: ${qty(state.advice.total_bound)}.`;
+}
+
+// A number shown with its unit, kept bare in data-value (for tests and scripts).
+function setNumber(id, x) {
+  const node = document.getElementById(id);
+  node.textContent = qty(x);
+  node.dataset.value = String(x);
 }
 
 async function finish(advice) {
   setStatus("the assembly is complete");
   const session = await api("GET", `/api/sessions/${state.session}`);
   const out = session.outcome;
-  document.getElementById("final-cost").textContent = fmt(out.cost);
-  document.getElementById("final-w0").textContent = fmt(out.w0);
-  document.getElementById("final-wstar").textContent = fmt(out.minimax);
+  setNumber("final-cost", out.cost);
+  setNumber("final-w0", out.w0);
+  setNumber("final-wstar", out.minimax);
   document.getElementById("final-deviations").textContent = String(out.deviations);
   if (out.robustness) {  // the concurrent game: W*(0) and W*(k) for the deviations made
     const rows = out.robustness.filter((r) => r.k !== null);
     const row = rows.find((r) => r.k === out.deviations) || rows[rows.length - 1];
-    document.getElementById("final-w0").textContent = fmt(rows[0].bound);
-    document.getElementById("final-wk").textContent = `${fmt(row.bound)} (k = ${row.k})`;
+    setNumber("final-w0", rows[0].bound);
+    document.getElementById("final-wk").textContent = `${qty(row.bound)} (k = ${row.k})`;
     document.getElementById("final-wk-note").hidden = false;
   }
   document.getElementById("final").hidden = false;
-  document.body.dataset.ready = "done";
+  document.getElementById("final-title").focus();
   const items = await api("GET", "/api/questionnaire");
+  questionnaire(items);
+  document.body.dataset.ready = "done";
+}
+
+// The questionnaire: a scale item is a row of radio buttons with none chosen (an item left
+// alone is missing, never a default value); a text item a text field.
+function questionnaire(items) {
   const form = document.getElementById("questionnaire");
   form.replaceChildren();
   if (!items.length) return;
   for (const item of items) {
-    form.append(el("label", { for: `q-${item.id}` }, item.text));
-    const input = item.scale
-      ? el("input", { type: "range", id: `q-${item.id}`, name: item.id,
-                      min: item.scale[0], max: item.scale[1], value: item.scale[0] })
-      : el("input", { type: "text", id: `q-${item.id}`, name: item.id, maxlength: "500" });
-    form.append(input);
+    if (item.scale) {
+      const set = el("fieldset", { "data-item": item.id });
+      set.append(el("legend", {}, item.text));
+      const row = el("div", { class: "scale" });
+      const [lo, hi] = item.scale;
+      row.append(el("span", { class: "ends" }, item.labels ? item.labels[0] : "disagree"));
+      for (let v = lo; v <= hi; v++) {
+        const id = `q-${item.id}-${v}`;
+        const label = el("label", { for: id });
+        label.append(el("input", { type: "radio", id, name: item.id, value: v }));
+        label.append(document.createTextNode(` ${v}`));
+        row.append(label);
+      }
+      row.append(el("span", { class: "ends" }, item.labels ? item.labels[1] : "agree"));
+      set.append(row);
+      form.append(set);
+    } else {
+      form.append(el("label", { for: `q-${item.id}`, class: "text" }, item.text));
+      form.append(el("input", { type: "text", id: `q-${item.id}`, name: item.id, maxlength: "500" }));
+    }
   }
-  const submit = el("button", { type: "submit", id: "submit-answers" }, "send the answers");
-  form.append(submit);
-  form.addEventListener("submit", async (ev) => {
+  form.append(el("button", { type: "submit", id: "submit-answers" }, "send the answers"));
+  form.onsubmit = async (ev) => {
     ev.preventDefault();
     const answers = {};
     for (const item of items) {
-      const v = form.elements[item.id].value;
-      answers[item.id] = item.scale ? Number(v) : v;
+      if (item.scale) {
+        const chosen = form.querySelector(`input[name="${CSS.escape(item.id)}"]:checked`);
+        if (chosen) answers[item.id] = Number(chosen.value);
+      } else {
+        const v = form.elements[item.id].value.trim();
+        if (v) answers[item.id] = v;
+      }
     }
     try {
       await api("POST", `/api/sessions/${state.session}/answers`, { answers });
       form.hidden = true;
       document.getElementById("thanks").hidden = false;
+      document.getElementById("thanks").focus();
+      setError("");
     } catch (err) {
-      document.getElementById("error").textContent = err.message;
+      setError(err.message);
     }
-  });
+  };
 }
 
 start().catch((err) => {
-  document.getElementById("error").textContent = err.message;
+  setError(err.message);
   setStatus("could not start");
+  if (document.body.dataset.ready === "error") document.getElementById("plan-pick").focus();
 });
