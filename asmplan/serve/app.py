@@ -25,6 +25,7 @@ Request bodies are validated (pydantic, unknown keys refused) and limited to
 from __future__ import annotations
 
 import contextlib
+import gc
 import json
 import re
 import time
@@ -262,6 +263,7 @@ def create_app(
     app.add_middleware(EventFastPath, store=store)
     app.add_middleware(BodyLimit, limit=MAX_BODY)
     app.add_middleware(HeadAsGet)
+    gc.freeze()  # the plans and the service: no collection walks them again (p99 latency)
     return app
 
 

@@ -69,6 +69,8 @@ SESSION_FORMAT = "asmplan-session/1"
 STORE_FORMAT = 2
 """The database's format (``PRAGMA user_version``)."""
 DB_NAME = "sessions.db"
+CHECKPOINT_S = 1.0
+"""Seconds between the background checkpoints of the write-ahead log."""
 CLOSED_CACHE = 64
 """Closed sessions kept in memory once read back (the most recently used)."""
 CSV_COLUMNS = (
@@ -299,12 +301,18 @@ class SessionStore:
         self._log = os.open(self.folder / "log.jsonl", os.O_WRONLY | os.O_APPEND | os.O_CREAT)
         self._import_files()
         self._load()
+        self._stop = threading.Event()
+        self._checkpointer = threading.Thread(
+            target=self._checkpoints, name="sessions-checkpoint", daemon=True
+        )
+        self._checkpointer.start()
 
     # ------------------------------------------------------------------ the database
     def _connect(self, path: Path, fsync: bool) -> sqlite3.Connection:
         db = sqlite3.connect(path, isolation_level=None, check_same_thread=False, timeout=10)
         db.execute("PRAGMA journal_mode=WAL")
         db.execute(f"PRAGMA synchronous={'FULL' if fsync else 'NORMAL'}")
+        db.execute("PRAGMA wal_autocheckpoint=0")  # checkpoints run beside, not in a request
         db.executescript(SCHEMA)
         version = db.execute("PRAGMA user_version").fetchone()[0]
         if version not in (0, STORE_FORMAT):
@@ -376,7 +384,22 @@ class SessionStore:
         except OSError as exc:  # the database holds the record; the log is a copy
             print(f"asmplan: warning: log.jsonl: {exc.strerror or exc}", file=sys.stderr)
 
+    def _checkpoints(self) -> None:
+        """Copy the log into the database every :data:`CHECKPOINT_S` seconds on a
+        connection of its own (a passive checkpoint never waits for the requests, so an
+        event never pays for one; the log stays small)."""
+        try:
+            db = sqlite3.connect(self.folder / DB_NAME, isolation_level=None, timeout=1)
+        except sqlite3.Error:
+            return
+        with contextlib.closing(db):
+            while not self._stop.wait(CHECKPOINT_S):
+                with contextlib.suppress(sqlite3.Error):
+                    db.execute("PRAGMA wal_checkpoint(PASSIVE)")
+
     def close(self) -> None:
+        self._stop.set()
+        self._checkpointer.join(timeout=5)
         with self._lock:
             with contextlib.suppress(sqlite3.Error):
                 self._db.close()

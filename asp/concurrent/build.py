@@ -145,14 +145,33 @@ def build_game(
             raise too_big
         order = np.argsort(src, kind="stable")
         src, dst, cost, side = src[order], dst[order], cost[order], side[order]
-        nodes = _NodeRows(rows, model.humans)
-        actions = _ActionRows(side, e_ops[order], e_dur[order], e_dev[order], cost)
+        nodes = NodeRows(rows, model.humans)
+        actions = ActionRows(side, e_ops[order], e_dur[order], e_dev[order], cost)
         starts = {b: int(starts_a[i]) for i, b in enumerate(levels)}
         end = 0
     else:
         nodes, actions, starts, end, src, dst, cost, side = _build_python(
             model, levels, max_nodes, too_big, progress
         )
+    return game_of(model, levels, nodes, actions, starts, end, (src, dst, cost, side), t0)
+
+
+def game_of(
+    model: ConcurrentModel,
+    levels: list,
+    nodes,
+    actions,
+    starts: dict,
+    end: int,
+    edges: tuple,
+    t0: float,
+    generator: str = "asmplan.concurrent/1",
+) -> ConcurrentGame:
+    """The :class:`ConcurrentGame` of built nodes and edges: its DAG (edges ``(src, dst,
+    cost, side)`` sorted by source, costs scaled; edge labels when there are at most
+    :data:`LABEL_LIMIT`), the start of ``levels[-1]`` its start. ``t0``: when the build
+    began (``seconds``)."""
+    src, dst, cost, side = edges
     labels = len(actions) <= LABEL_LIMIT
     dag = from_arrays(
         list(range(len(nodes))),
@@ -166,7 +185,7 @@ def build_game(
         agents=tuple(_edge_agents(model, a) for a in actions) if labels else None,
         cost_model="time",
         metadata={
-            "generator": "asmplan.concurrent/1",
+            "generator": generator,
             "assembly": model.spec.name,
             "source": model.spec.source,
             "turn_model": "concurrent",
@@ -185,7 +204,7 @@ def build_game(
     )
 
 
-class _NodeRows(Sequence):
+class NodeRows(Sequence):
     """The compiled builder's node rows read as the Python builder's node tuples."""
 
     def __init__(self, rows: np.ndarray, humans: list[int]):
@@ -210,7 +229,7 @@ class _NodeRows(Sequence):
         return ("R" if kind == 0 else "H", state, running, budget, told)
 
 
-class _ActionRows(Sequence):
+class ActionRows(Sequence):
     """The compiled builder's edge arrays read as :class:`Commit` and :class:`Reply`."""
 
     def __init__(self, side, ops, durations, deviations, cost):

@@ -408,13 +408,13 @@ def _append_edge(edges, m, v, t, cost, side, dev, deciders, chosen, nd):  # prag
     e_src, e_dst, e_cost, e_side, e_dev, e_ops, e_dur = edges
     if m >= e_src.shape[0]:
         size = 2 * e_src.shape[0]
-        e_src = _grow1(e_src, size)
-        e_dst = _grow1(e_dst, size)
-        e_cost = _grow1(e_cost, size)
-        e_side = _grow1(e_side, size)
-        e_dev = _grow1(e_dev, size)
-        e_ops = _grow2(e_ops, size)
-        e_dur = _grow2(e_dur, size)
+        e_src = grow(e_src, size)
+        e_dst = grow(e_dst, size)
+        e_cost = grow(e_cost, size)
+        e_side = grow(e_side, size)
+        e_dev = grow(e_dev, size)
+        e_ops = grow_rows(e_ops, size)
+        e_dur = grow_rows(e_dur, size)
     e_src[m] = v
     e_dst[m] = t
     e_cost[m] = cost
@@ -451,14 +451,16 @@ def _intern(new, nw, index, rows, stack, n, top, max_nodes):  # pragma: no cover
 
 
 @numba.njit(cache=True)
-def _grow1(a, size):  # pragma: no cover - compiled
+def grow(a, size):  # pragma: no cover - compiled
+    """``a`` (1-d) in a new array of ``size`` entries (the first ones copied)."""
     out = np.empty(size, a.dtype)
     out[: a.shape[0]] = a
     return out
 
 
 @numba.njit(cache=True)
-def _grow2(a, size):  # pragma: no cover - compiled
+def grow_rows(a, size):  # pragma: no cover - compiled
+    """``a`` (2-d) in a new array of ``size`` rows (the first ones copied)."""
     out = np.empty((size, a.shape[1]), a.dtype)
     out[: a.shape[0]] = a
     return out

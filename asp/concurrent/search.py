@@ -1,0 +1,1142 @@
+"""The concurrent game solved on the fly: ``W*(k)`` without building the game.
+
+The game is walked from its start by the rules of :mod:`asp.concurrent.rules`; only the
+positions the search needs are ever made. Two compiled kernels (numba, ``cache=True``) do
+the work: a minimax search for values and a builder of the *policy game* (the states one
+robot policy can reach against every human, with all their replies), whose exact solution
+(:func:`asp.solve.solve`) is that policy's certified worst case state by state.
+
+The search
+----------
+Depth-first minimax, alpha-beta with fail-soft bounds, over positions (the robot side on
+turn); a human node (a position and one commitment) is the max over its replies, searched
+inside its position's frame, and is not stored. A transposition table keyed on the positions'
+canonical keys
+(:meth:`asp.concurrent.rules.Rules.key`: alike operations and budgets that no longer bind
+identified, both exact) keeps for each position a proven interval ``[lo, hi]`` of its value
+and the commitment that proved ``hi``. Depth-first was chosen over best-first (AO*) for
+memory: the only memory is the table (sized before the search, see *Limits*), and the
+recursion is as deep as the number of events. Times are the rules' integers, so every
+comparison is exact.
+
+Every rule that cuts the search, with its proof:
+
+1. *Alpha-beta with a transposition table.* A call with window ``(a, b)`` returns ``v``
+   with ``W <= v`` if ``v <= a``, ``W >= v`` if ``v >= b``, else ``W = v`` (the standard
+   fail-soft invariant, by induction over the calls). A stored interval narrows the window
+   or answers at once; the commitment stored with ``hi`` achieves ``hi`` (its returned
+   value is an upper bound of its true one).
+2. *Admissible lower bounds.* ``lo`` starts at :meth:`~asp.concurrent.rules.Rules.lower_bound`
+   (critical path and per-side load against a person who follows and is slow, one human
+   strategy: the value is at least the robot's best against it). A commitment's human node
+   is at least the bound of the position with the commitment's starts and instructions
+   running (the follow reply, durations at their longest, is one reply): commitments are
+   tried in increasing order of it, and the loop stops at the first whose bound reaches the
+   best value found (or the window's top), which neither it nor any later one can beat.
+3. *Budgets.* A human allowed ``b + 1`` deviations can play every strategy of ``b``, so
+   ``W(s, b - 1) <= W(s, b) <= W(s, b + 1)``: a new position takes ``lo`` from the same
+   position one budget lower and ``hi`` from one budget higher when the table has them. At
+   the root, the search for ``k`` runs in the window ``(W*(k - 1) - 1, W*(inf) + 1)``.
+4. *Instructions that cannot bind.* With the budget at its cap (every deviation affordable,
+   :mod:`asp.concurrent.rules`) the person may do anything at no cost, and the child's budget
+   is its own cap whatever the instruction (a reply with ``d`` starting deviations has at
+   most ``H * d`` in all, and starts at least ``d`` of the operations the cap counts). So
+   the replies to two commitments with the same robot starts depend only on which free
+   humans are told to wait (a told-to-wait person may idle, a told-to-work one only with
+   nothing to start), and telling a set of them to wait gives the human side a superset
+   of the replies of any subset. Per robot starts and set of waiting persons one
+   commitment is kept (the one of least bound of rule 2: the instruction a person sees),
+   and none whose set has a kept strict subset.
+5. *Symmetry.* Positions are orbits under the alike-part symmetry (rules' docstring).
+
+The values ``W*(k)`` for ``k = 0, 1, ...`` and ``W*(inf)`` (the budget at its cap) share one
+table; a curve stops when ``W*(k) = W*(inf)`` (flat), at ``max_k``, or when a limit is hit.
+
+The robust policy and certificates
+----------------------------------
+The plan's policy is built as a policy game: at each position it reaches, the search is
+run to the exact value and its stored commitment taken (so the policy is optimal at every
+state it reaches, after any human move, not only on the principal line); every human reply
+is followed. Solving that small DAG gives each state's bound, and it is an ordinary
+:class:`asp.concurrent.build.ConcurrentGame`: the plan file, the timelines and the runtime
+advisor read it as they read the compiled game. A fixed policy is certified the same way
+(an exact best response of the human side against it: the policy game of the CP-SAT
+schedule run as a plan, of a greedy adaptive policy, or of the table's moves where the
+search was cut short). One policy game holds every budget's start, and ``k = inf`` is the
+budget at its cap in the same game, so a fixed policy's certified worst case never falls
+as ``k`` grows.
+
+Limits and the anytime answer
+-----------------------------
+The table is sized before the search from the memory allowed (``memory``: its bytes per
+entry are known, :func:`table_entries`); it never grows. The search stops when the table is
+full, at ``max_nodes`` positions expanded, or at ``time_limit``; the policy games stop at
+their own node limit (from the same memory). Stopped, :func:`solve_curve` still answers:
+for each ``k`` a proven lower bound ``L(k)`` (the CP-SAT bound, the start's bound, what the
+search proved, and ``L(k - 1)``: the curve never falls) and the least certified worst case
+``U(k)`` of the policies above (and of larger budgets: ``U(k) <= U(k + 1)``), the policy
+handed to the cell being the one certified at ``U``. ``W*(k)`` lies in ``[L(k), U(k)]``.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numba
+import numpy as np
+from numba.typed import List
+
+from asp.concurrent.build import ActionRows, ConcurrentGame, NodeRows, game_of
+from asp.concurrent.kernel import grow, grow_rows
+from asp.concurrent.model import UNBOUNDED
+from asp.concurrent.rules import (
+    NONE,
+    Rules,
+    budget_cap_of,
+    commit_rows,
+    committed_row,
+    is_done,
+    key_of,
+    lower_bound_of,
+    reply_rows,
+)
+from asp.graph.together import edge
+
+INF = 1 << 60
+"""A value above every makespan (scaled)."""
+ROBUST, SCHEDULE, GREEDY, HYBRID = 0, 1, 2, 3
+"""Robot policies of a policy game: the search's (exact, per budget), the CP-SAT schedule run
+as a plan (:func:`asp.concurrent.robustness.schedule_rule`'s rule), greedy (least bound of
+rule 2), and the table's moves where it has them (of the state at the highest budget the
+table holds), else greedy. The last three choose by the state alone, not the budget: fixed
+policies, whose certified worst case never falls as ``k`` grows."""
+DEFAULT_MEMORY = 1 << 30
+"""Bytes for the search table and the policy games by default (1 GiB)."""
+DEFAULT_MAX_NODES = 50_000_000
+"""Positions the search expands at most by default."""
+GENERATOR = "asmplan.concurrent.search/1"
+"""The ``generator`` of a policy game's DAG."""
+TICK = (1 << 15) - 1
+"""The clock and the progress line are looked at every ``TICK + 1`` positions."""
+
+# stats array
+NODES, NODE_LIMIT, ABORT, ENTRIES, MAX_ENTRIES, DEADLINE, PROGRESS, NEXT_REPORT = range(8)
+ROOT_BEST, BUDGET, T0 = 8, 9, 10
+N_STATS = 11
+STOP_NODES, STOP_MEMORY, STOP_TIME = 1, 2, 3
+STOP_NAMES = {STOP_NODES: "node limit", STOP_MEMORY: "memory limit", STOP_TIME: "time limit"}
+
+
+class Table(NamedTuple):
+    """An open-addressing hash table of positions (capacity a power of two).
+
+    keys (C, K) int64 : canonical keys, zero rows free (a key's first word is never 0);
+    lo, hi (C,) int64 : the proven interval of the value (search) or the node id (policy
+    games, in ``lo``); move (C,) int64 : the commitment index that proved ``hi``, or -1.
+    """
+
+    keys: np.ndarray
+    lo: np.ndarray
+    hi: np.ndarray
+    move: np.ndarray
+
+
+ENTRY_BYTES = 3 * 8
+"""Bytes of one table entry besides its key words (``lo``, ``hi``, ``move``)."""
+LOAD = 0.7
+"""Largest share of a table's slots in use."""
+MIN_ENTRIES = 1024
+"""The least search table worth starting."""
+
+
+def table_entries(memory: int, key_words: int) -> int:
+    """Positions a table of at most ``memory`` bytes holds (its slots a power of two, at most
+    :data:`LOAD` of them used)."""
+    per_slot = 8 * key_words + ENTRY_BYTES
+    slots = 1 << max(4, int(memory // per_slot).bit_length() - 1)
+    return int(slots * LOAD)
+
+
+def new_table(entries: int, key_words: int) -> Table:
+    """A free table for ``entries`` positions."""
+    slots = 1 << max(4, int(np.ceil(entries / LOAD)).bit_length())
+    return Table(
+        keys=np.zeros((slots, key_words), dtype=np.int64),
+        lo=np.zeros(slots, dtype=np.int64),
+        hi=np.full(slots, INF, dtype=np.int64),
+        move=np.full(slots, -1, dtype=np.int64),
+    )
+
+
+# --------------------------------------------------------------------------- table kernels
+
+
+@numba.njit(cache=True)
+def _slot(H, key):  # pragma: no cover - compiled
+    """The slot of ``key``: where it is, or the free slot where it goes."""
+    h = np.uint64(0x9E3779B97F4A7C15)
+    for w in range(key.shape[0]):
+        h ^= np.uint64(key[w])
+        h *= np.uint64(0xBF58476D1CE4E5B9)
+        h ^= h >> np.uint64(31)
+    mask = np.uint64(H.keys.shape[0] - 1)
+    i = np.int64(h & mask)
+    kw = key.shape[0]
+    while True:
+        if H.keys[i, 0] == 0:
+            return i
+        same = True
+        for w in range(kw):
+            if H.keys[i, w] != key[w]:
+                same = False
+                break
+        if same:
+            return i
+        i = (i + 1) & np.int64(mask)
+
+
+@numba.njit(cache=True)
+def _find(H, key):  # pragma: no cover - compiled
+    """The slot holding ``key``, or -1."""
+    i = _slot(H, key)
+    return -1 if H.keys[i, 0] == 0 else i
+
+
+@numba.njit(cache=True)
+def _entry(T, H, row, st, lb):  # pragma: no cover - compiled
+    """The slot of the position ``row``, made when new: ``lo`` its lower bound (``lb`` when
+    given, >= 0), raised to the same position's one budget lower and ``hi`` lowered to its
+    one budget higher (rule 3). -1 (and the stop flag) when the table is full."""
+    key = key_of(T, row)
+    i = _slot(H, key)
+    if H.keys[i, 0] != 0:
+        return i
+    if st[ENTRIES] >= st[MAX_ENTRIES]:
+        st[ABORT] = STOP_MEMORY
+        return -1
+    lo = lb if lb >= 0 else lower_bound_of(T, row)
+    hi = INF
+    b = row[1]
+    other = row.copy()
+    if b > 0:
+        other[1] = b - 1
+        j = _find(H, key_of(T, other))
+        if j >= 0 and H.lo[j] > lo:
+            lo = H.lo[j]
+    if b < budget_cap_of(T, row):
+        other[1] = b + 1
+        j = _find(H, key_of(T, other))
+        if j >= 0:
+            hi = H.hi[j]
+    i = _slot(H, key)  # (the probes above did not write)
+    H.keys[i] = key
+    H.lo[i] = lo
+    H.hi[i] = max(hi, lo)
+    H.move[i] = -1
+    st[ENTRIES] += 1
+    return i
+
+
+# --------------------------------------------------------------------------- search kernels
+
+
+@numba.njit(cache=True)
+def _estimate(T, row, commit):  # pragma: no cover - compiled
+    """Rule 2's bound of a commitment: the lower bound of the position with the robots'
+    starts and the instructed persons' operations running (a person's at its longest)."""
+    nw = T.side.shape[0]
+    cur, told = committed_row(T, row, commit)
+    s = row[0]
+    for w in range(nw):
+        o = told[w]
+        if o >= 0:
+            cur[2 + w] = o
+            cur[2 + nw + w] = (
+                T.dur[w, o, T.ndur[w, o] - 1] + T.change[edge(s, T.label[o], T.indptr, T.lab)]
+            )
+    return lower_bound_of(T, cur)
+
+
+@numba.njit(cache=True)
+def _dominant(T, row, commits, est):  # pragma: no cover - compiled
+    """(M,) bool: the commitments rule 4 keeps (all when the budget is below its cap)."""
+    m = commits.shape[0]
+    keep = np.ones(m, np.bool_)
+    if row[1] < budget_cap_of(T, row):
+        return keep
+    nw = T.side.shape[0]
+    mask = np.zeros(m, np.int64)
+    for i in range(m):
+        bit = 0
+        for w in range(nw):
+            if T.side[w] == 1 and commits[i, w] != NONE:
+                if commits[i, w] == -1:
+                    mask[i] |= 1 << bit
+                bit += 1
+    lo = 0
+    while lo < m:  # runs of equal robot starts (robots are the odometer's leading digits)
+        hi = lo + 1
+        while hi < m:
+            same = True
+            for w in range(nw):
+                if T.side[w] == 0 and commits[hi, w] != commits[lo, w]:
+                    same = False
+                    break
+            if not same:
+                break
+            hi += 1
+        for i in range(lo, hi):  # one per set of waiting persons: the least bound
+            for j in range(lo, hi):
+                better = est[j] < est[i] or (est[j] == est[i] and j < i)
+                if j != i and keep[j] and mask[j] == mask[i] and better:
+                    keep[i] = False
+                    break
+        for i in range(lo, hi):  # none whose set has a strict subset kept
+            if not keep[i]:
+                continue
+            for j in range(lo, hi):
+                if keep[j] and mask[j] != mask[i] and (mask[j] & mask[i]) == mask[j]:
+                    keep[i] = False
+                    break
+        lo = hi
+    return keep
+
+
+@numba.njit(cache=True)
+def _tick(st):  # pragma: no cover - compiled
+    """Look at the clock (and print the progress line when it is due); True to stop."""
+    with numba.objmode(now="float64"):
+        now = time.perf_counter()
+    ms = np.int64(now * 1000)
+    if st[DEADLINE] > 0 and ms >= st[DEADLINE]:
+        st[ABORT] = STOP_TIME
+        return True
+    if st[PROGRESS] and ms >= st[NEXT_REPORT]:
+        st[NEXT_REPORT] = ms + 1000
+        nodes, entries, best, budget = st[NODES], st[ENTRIES], st[ROOT_BEST], st[BUDGET]
+        secs = (ms - st[T0]) / 1000.0
+        with numba.objmode():
+            _report(nodes, entries, best, budget, secs)
+    return False
+
+
+def _report(nodes: int, entries: int, best: int, budget: int, secs: float) -> None:
+    found = "" if best >= INF else f", best commitment so far {best}"
+    print(
+        f"  concurrent search, budget {budget}: {nodes:,} positions expanded, {entries:,} "
+        f"in the table{found} ({secs:.0f} s)",
+        file=sys.stderr,
+        flush=True,
+    )
+
+
+ENTER, NEXT_COMMIT, NEXT_REPLY, AFTER_CHILD = 0, 1, 2, 3
+"""Phases of a frame of :func:`_search`'s explicit stack."""
+
+
+@numba.njit(cache=True)
+def _search(T, H, root, alpha, beta, st):  # pragma: no cover - compiled
+    """The value of position ``root`` in the window ``(alpha, beta)`` (fail-soft, module
+    docstring); 0 when stopped (``st[ABORT]``; nothing is stored then).
+
+    Depth-first with an explicit stack of positions (numba cannot cache a recursive
+    function): a frame is a position, its commitments in the order tried and, for the one
+    being tried, its human node's replies. A frame's depth is at most the operations + 2
+    (each event completes one)."""
+    nw = T.side.shape[0]
+    width = root.shape[0]
+    D = T.label.shape[0] + 3
+    rows = np.empty((D, width), np.int64)
+    phase = np.zeros(D, np.int64)
+    lbh = np.full(D, -1, np.int64)  # a lower bound the parent computed, or -1
+    win_a = np.empty(D, np.int64)  # the call's window
+    win_b = np.empty(D, np.int64)
+    a_ = np.empty(D, np.int64)  # narrowed by the table
+    b_ = np.empty(D, np.int64)
+    slot = np.empty(D, np.int64)
+    first = np.empty(D, np.int64)
+    jc = np.empty(D, np.int64)  # next commitment (position in the order)
+    best = np.empty(D, np.int64)
+    best_i = np.empty(D, np.int64)
+    pruned = np.empty(D, np.int64)
+    ci = np.empty(D, np.int64)  # the commitment being tried
+    beta_h = np.empty(D, np.int64)
+    jr = np.empty(D, np.int64)  # next reply (position in the order)
+    v = np.empty(D, np.int64)  # the human node's max so far
+    cur_r = np.empty(D, np.int64)  # the reply whose child is being searched
+    commits_l = List()
+    est_l = List()
+    order_l = List()
+    rrows_l = List()
+    rdelta_l = List()
+    rlbs_l = List()
+    rby_l = List()
+    for _ in range(D):  # (made as the rules' kernels make them: the same array types)
+        commits_l.append(np.empty((1, nw), np.int64)[:0])
+        est_l.append(np.empty(0, np.int64))
+        order_l.append(np.empty(0, np.int64))
+        rrows_l.append(np.empty((1, width), np.int64)[:0])
+        rdelta_l.append(np.empty((1, 2), np.int64)[:0, 1])
+        rlbs_l.append(np.empty(0, np.int64))
+        rby_l.append(np.empty(0, np.int64))
+    if root[0] < 0:
+        return 0
+    d = 0
+    rows[0] = root
+    win_a[0], win_b[0], phase[0], lbh[0] = alpha, beta, ENTER, -1
+    ret = 0
+    while d >= 0:
+        p = phase[d]
+        if p == ENTER:
+            row = rows[d]
+            s_ = _entry(T, H, row, st, lbh[d])
+            if s_ < 0:
+                return 0
+            lo, hi = H.lo[s_], H.hi[s_]
+            if lo >= win_b[d] or lo == hi:
+                ret = lo
+                d -= 1
+                continue
+            if hi <= win_a[d]:
+                ret = hi
+                d -= 1
+                continue
+            st[NODES] += 1
+            if st[NODES] >= st[NODE_LIMIT]:
+                st[ABORT] = STOP_NODES
+                return 0
+            if (st[NODES] & TICK) == 0 and _tick(st):
+                return 0
+            slot[d] = s_
+            a_[d] = max(win_a[d], lo)
+            b_[d] = min(win_b[d], hi)
+            commits = commit_rows(T, row)
+            m = commits.shape[0]
+            est = np.empty(m, np.int64)
+            for i in range(m):
+                est[i] = _estimate(T, row, commits[i])
+            keep = _dominant(T, row, commits, est)
+            for i in range(m):
+                if not keep[i]:
+                    est[i] = INF
+            order = np.argsort(est, kind="mergesort")
+            f = H.move[s_]
+            if f >= 0 and f < m and keep[f]:  # the table's move first
+                k = 0
+                while order[k] != f:
+                    k += 1
+                for q in range(k, 0, -1):
+                    order[q] = order[q - 1]
+                order[0] = f
+            else:
+                f = -1
+            commits_l[d] = commits
+            est_l[d] = est
+            order_l[d] = order
+            first[d] = f
+            jc[d] = 0
+            best[d] = INF
+            best_i[d] = -1
+            pruned[d] = INF
+            phase[d] = NEXT_COMMIT
+            continue
+        if p == NEXT_COMMIT:
+            commits = commits_l[d]
+            est = est_l[d]
+            order = order_l[d]
+            m = commits.shape[0]
+            chosen = -1
+            while jc[d] < m:
+                i = order[jc[d]]
+                if est[i] >= min(b_[d], best[d]):
+                    if est[i] < pruned[d]:
+                        pruned[d] = est[i]
+                    if jc[d] == 0 and i == first[d]:
+                        jc[d] += 1
+                        continue  # the table's move went first out of order; the rest are sorted
+                    jc[d] = m
+                    break
+                chosen = i
+                jc[d] += 1
+                break
+            if chosen < 0 or best[d] <= a_[d]:
+                # finished: store the result (module docstring, rule 1)
+                bst = best[d]
+                if bst >= b_[d] and pruned[d] < bst:
+                    bst = pruned[d]
+                s_ = slot[d]
+                if bst <= a_[d]:
+                    H.hi[s_] = bst
+                    H.move[s_] = best_i[d]
+                elif bst >= b_[d]:
+                    if bst > H.lo[s_]:
+                        H.lo[s_] = bst
+                else:
+                    H.lo[s_] = bst
+                    H.hi[s_] = bst
+                    H.move[s_] = best_i[d]
+                ret = bst
+                d -= 1
+                continue
+            # The human node of the chosen commitment: the max over its replies.
+            ci[d] = chosen
+            beta_h[d] = min(b_[d], best[d])
+            ops, durs, dev, delta, rws = reply_rows(T, rows[d], commits[chosen])
+            n = delta.shape[0]
+            lbs = np.empty(n, np.int64)
+            key_r = np.empty(n, np.int64)
+            for r in range(n):
+                if rws[r, 0] < 0:
+                    lbs[r] = 0
+                else:
+                    jj = _find(H, key_of(T, rws[r]))
+                    lbs[r] = H.lo[jj] if jj >= 0 else lower_bound_of(T, rws[r])
+                key_r[r] = -(delta[r] + lbs[r])
+            rrows_l[d] = rws
+            rdelta_l[d] = delta
+            rlbs_l[d] = lbs
+            rby_l[d] = np.argsort(key_r, kind="mergesort")
+            jr[d] = 0
+            v[d] = -1 if n > 0 else INF  # (no reply: never taken)
+            phase[d] = NEXT_REPLY
+            continue
+        if p == NEXT_REPLY:
+            delta = rdelta_l[d]
+            n = delta.shape[0]
+            if jr[d] < n and v[d] < beta_h[d]:
+                r = rby_l[d][jr[d]]
+                dr = delta[r]
+                rws = rrows_l[d]
+                if rws[r, 0] < 0:  # the end: nothing more to do
+                    if dr > v[d]:
+                        v[d] = dr
+                    jr[d] += 1
+                    continue
+                cur_r[d] = r
+                phase[d] = AFTER_CHILD
+                c = d + 1
+                rows[c] = rws[r]
+                win_a[c] = max(a_[d], v[d]) - dr
+                win_b[c] = beta_h[d] - dr
+                lbh[c] = rlbs_l[d][r]
+                phase[c] = ENTER
+                d = c
+                continue
+            # the human node is done: its value is v[d]
+            if v[d] < best[d]:
+                best[d] = v[d]
+                best_i[d] = ci[d]
+                if d == 0:
+                    st[ROOT_BEST] = best[d]
+            phase[d] = NEXT_COMMIT
+            continue
+        # AFTER_CHILD: the child's value came back in ret
+        w = rdelta_l[d][cur_r[d]] + ret
+        if w > v[d]:
+            v[d] = w
+        jr[d] += 1
+        phase[d] = NEXT_REPLY
+    return ret
+
+
+# --------------------------------------------------------------------------- policy games
+
+
+@numba.njit(cache=True)
+def _choose(T, H, row, commits, kind, prefs, n_prefs, st):  # pragma: no cover - compiled
+    """The commitment (index) a policy of ``kind`` takes at ``row``; -1 when stopped."""
+    m = commits.shape[0]
+    if kind == ROBUST:
+        v = _search(T, H, row, -1, INF, st)
+        if st[ABORT]:
+            return -1
+        i = _find(H, key_of(T, row))
+        if H.move[i] < 0:  # exact by bounds alone (rule 3): search again for the move
+            H.hi[i] = INF
+            _search(T, H, row, v - 1, v + 1, st)
+            if st[ABORT]:
+                return -1
+        return H.move[i]
+    if kind == HYBRID:  # the table's move of the same state at the highest budget it has
+        other = row.copy()
+        for b in range(budget_cap_of(T, row), -1, -1):
+            other[1] = b
+            i = _find(H, key_of(T, other))
+            if i >= 0 and 0 <= H.move[i] < m:
+                return H.move[i]
+    if kind == SCHEDULE:
+        return _schedule_choice(T, row, commits, prefs, n_prefs)
+    best, best_i = INF, 0
+    for i in range(m):
+        e = _estimate(T, row, commits[i])
+        if e < best:
+            best, best_i = e, i
+    return best_i
+
+
+@numba.njit(cache=True)
+def _schedule_choice(T, row, commits, prefs, n_prefs):  # pragma: no cover - compiled
+    """:func:`asp.concurrent.schedule_rule` on a position: each free worker wants the first
+    operation of its list neither done nor running (alike ones by label); the commitment
+    with every free worker as wanted, else the most, ties by order."""
+    nw = T.side.shape[0]
+    s = row[0]
+    want = np.full(nw, NONE, np.int64)
+    for w in range(nw):
+        if row[2 + w] >= 0:
+            continue
+        want[w] = -1
+        for j in range(n_prefs[w]):
+            o = prefs[w, j]
+            if T.chain_of[o] >= 0:
+                # the list's j-th operation of its chain is done or running by count
+                c = T.chain_of[o]
+                rank = 0
+                for p in range(T.chain_len[c]):
+                    if T.chains[c, p] == o:
+                        rank = p
+                left = 0
+                for p in range(T.chain_len[c]):
+                    q = T.chains[c, p]
+                    if is_done(T, s, q) or _running(row, nw, q):
+                        left += 1
+                if rank >= left:
+                    want[w] = T.label[o]
+                    break
+            elif not is_done(T, s, o) and not _running(row, nw, o):
+                want[w] = o
+                break
+    best, best_score = 0, -1
+    for i in range(commits.shape[0]):
+        score = 0
+        exact = True
+        for w in range(nw):
+            if want[w] == NONE:
+                continue
+            got = commits[i, w]
+            got = got if got < 0 else T.label[got]
+            if got == want[w]:
+                score += 1
+            else:
+                exact = False
+        if exact:
+            score += 1000
+        if score > best_score:
+            best, best_score = i, score
+    return best
+
+
+@numba.njit(cache=True)
+def _running(row, nw, o):  # pragma: no cover - compiled
+    for w in range(nw):  # noqa: SIM110 - numba has no generator expressions
+        if row[2 + w] == o:
+            return True
+    return False
+
+
+@numba.njit(cache=True)
+def _node_row(row, kind, told, nw):  # pragma: no cover - compiled
+    """A position as :class:`asp.concurrent.NodeRows` reads a node:
+    ``[kind, state, budget, ops, remains, instructions]``."""
+    out = np.full(3 + 3 * nw, NONE, np.int64)
+    out[0] = kind
+    out[1] = row[0]
+    out[2] = row[1]
+    for w in range(nw):
+        out[3 + w] = row[2 + w]
+        out[3 + nw + w] = row[2 + nw + w]
+        out[3 + 2 * nw + w] = told[w]
+    return out
+
+
+@numba.njit(cache=True)
+def _policy_game(T, H, P, starts, kind, prefs, n_prefs, st, max_nodes):  # pragma: no cover
+    """The policy game of ``kind`` from the rows ``starts`` (module docstring).
+
+    Node 0 is the end; robot and human nodes alternate. Returns ``(ok, node rows, start
+    nodes, edge src, dst, cost, side, ops, durations, deviations)``; ``ok`` False when
+    stopped (``st[ABORT]``) or over ``max_nodes``."""
+    nw = T.side.shape[0]
+    width = 3 + 3 * nw
+    nodes = np.zeros((1024, width), np.int64)
+    nodes[0] = _node_row(np.full(2 + 2 * nw, -1, np.int64), 2, np.full(nw, NONE, np.int64), nw)
+    n = 1
+    cap_e = 1024
+    e_src = np.empty(cap_e, np.int64)
+    e_dst = np.empty(cap_e, np.int64)
+    e_cost = np.empty(cap_e, np.int64)
+    e_side = np.empty(cap_e, np.int64)
+    e_dev = np.empty(cap_e, np.int64)
+    e_ops = np.empty((cap_e, nw), np.int64)
+    e_dur = np.empty((cap_e, nw), np.int64)
+    m = 0
+    stack = np.empty((64, 2 + 2 * nw), np.int64)
+    top = 0
+    start_ids = np.empty(starts.shape[0], np.int64)
+    none = np.full(nw, NONE, np.int64)
+    for b in range(starts.shape[0]):
+        slot = _slot(P, key_of(T, starts[b]))
+        if P.keys[slot, 0] != 0:
+            start_ids[b] = P.lo[slot]
+            continue
+        P.keys[slot] = key_of(T, starts[b])
+        P.lo[slot] = n
+        if n >= nodes.shape[0]:
+            nodes = grow_rows(nodes, 2 * nodes.shape[0])
+        nodes[n] = _node_row(starts[b], 0, none, nw)
+        start_ids[b] = n
+        n += 1
+        if top >= stack.shape[0]:
+            stack = grow_rows(stack, 2 * stack.shape[0])
+        stack[top] = starts[b]
+        top += 1
+    while top > 0:
+        top -= 1
+        row = stack[top].copy()
+        v = P.lo[_slot(P, key_of(T, row))]
+        commits = commit_rows(T, row)
+        i = _choose(T, H, row, commits, kind, prefs, n_prefs, st)
+        if i < 0 or n + 1 >= max_nodes:
+            return False, nodes[:n], start_ids, e_src[:m], e_dst[:m], e_cost[:m], e_side[:m], \
+                e_ops[:m], e_dur[:m], e_dev[:m]  # fmt: skip
+        commit = commits[i]
+        cur, told = committed_row(T, row, commit)
+        u = n
+        if n >= nodes.shape[0]:
+            nodes = grow_rows(nodes, 2 * nodes.shape[0])
+        nodes[u] = _node_row(cur, 1, told, nw)
+        n += 1
+        ops, durs, dev, delta, rows = reply_rows(T, row, commit)
+        need = m + 1 + delta.shape[0]
+        if need > cap_e:
+            while cap_e < need:
+                cap_e *= 2
+            e_src, e_dst, e_cost = grow(e_src, cap_e), grow(e_dst, cap_e), grow(e_cost, cap_e)
+            e_side, e_dev = grow(e_side, cap_e), grow(e_dev, cap_e)
+            e_ops, e_dur = grow_rows(e_ops, cap_e), grow_rows(e_dur, cap_e)
+        e_src[m], e_dst[m], e_cost[m], e_side[m], e_dev[m] = v, u, 0, 0, 0
+        e_ops[m] = commit
+        e_dur[m] = NONE
+        m += 1
+        for r in range(delta.shape[0]):
+            t = 0
+            if rows[r, 0] >= 0:
+                key = key_of(T, rows[r])
+                slot = _slot(P, key)
+                if P.keys[slot, 0] != 0:
+                    t = P.lo[slot]
+                else:
+                    if n >= max_nodes:
+                        return False, nodes[:n], start_ids, e_src[:m], e_dst[:m], \
+                            e_cost[:m], e_side[:m], e_ops[:m], e_dur[:m], e_dev[:m]  # fmt: skip
+                    P.keys[slot] = key
+                    P.lo[slot] = n
+                    t = n
+                    if n >= nodes.shape[0]:
+                        nodes = grow_rows(nodes, 2 * nodes.shape[0])
+                    nodes[n] = _node_row(rows[r], 0, none, nw)
+                    n += 1
+                    if top >= stack.shape[0]:
+                        stack = grow_rows(stack, 2 * stack.shape[0])
+                    stack[top] = rows[r]
+                    top += 1
+            e_src[m], e_dst[m], e_cost[m], e_side[m], e_dev[m] = u, t, delta[r], 1, dev[r]
+            e_ops[m] = ops[r]
+            e_dur[m] = durs[r]
+            m += 1
+    return True, nodes[:n], start_ids, e_src[:m], e_dst[:m], e_cost[:m], e_side[:m], \
+        e_ops[:m], e_dur[:m], e_dev[:m]  # fmt: skip
+
+
+# --------------------------------------------------------------------------- Python side
+
+
+@dataclass
+class Limits:
+    """What the search may use: ``memory`` bytes (the table and the policy games),
+    ``max_nodes`` positions expanded, ``time_limit`` seconds (None: no limit)."""
+
+    memory: int = DEFAULT_MEMORY
+    max_nodes: int = DEFAULT_MAX_NODES
+    time_limit: float | None = None
+
+
+class Search:
+    """One search over a game's positions: the table, the counters, the limits.
+
+    Its table is shared by every budget and by the policy games built from it (the robust
+    policy's exact values, the hybrid policy's moves).
+    """
+
+    def __init__(self, rules: Rules, limits: Limits | None = None, *, progress: bool = False):
+        self.rules = rules
+        self.limits = limits or Limits()
+        kw = rules.key_words
+        # Half the memory for the search table, the rest for the policy games' tables
+        # and node arrays.
+        self.entries = table_entries(self.limits.memory // 2, kw)
+        if self.entries < MIN_ENTRIES:
+            from asp.errors import GameError
+
+            need = 2 * MIN_ENTRIES * (8 * kw + ENTRY_BYTES) / LOAD
+            raise GameError(
+                f"--max-memory: {self.limits.memory:,} bytes is too little for the concurrent "
+                f"search (at least {need:,.0f} bytes)"
+            )
+        self.table = new_table(self.entries, kw)
+        self.stats = np.zeros(N_STATS, dtype=np.int64)
+        self.stats[MAX_ENTRIES] = self.entries
+        self.stats[NODE_LIMIT] = self.limits.max_nodes
+        self.stats[PROGRESS] = int(progress)
+        self.t0 = time.perf_counter()
+        self.stats[T0] = int(self.t0 * 1000)
+        if self.limits.time_limit is not None:
+            self.stats[DEADLINE] = int((self.t0 + self.limits.time_limit) * 1000)
+
+    @property
+    def stopped(self) -> str | None:
+        """Why the search stopped (``"node limit"``, ``"memory limit"``, ``"time limit"``),
+        or None."""
+        return STOP_NAMES.get(int(self.stats[ABORT]))
+
+    @property
+    def nodes(self) -> int:
+        return int(self.stats[NODES])
+
+    @property
+    def positions(self) -> int:
+        return int(self.stats[ENTRIES])
+
+    def value(self, budget: int | None, lower: int = -1, upper: int = INF) -> int | None:
+        """``W*(budget)`` (scaled) searched in the window ``(lower, upper)`` where the caller
+        knows ``lower < W* < upper``; None when a limit stopped it."""
+        if self.stopped:
+            return None
+        row = self.rules.start(budget).row()
+        self.stats[BUDGET] = row[1]
+        self.stats[ROOT_BEST] = INF
+        v = _search(self.rules.tables, self.table, row, lower, upper, self.stats)
+        if self.stopped:
+            return None
+        if not lower < v < upper:  # the window was wrong: search it again in full
+            v = _search(self.rules.tables, self.table, row, -1, INF, self.stats)
+            if self.stopped:
+                return None
+        return int(v)
+
+    def value_at(self, pos) -> int | None:
+        """The exact value (scaled) of any position (:class:`asp.concurrent.rules.Position`),
+        None when a limit stopped the search."""
+        if self.rules.is_end(pos):
+            return 0
+        v = _search(self.rules.tables, self.table, pos.row(), -1, INF, self.stats)
+        return None if self.stopped else int(v)
+
+    def proven(self, budget: int | None) -> tuple[int, int]:
+        """The interval the table proves for the start of ``budget`` (scaled)."""
+        row = self.rules.start(budget).row()
+        i = _find(self.table, key_of(self.rules.tables, row))
+        if i < 0:
+            return int(lower_bound_of(self.rules.tables, row)), INF
+        return int(self.table.lo[i]), int(self.table.hi[i])
+
+    def policy_game(
+        self, budgets: list[int | None], kind: int, schedule: list[dict] | None = None
+    ) -> ConcurrentGame | None:
+        """The policy game of ``kind`` with a start per budget (None: ``k = inf``), or None
+        when a limit stopped it (module docstring)."""
+        rules = self.rules
+        t0 = time.perf_counter()
+        starts = np.array([rules.start(b).row() for b in budgets], dtype=np.int64)
+        prefs, n_prefs = schedule_lists(rules, schedule or [])
+        nw = rules.n_workers
+        kw = rules.key_words
+        # Bytes per policy-game node: its row, its table slot, and about two edges.
+        per_node = 8 * (3 + 3 * nw) + (8 * kw + ENTRY_BYTES) / LOAD + 2 * 8 * (5 + 2 * nw)
+        room = max(1024, int((self.limits.memory // 2) / per_node))
+        table = new_table(room, kw)
+        out = _policy_game(
+            rules.tables, self.table, table, starts, kind, prefs, n_prefs, self.stats, room
+        )
+        ok, rows, start_ids, src, dst, cost, side, e_ops, e_dur, e_dev = out
+        if not ok:
+            return None
+        edges = (src, dst, cost, side, e_ops, e_dur, e_dev)
+        return _as_game(rules, budgets, rows, start_ids, edges, t0)
+
+
+def schedule_lists(rules: Rules, rows: list[dict]) -> tuple[np.ndarray, np.ndarray]:
+    """Each worker's operations of a CP-SAT schedule in start order, alike operations named
+    by the rank of their start within their chain (:func:`_schedule_choice`)."""
+    model = rules.model
+    ids = {oid: i for i, oid in enumerate(model.spec.op_ids)}
+    names = {w.name: k for k, w in enumerate(model.workers)}
+    by_agent = {}
+    for k, w in enumerate(model.workers):
+        by_agent.setdefault(w.agent, []).append(k)
+    lists: list[list[int]] = [[] for _ in model.workers]
+    started: dict[int, int] = {}
+    t = rules.tables
+    for row in sorted(rows, key=lambda r: (float(r["start"]), str(r["task"]))):
+        o = ids[str(row["task"])]
+        c = int(t.chain_of[o])
+        if c >= 0:
+            rank = started.get(c, 0)
+            started[c] = rank + 1
+            o = int(t.chains[c, rank])
+        agent = str(row["agent"])
+        k = names.get(agent)
+        if k is None:  # an agent of side "any": the worker of the side that may do it
+            k = next((j for j in by_agent.get(agent, []) if t.ndur[j, o]), 0)
+        lists[k].append(o)
+    width = max((len(x) for x in lists), default=1)
+    prefs = np.zeros((len(lists), max(1, width)), dtype=np.int64)
+    n_prefs = np.array([len(x) for x in lists], dtype=np.int64)
+    for k, x in enumerate(lists):
+        prefs[k, : len(x)] = x
+    return prefs, n_prefs
+
+
+def _as_game(rules, budgets, rows, start_ids, edges, t0):
+    """A policy game's arrays as a :class:`asp.concurrent.build.ConcurrentGame`."""
+    model = rules.model
+    src, dst, cost, side, e_ops, e_dur, e_dev = edges
+    order = np.argsort(src, kind="stable")
+    src, dst, cost, side = src[order], dst[order], cost[order], side[order]
+    nodes = NodeRows(rows.astype(np.int64), model.humans)
+    actions = ActionRows(side.astype(np.int8), e_ops[order], e_dur[order], e_dev[order], cost)
+    levels = [UNBOUNDED if b is None else int(b) for b in budgets]
+    starts = {b: int(start_ids[i]) for i, b in enumerate(levels)}
+    edges = (src, dst, cost, side)
+    return game_of(model, levels, nodes, actions, starts, 0, edges, t0, GENERATOR)
+
+
+# --------------------------------------------------------------------------- the curve
+
+
+@dataclass(frozen=True, eq=False)
+class Curve:
+    """``W*(k)`` for ``k = 0..K`` and ``k = inf``, each exact or as a certified interval.
+
+    Attributes
+    ----------
+    lower, upper : tuple of float
+        ``L(k)`` and ``U(k)`` for ``k = 0..K`` then ``k = inf`` (spec units):
+        ``L(k) <= W*(k) <= U(k)``, equal where exact; both never fall as ``k`` grows.
+    bounds : tuple of float
+        The certified worst case of the plan's policy for the same budgets (``upper`` at
+        ``K``; ``W*(k)`` where exact). At ``inf``: the policy's own when its game has that
+        start, else ``upper``.
+    flat : bool
+        ``W*(K) = W*(inf)`` is proven (the curve stops there), else ``max_k`` or a limit
+        stopped it.
+    game : asp.concurrent.build.ConcurrentGame
+        The policy game of the plan's policy (its starts: budgets ``0..K``, and ``inf``
+        unless the policy is the exact one; the plan's ``K`` is the DAG's start), and
+        ``solution`` its exact solution: each state's bound is the policy's certified worst
+        case from it.
+    policy : str
+        ``"robust"`` (exact), ``"hybrid"``, ``"greedy"`` or ``"schedule"``: the certified
+        policy of least worst case at ``K``.
+    schedule_worst : list of {"k", "bound"}
+        The CP-SAT schedule's certified worst case per ``k`` (``None`` for ``inf``), empty
+        without a schedule or when its policy game was over the limits.
+    stopped : str or None
+        The limit that stopped the search (``"time limit"``, ...), None when exact.
+    nodes, positions : int
+        Positions the search expanded, and the table's entries.
+    seconds : float
+    """
+
+    lower: tuple[float, ...]
+    upper: tuple[float, ...]
+    bounds: tuple[float, ...]
+    flat: bool
+    game: ConcurrentGame
+    solution: object
+    policy: str
+    schedule_worst: list
+    stopped: str | None
+    nodes: int
+    positions: int
+    seconds: float
+
+    @property
+    def k(self) -> int:
+        """The plan's budget ``K``."""
+        return len(self.lower) - 2
+
+    @property
+    def exact(self) -> tuple[bool, ...]:
+        return tuple(lo == hi for lo, hi in zip(self.lower, self.upper, strict=True))
+
+    def gap(self, i: int) -> float:
+        """The gap of entry ``i`` in per cent of the upper bound."""
+        lo, hi = self.lower[i], self.upper[i]
+        return 0.0 if hi <= lo or hi <= 0 else 100.0 * (hi - lo) / hi
+
+    def to_list(self) -> list[dict]:
+        """``[{"k", "bound", "lower", "upper", "exact"}, ..., {"k": None, ...}]``: ``bound``
+        is the certified worst case of the plan's policy (``W*(k)`` where exact)."""
+        from asp.numbers import json_number
+
+        out = []
+        n = len(self.lower)
+        for i in range(n):
+            out.append(
+                {
+                    "k": None if i == n - 1 else i,
+                    "bound": json_number(self.bounds[i], 6),
+                    "lower": json_number(self.lower[i], 6),
+                    "upper": json_number(self.upper[i], 6),
+                    "exact": self.lower[i] == self.upper[i],
+                }
+            )
+        return out
+
+
+def solve_curve(
+    rules: Rules,
+    *,
+    max_k: int = 12,
+    min_k: int = 2,
+    limits: Limits | None = None,
+    schedule: list[dict] | None = None,
+    lower: float | None = None,
+    progress: bool = False,
+) -> Curve:
+    """``W*(k)`` for ``k = 0, 1, ...`` until it reaches ``W*(inf)`` (module docstring).
+
+    Parameters
+    ----------
+    max_k : int
+        The largest finite budget of the curve.
+    min_k : int
+        The curve goes at least this far (while ``<= max_k``), flat or not.
+    limits : Limits, optional
+        Memory, positions and seconds for the search (default :class:`Limits`).
+    schedule : list of dict, optional
+        A CP-SAT schedule (``{"task", "agent", "start"}`` rows), run as a plan: certified for
+        every ``k``, and one more policy for ``U`` when the search stops.
+    lower : float, optional
+        A proven lower bound of ``W*(0)`` (the CP-SAT bound), spec units.
+    progress : bool
+        A line on stderr per value found and every second of search.
+
+    Raises
+    ------
+    asp.errors.GameError
+        The memory allowed holds no search table, or no policy could be certified in it.
+    """
+    from asp.game.solve import solve
+
+    t0 = time.perf_counter()
+    search = Search(rules, limits, progress=progress)
+    scale = rules.scale
+    floor = int(np.ceil((lower or 0) * scale - 1e-9))
+    floor = max(floor, int(lower_bound_of(rules.tables, rules.start(0).row())))
+
+    def say(text: str) -> None:
+        if progress:
+            print(f"  {text} ({time.perf_counter() - t0:.1f} s)", file=sys.stderr, flush=True)
+
+    exact: dict = {}  # budget (None: inf) -> W* (scaled)
+    v0 = search.value(0, floor - 1)
+    if v0 is not None:
+        exact[0] = v0
+        say(f"W*(0) = {v0 / scale:g}")
+        top = search.value(None, v0 - 1)
+        if top is not None:
+            exact[None] = top
+            say(f"W*(inf) = {top / scale:g}")
+    k = 0
+    while None in exact and k < max_k and not (exact[k] == exact[None] and k >= min_k):
+        if exact[k] == exact[None]:
+            v = exact[None]  # flat from k on (the curve never falls, never passes W*(inf))
+        else:
+            v = search.value(k + 1, exact[k] - 1, exact[None] + 1)
+            if v is None:
+                break
+            say(f"W*({k + 1}) = {v / scale:g}")
+        exact[k + 1] = v
+        k += 1
+    finished = None in exact and (k == max_k or exact[k] == exact[None])
+    flat = None in exact and exact.get(k) == exact[None]
+    K = k if finished else min(max_k, max(min_k, k))  # stopped: the budgets reached so far
+    budgets = list(range(K + 1))
+    ks: list = [*budgets, None]
+    # The certified policies: the exact one when every value is known, else the others.
+    candidates = []
+    if finished:
+        game = search.policy_game(budgets, ROBUST)
+        if game is not None:
+            candidates.append(("robust", game))
+    if not candidates:
+        for name, kind in (("hybrid", HYBRID), ("greedy", GREEDY)):
+            game = search.policy_game([None, *budgets], kind)
+            if game is not None:
+                candidates.append((name, game))
+    sched_game = None
+    if schedule:
+        sched_game = search.policy_game([None, *budgets], SCHEDULE, schedule)
+        if sched_game is not None and candidates and candidates[0][0] != "robust":
+            candidates.append(("schedule", sched_game))
+    if not candidates:
+        from asp.errors import GameError
+
+        raise GameError(
+            f"--max-memory: {search.limits.memory:,} bytes certify no policy of this game "
+            "(each policy game was over the limit); allow more memory"
+        )
+    solved = []
+    for name, game in candidates:
+        sol = solve(game.dag)
+        values = {
+            (None if b == UNBOUNDED else b): float(sol.value[v, 0]) for b, v in game.starts.items()
+        }
+        solved.append((name, game, sol, values))
+    # U(k): the least certified worst case at k or at a larger budget (W* never falls);
+    # L(k): exact, else the best proven bound, never below L(k - 1).
+    upper, lows = [], []
+    for i, b in enumerate(ks):
+        later = ks[i:]
+        u = min((vals[c] for *_, vals in solved for c in later if c in vals), default=np.inf)
+        if b in exact:
+            u = min(u, exact[b] / scale)
+        upper.append(u)
+        lo = exact[b] if b in exact else max(search.proven(b)[0], floor)
+        lows.append(lo / scale)
+    lower_k = list(np.maximum.accumulate(lows))
+    upper_k = list(np.minimum.accumulate(upper[::-1])[::-1])
+    name, game, solution, values = min(solved, key=lambda x: (x[3][K], x[0] != "robust"))
+    bounds = [values.get(b, upper_k[i]) for i, b in enumerate(ks)]
+    schedule_worst = []
+    if sched_game is not None:
+        sol = solve(sched_game.dag)
+        schedule_worst = [
+            {"k": None if b == UNBOUNDED else b, "bound": float(sol.value[v, 0])}
+            for b, v in sorted(sched_game.starts.items(), key=lambda x: (x[0] == UNBOUNDED, x[0]))
+        ]
+    if progress and search.stopped:
+        worst = max(range(len(ks)), key=lambda i: upper_k[i] - lower_k[i])
+        say(
+            f"{search.stopped} reached: W*({K}) in [{lower_k[K]:g}, {upper_k[K]:g}], "
+            f"the largest gap {100 * (upper_k[worst] - lower_k[worst]) / upper_k[worst]:.1f} %"
+        )
+    return Curve(
+        lower=tuple(float(x) for x in lower_k),
+        upper=tuple(float(x) for x in upper_k),
+        bounds=tuple(float(x) for x in bounds),
+        flat=bool(flat),
+        game=game,
+        solution=solution,
+        policy=name,
+        schedule_worst=schedule_worst,
+        stopped=search.stopped,
+        nodes=search.nodes,
+        positions=search.positions,
+        seconds=time.perf_counter() - t0,
+    )
