@@ -16,7 +16,7 @@ import typer
 from asmplan.cli.app import app
 from asmplan.cli.graph import say
 from asmplan.cli.options import TurnModel, turn_model_option
-from asmplan.serve.limits import DEFAULT_MAX_SESSIONS, DEFAULT_TTL
+from asmplan.serve.limits import DEFAULT_MAX_DB_MB, DEFAULT_MAX_SESSIONS, DEFAULT_TTL
 
 LOCAL_HOSTS = ("127.0.0.1", "localhost", "::1")
 
@@ -113,6 +113,13 @@ def serve_command(
     fsync: bool = typer.Option(
         False, "--fsync", help="Wait for the disk at every event (survives a power cut)."
     ),
+    max_db_mb: float = typer.Option(
+        DEFAULT_MAX_DB_MB,
+        "--max-db-mb",
+        min=1,
+        max=1e7,
+        help="Largest size of the sessions database, MB (503 past it, nothing changed).",
+    ),
     study: Path | None = typer.Option(
         None, "--study", help="A study file (study.yaml): conditions, participants, questionnaire."
     ),
@@ -155,6 +162,7 @@ def serve_command(
         max_sessions=max_sessions,
         session_ttl=session_ttl,
         fsync=fsync,
+        max_db_mb=max_db_mb,
     )
     store = application.state.store
     for note in store.notes:

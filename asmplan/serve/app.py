@@ -41,6 +41,7 @@ from asmplan.advisor import Advisor, ObservationError
 from asmplan.serve.clock import clock_view
 from asmplan.serve.docs import add_docs
 from asmplan.serve.explain import add_explain_routes
+from asmplan.serve.limits import DEFAULT_MAX_DB_MB
 from asmplan.serve.meshes import base_parts, plan_meshes
 from asmplan.serve.sessions import (
     DEFAULT_MAX_SESSIONS,
@@ -203,11 +204,13 @@ def create_app(
     max_sessions: int = DEFAULT_MAX_SESSIONS,
     session_ttl: float = DEFAULT_TTL,
     fsync: bool = False,
+    max_db_mb: float = DEFAULT_MAX_DB_MB,
     clock=time.time,
 ) -> FastAPI:
     """The service for ``plans`` (plan documents), keeping its sessions in ``state_dir``
     (:class:`~asmplan.serve.sessions.SessionStore`: ``max_sessions`` open at once, aged out
-    after ``session_ttl`` seconds without an event, ``fsync`` at every commit).
+    after ``session_ttl`` seconds without an event, ``fsync`` at every commit, the database
+    at most ``max_db_mb`` MB).
 
     ``study``: a :class:`~asmplan.study.config.Study` (``asmplan serve --study``), served
     with ``variants``, ``(plan id, condition id) -> plan document``
@@ -230,6 +233,7 @@ def create_app(
         max_sessions=max_sessions,
         ttl=session_ttl,
         fsync=fsync,
+        max_db_mb=max_db_mb,
         clock=clock,
     )
     if study is not None:

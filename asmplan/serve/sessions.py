@@ -39,6 +39,9 @@ At most ``max_sessions`` sessions are open (not finished, not aged out) at once;
 refused (:class:`SessionLimit`, 429). A session with no event for ``ttl`` seconds ages out:
 it is closed (kept, exported, no more events: :class:`SessionClosed`, 410). Only open
 sessions are held in memory; a closed one is read back from the database when asked for.
+The database grows to at most ``max_db_mb`` MB (SQLite's page limit): past it every change
+is refused like one on a full disk (503 naming ``--max-db-mb``, nothing changed) while
+reads and the export go on.
 Session ids are made here (random hex); a request's id is only ever looked up, never turned
 into a path.
 """
@@ -61,7 +64,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from asmplan.advisor import Advisor, Event, ObservationError
-from asmplan.serve.limits import DEFAULT_MAX_SESSIONS, DEFAULT_TTL
+from asmplan.serve.limits import DEFAULT_MAX_DB_MB, DEFAULT_MAX_SESSIONS, DEFAULT_TTL
 from asp.atomic import remove_stale_temps
 
 SESSION_FORMAT = "asmplan-session/1"
@@ -263,6 +266,8 @@ class SessionStore:
     fsync : bool
         Wait for the disk at every commit (durable across a power cut), not only for the
         operating system (durable across a killed service).
+    max_db_mb : float
+        Largest size of ``sessions.db``, MB.
     clock : callable
         Wall-clock time (Unix seconds); tests give their own.
     """
@@ -275,12 +280,16 @@ class SessionStore:
         max_sessions: int = DEFAULT_MAX_SESSIONS,
         ttl: float = DEFAULT_TTL,
         fsync: bool = False,
+        max_db_mb: float = DEFAULT_MAX_DB_MB,
         clock=time.time,
     ):
         if max_sessions < 1:
             raise ValueError(f"max_sessions: expected at least 1, got {max_sessions}")
         if not ttl > 0:
             raise ValueError(f"session ttl: expected seconds > 0, got {ttl}")
+        if not max_db_mb > 0:
+            raise ValueError(f"max_db_mb: expected MB > 0, got {max_db_mb}")
+        self.max_db_mb = float(max_db_mb)
         self.folder = Path(folder)
         self.plans: dict[PlanKey, dict] = {
             (k if isinstance(k, tuple) else (k, None)): doc for k, doc in plans.items()
@@ -313,6 +322,8 @@ class SessionStore:
         db.execute("PRAGMA journal_mode=WAL")
         db.execute(f"PRAGMA synchronous={'FULL' if fsync else 'NORMAL'}")
         db.execute("PRAGMA wal_autocheckpoint=0")  # checkpoints run beside, not in a request
+        (page,) = db.execute("PRAGMA page_size").fetchone()
+        db.execute(f"PRAGMA max_page_count={max(1, int(self.max_db_mb * 1e6 // page))}")
         db.executescript(SCHEMA)
         version = db.execute("PRAGMA user_version").fetchone()[0]
         if version not in (0, STORE_FORMAT):
@@ -375,7 +386,21 @@ class SessionStore:
         except sqlite3.Error as exc:
             with contextlib.suppress(sqlite3.Error):
                 self._db.execute("ROLLBACK")
-            raise StorageError(f"the sessions database refused the change: {exc}") from exc
+            raise self._refused(exc) from exc
+
+    def _refused(self, exc: sqlite3.Error) -> StorageError:
+        """The :class:`StorageError` of a refused change, saying whether the database is at
+        its size cap (``--max-db-mb``) or the disk refused."""
+        with contextlib.suppress(sqlite3.Error):
+            (pages,) = self._db.execute("PRAGMA page_count").fetchone()
+            (cap,) = self._db.execute("PRAGMA max_page_count").fetchone()
+            if pages >= cap:
+                return StorageError(
+                    f"the sessions database is full: it reached its cap of "
+                    f"{self.max_db_mb:g} MB (--max-db-mb); export the sessions and serve "
+                    "another --sessions folder, or raise the cap"
+                )
+        return StorageError(f"the sessions database refused the change: {exc}")
 
     def _append_log(self, session: Session, change: dict) -> None:
         line = json.dumps({"session": session.id, "plan": session.plan_id, **change})
@@ -748,7 +773,7 @@ class SessionStore:
             try:
                 self._db.execute(insert, row)
             except sqlite3.Error as exc:
-                raise StorageError(f"the sessions database refused the change: {exc}") from exc
+                raise self._refused(exc) from exc
             return
         outcome = dict(session.outcome() or {})
         outcome["deviations"] = session.deviations + bool(record["deviation"])

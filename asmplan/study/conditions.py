@@ -10,9 +10,10 @@ A condition is a robot policy over the assembly's game (either turn model):
   :func:`asp.concurrent.robustness.schedule_rule`, which also tells the person the schedule's next
   operation);
 - ``ignores-person``: a scripted robot, the same rule over a list the study gives
-  (``script: {R1: [op, ...], ...}``; default: the robust plan's own line when the person
-  follows it, kept whatever she does);
-- ``{run: DIR}``: a policy learned by ``asmplan train`` on this game (its run folder).
+  (``script: {R1: [op, ...], ...}``, the person told the robust line's operations; default:
+  the robust plan's own line when the person follows it, kept whatever she does);
+- ``{run: DIR}``: a policy learned by ``asmplan train`` on this game (its run folder; in
+  the concurrent game learned against the unbounded adversary: :func:`learned_rule`).
 
 For each, :func:`condition_plan` evaluates the policy exactly against a best-response person
 (:func:`asp.game.solve.evaluate_policy`) and writes the plan document of that policy: its table
@@ -198,12 +199,18 @@ def _concurrent_plan(result, condition: Condition) -> dict:
     elif condition.robot == "run":
         from arl.trainer import load_policies
 
-        policy = load_policies(game.dag, condition.run)[0]
+        learned = load_policies(curve.adversary.dag, condition.run)[0]
+        rule = learned_rule(curve.adversary, learned, solution)
+        policy = policy_array(game, rule)
     else:
         if condition.robot == "cp-sat":
             rows = result.schedule.result.detail.get("schedule") or []
         else:
-            rows = _script_rows(condition.script) if condition.script else _bar_rows(plan)
+            rows = _bar_rows(plan)
+            if condition.script:  # the robots keep the script; the person is told the line
+                rows = _script_rows(condition.script) + [
+                    r for r in rows if r["agent"] not in condition.script
+                ]
         rule = schedule_rule(rows)
         policy = policy_array(game, rule)
     fixed = _fixed_solution(game.dag, solution, policy)
@@ -213,6 +220,46 @@ def _concurrent_plan(result, condition: Condition) -> dict:
     swapped = dataclasses.replace(curve, solution=fixed)
     doc = dataclasses.replace(result, concurrent=dataclasses.replace(plan, curve=swapped)).to_dict()
     return _tagged(doc, condition, worst)
+
+
+def learned_rule(adversary, policy: np.ndarray, solution):
+    """A learned robot of the concurrent game as a rule for a game with a deviation budget.
+
+    ``asmplan train --turn-model concurrent`` learns on the game against the unbounded
+    adversary (``adversary``; ``policy``: its robot edge per node), where the person is told
+    nothing. In a game with a budget the same robot node is the same state, running
+    operations and pending starts with a budget attached, and each robot edge also tells the
+    person what to do: the rule takes the edges that start what the learned robot starts
+    there and, of those, tells the person what the robust plan (``solution``, of the game
+    with the budget) would tell her given that start (the first edge where the learned game
+    has no such node)."""
+    from asp.game.rules import HUMAN
+
+    index = {_unbudgeted(key): v for v, key in enumerate(adversary.nodes) if key[0] == "R"}
+    robots = set(adversary.model.robots)
+
+    def rule(game, v: int, edges: list[int]) -> int:
+        u = index.get(_unbudgeted(game.nodes[v]))
+        if u is None or policy[u] < 0:
+            return edges[0]
+        wanted = adversary.actions[int(policy[u])].ops
+        same = [
+            e
+            for e in edges
+            if all(o == wanted[w] for w, o in enumerate(game.actions[e].ops) if w in robots)
+        ]
+        if not same:
+            return edges[0]
+        dag = game.dag
+        return min(same, key=lambda e: (solution.value[dag.targets[e], HUMAN], e))
+
+    return rule
+
+
+def _unbudgeted(key: tuple) -> tuple:
+    """A game node's key without its deviation budget (``(kind, state, running, budget,
+    pending)``)."""
+    return (key[0], key[1], key[2], key[4])
 
 
 def _bar_rows(plan) -> list[dict]:

@@ -338,6 +338,39 @@ def test_session_cap_and_age_out(tmp_path):
         assert c.get(f"/api/sessions/{a['id']}").json()["closed"] == "aged out"
 
 
+def test_the_database_stops_at_its_size_cap(tmp_path):
+    """``--max-db-mb``: past the cap every change is refused (503 naming the flag, the
+    session unchanged), reads and the export go on, and a restart serves what was taken."""
+    with running([PLAN], tmp_path, max_db_mb=0.08) as url, httpx.Client(base_url=url) as c:
+        refused, sid, before = None, None, None
+        for _ in range(500):
+            if sid is None:
+                r = c.post("/api/sessions", json={"plan": "cell"})
+                if r.status_code != 201:
+                    refused = r
+                    break
+                sid, advice = r.json()["id"], r.json()["advice"]
+            before = c.get(f"/api/sessions/{sid}").json()
+            r = c.post(f"/api/sessions/{sid}/events", json=_move(advice))
+            if r.status_code != 200:
+                refused = r
+                break
+            advice = r.json()
+            if advice["finished"]:
+                sid = None
+        assert refused is not None, "the cap never refused a change"
+        assert refused.status_code == 503, refused.text
+        assert "--max-db-mb" in refused.json()["detail"] and "0.08 MB" in refused.text
+        if sid is not None:
+            assert c.get(f"/api/sessions/{sid}").json() == before
+        assert c.get("/api/export.csv").status_code == 200
+        listed = c.get("/api/sessions").json()
+    assert (tmp_path / "sessions.db").stat().st_size <= 0.08e6
+    again = SessionStore(tmp_path, {"cell": PLAN})
+    assert [s["events"] for s in again.all()] == [s["events"] for s in listed]
+    again.close()
+
+
 def test_busy_port_fails_before_saying_it_serves(tmp_path):
     with socket.socket() as taken:
         taken.bind(("127.0.0.1", 0))

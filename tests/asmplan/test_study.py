@@ -275,3 +275,112 @@ def test_serve_study_from_the_command_line(tmp_path):
     text = "\n".join(lines)
     assert "choices-concurrent / schedule (cp-sat): worst case" in text
     assert "serving study 'Two robots'" in text
+
+
+# --------------------------------------------------------------------------- scripted and learned
+
+
+def _robot_starts(doc: dict, order: list[str]) -> tuple[list[str], float]:
+    """Play a concurrent plan with a person who starts what she can in ``order`` (else
+    lets the cell run): the operations the robots start, in order, and the makespan."""
+    from asmplan.advisor import Advisor
+
+    advisor = Advisor(doc)
+    advice, robots = advisor.advice(), []
+    while not advice.finished:
+        robots += [r["operation"] for r in advice.robots if r["operation"] not in robots]
+        mine = [o for o in advice.options if o["operation"] in order]
+        if mine:
+            o = min(mine, key=lambda o: order.index(o["operation"]))
+            ev = {"kind": "started", "operation": o["operation"], "agent": o["agent"]}
+            advice = advisor.observe({**ev, "duration": o["durations"][-1]})
+        else:
+            f = advice.finishes[0]
+            ev = {"kind": "finished", "operation": f["operation"], "agent": f["agent"]}
+            advice = advisor.observe({**ev, "time": f["time"]})
+    return robots, advice.elapsed
+
+
+def _worst(doc: dict) -> dict:
+    return {x["k"]: x["bound"] for x in doc["condition"]["worst_case"]}
+
+
+def test_the_robot_that_ignores_the_person_keeps_its_list(tmp_path):
+    """``ignores-person``: the robot keeps its script (given, or the robust plan's line)
+    whatever the person does, where the robust robot adapts; each is certified honestly."""
+    conditions = [
+        {"id": "robust", "robot": "robust"},
+        {"id": "line", "robot": "ignores-person"},
+        {"id": "script", "robot": "ignores-person", "script": {"R1": ["r", "s", "t"]}},
+    ]
+    study = load_study(write_study(tmp_path, conditions=conditions))
+    variants = study_plans(study, say=lambda _: None)
+    docs = {c: variants[("choices-concurrent", c)] for c in ("robust", "line", "script")}
+    assert docs["line"]["condition"]["robot"] == "ignores-person"
+    # the person follows the plan (p first): the line robot is the robust one
+    assert _robot_starts(docs["line"], ["p", "q", "r"]) == _robot_starts(
+        docs["robust"], ["p", "q", "r"]
+    )
+    # she does q first: the robust robot screws the cover first, the line robot waits for p
+    robust, robust_cost = _robot_starts(docs["robust"], ["q", "p", "r"])
+    line, line_cost = _robot_starts(docs["line"], ["q", "p", "r"])
+    assert robust == ["t", "s"] and line == ["s", "t"] and line_cost > robust_cost
+    for order in (["p", "q", "r"], ["q", "p", "r"], ["r", "q", "p"]):
+        assert _robot_starts(docs["script"], order)[0] == ["r", "s", "t"]
+    r = _worst(docs["robust"])
+    for c in ("line", "script"):
+        w = _worst(docs[c])
+        assert all(w[k] >= r[k] for k in r) and w[None] > r[None]
+        assert all(w[a] <= w[b] for a, b in itertools.pairwise([0, 1, 2, None]))
+
+
+@pytest.fixture(scope="module")
+def learned(tmp_path_factory):
+    """A study folder with one learned run per turn model (one training cycle each)."""
+    from asmplan.cli.app import main
+
+    tmp = tmp_path_factory.mktemp("learned")
+    write_study(tmp)
+    for turn in ("concurrent", "alternate"):
+        argv = ["train", str(tmp / "job"), "--turn-model", turn, "--config", "fast"]
+        argv += ["--output", str(tmp / f"run-{turn}"), "--no-progress", "--max-cycles", "1"]
+        with pytest.raises(SystemExit) as exit_info:
+            main(argv)
+        assert exit_info.value.code == 0
+    return tmp
+
+
+def test_a_learned_robot_is_served_with_its_certified_worst_case(learned, capsys):
+    """``{run: DIR}``: the policy ``asmplan train`` learned, served with the worst case
+    ``asmplan evaluate`` certifies for it, in either turn model; a game over HTTP ends
+    within it."""
+    from asmplan.cli.app import main
+
+    conditions = [{"id": "learned", "robot": {"run": "run-concurrent"}}]
+    plans = [{"source": "job", "turn_model": "concurrent"}]
+    study = load_study(write_study(learned, conditions=conditions, plans=plans))
+    concurrent = study_plans(study, say=lambda _: None)
+    conditions = [{"id": "learned", "robot": {"run": "run-alternate"}}]
+    plans = [{"source": "job", "turn_model": "alternate"}]
+    alternate = study_plans(
+        load_study(write_study(learned, conditions=conditions, plans=plans)), say=lambda _: None
+    )
+    for doc in [*concurrent.values(), *alternate.values()]:
+        turn = doc["turn_model"]
+        assert doc["condition"]["robot"].startswith("learned (")
+        argv = ["evaluate", str(learned / "job"), "--turn-model", turn, "--format", "json"]
+        with pytest.raises(SystemExit):
+            main([*argv, "--model", str(learned / f"run-{turn}")])
+        certified = json.loads(capsys.readouterr().out)["certified_wcpl"]
+        worst = _worst(doc)
+        assert worst[None] == certified, (turn, worst, certified)
+        assert doc["minimax"] == max(worst.values())
+    service = running([], learned / "state", study=study, variants=concurrent)
+    with service as url, httpx.Client(base_url=url) as c:
+        part = c.post("/api/participants", json={"participant": "P01"}).json()
+        start = c.get("/api/plans/choices-concurrent/advice", params={"condition": "learned"})
+        body = {"participant": "P01", "block": 0, "event": _next(start.json(), True)}
+        s = c.post("/api/sessions", json=body).json()
+        end = _finish(c, s["id"], s["advice"], True)
+    assert part["blocks"][0]["condition"] == "learned"
+    assert end["elapsed"] <= _worst(concurrent[("choices-concurrent", "learned")])[None]
