@@ -50,10 +50,6 @@ if TYPE_CHECKING:  # pragma: no cover - types only
 PLAN_FORMAT = "asmplan-plan/2"
 GRAPH_SUFFIXES = (".json", ".graphml", ".xml")
 """Suffixes read as a game DAG file rather than an assembly."""
-PLAN_FILES = ("plan.json", "dag.png", "report.html")
-"""The files ``asmplan plan`` writes (besides ``manifest.json``)."""
-CONCURRENT_FILES = ("robustness.png", "gantt_cooperative.png", "gantt_worst.png")
-"""The figures ``asmplan plan --turn-model concurrent`` adds (:mod:`asp.concurrent_plan`)."""
 
 Progress = Callable[[str], None]
 """A callback that shows one line of progress (e.g. prints it on stderr)."""
@@ -788,12 +784,17 @@ def plan(
 
 
 def write_plan(
-    result: AssemblyPlan, output: str | os.PathLike[str], *, on_step: Progress | None = None
+    result: AssemblyPlan,
+    output: str | os.PathLike[str],
+    *,
+    on_step: Progress | None = None,
+    force: bool = False,
 ) -> tuple[Path, ...]:
     """Write ``plan.json``, ``dag.png`` and ``report.html`` into ``output`` as one unit.
 
-    The files of one run are named by ``manifest.json``, written last; the previous run's
-    files are removed first, so the folder never mixes two runs (see
+    The files of one run are named by ``manifest.json``; the previous run's files (only
+    those its manifest names) are removed once this run is complete, and a folder holding
+    files asmplan did not write is refused unless ``force`` (see
     :class:`asp.atomic.OutputSet`). A failure removes what this run wrote.
 
     Returns
@@ -805,7 +806,7 @@ def write_plan(
     from asp.atomic import OutputSet
 
     played = result.played_game
-    with OutputSet(output, owns=PLAN_FILES + CONCURRENT_FILES) as out:
+    with OutputSet(output, force=force) as out:
         doc = result.to_dict()
         out.write_text("plan.json", json.dumps(doc, separators=(",", ":"), allow_nan=False) + "\n")
         game = played.policy

@@ -5,8 +5,9 @@ version (or nothing) in place. A temporary file is named ``.<target>.<pid>.<rand
 one left behind by a killed process is removed by :func:`remove_stale_temps` (which
 :class:`OutputSet` calls before a run writes into a folder).
 
-:class:`OutputSet` writes the files of one run into a folder as one unit: the manifest
-naming them is written last, so a folder with a manifest never mixes two runs.
+:class:`OutputSet` writes the files of one run into a folder as one unit: its manifest
+(asmplan's own format only) names the files asmplan wrote, so a rerun removes its own old
+files and nothing else, and a folder holding anyone else's files is refused unless forced.
 """
 
 from __future__ import annotations
@@ -90,16 +91,31 @@ MANIFEST = "manifest.json"
 MANIFEST_FORMAT = "asmplan-manifest/1"
 
 
+class ForeignFilesError(FileExistsError):
+    """An output folder that holds files asmplan did not write (``--force`` writes anyway)."""
+
+
 class OutputSet:
     """The files of one run, written into ``folder`` as one unit (a context manager).
 
-    On entry: leftover temporary files of killed writes are removed, then the previous
-    run's manifest and the files it names (and the names in ``owns``, the files this kind
-    of run always writes, for folders written before manifests existed). Each file is
-    written atomically; on a clean exit the manifest (``manifest.json``: ``{"format",
-    "files"}``) is written last. On an exception the files this run wrote are removed
-    again, so the folder holds either one complete run with its manifest or no run at all
-    (files not named by a manifest, e.g. the user's own, are never touched).
+    The manifest (``manifest.json``: ``{"format": "asmplan-manifest/1", "files",
+    "pending"}``) says which files of the folder asmplan wrote: ``files`` are one complete
+    run (each exists), ``pending`` the files of an unfinished or replaced run, still to be
+    removed. Only a manifest of this format counts: any other ``manifest.json`` is the
+    user's file like any other.
+
+    On entry: leftover temporary files of killed writes are removed, and a folder holding
+    any file the manifest does not name is refused (:class:`ForeignFilesError`, naming
+    the folder and a file) unless ``force`` (then those files are left alone, never
+    deleted; a ``manifest.json`` not of asmplan's format is refused even then).
+
+    Before this run's first file is written, the manifest switches atomically to "no
+    complete run; these files pending" (the previous run's and this run's names); each
+    file is written atomically; on a clean exit the stale files of the previous run are
+    removed and the manifest switches atomically to this run's files. A kill at any point
+    leaves a manifest whose ``files`` all exist and which names every file asmplan wrote,
+    so the next run cleans up. On an exception the files this run and the previous one
+    wrote are removed, so the folder holds one complete run with its manifest or no run.
 
     Example
     -------
@@ -112,24 +128,23 @@ class OutputSet:
         self,
         folder: str | os.PathLike[str],
         *,
-        owns: tuple[str, ...] = (),
+        force: bool = False,
         manifest: str = MANIFEST,
     ):
         self.folder = Path(folder)
-        self.owns = owns
+        self.force = force
         self.manifest = manifest
         self._names: list[str] = []
+        self._owned: list[str] = []  # files of earlier runs, from the manifest
+        self._claimed: set[str] = set()  # the names the manifest says are pending
         self._created = False
 
     def __enter__(self) -> OutputSet:
-        if self.folder.exists() and not self.folder.is_dir():
-            raise NotADirectoryError(f"{self.folder}: exists and is not a folder")
+        check_output_folder(self.folder, force=self.force, manifest=self.manifest)
         self._created = not self.folder.exists()
         self.folder.mkdir(parents=True, exist_ok=True)
         remove_stale_temps(self.folder)
-        for name in {*previous_files(self.folder, self.manifest), *self.owns}:
-            (self.folder / name).unlink(missing_ok=True)
-        (self.folder / self.manifest).unlink(missing_ok=True)
+        self._owned = owned_files(self.folder, self.manifest)
         return self
 
     def path(self, name: str) -> Path:
@@ -138,7 +153,16 @@ class OutputSet:
             raise ValueError(f"output name {name!r}: expected a plain file name")
         if name not in self._names:
             self._names.append(name)
+        self._claim()
         return self.folder / name
+
+    def _claim(self) -> None:
+        """Make the manifest name every file asmplan may have written here, before one is."""
+        pending = list(dict.fromkeys([*self._owned, *self._names]))
+        if self._claimed.issuperset(pending):
+            return
+        _write_manifest(self.folder / self.manifest, [], pending)
+        self._claimed = set(pending)
 
     def write_bytes(self, name: str, data: bytes) -> Path:
         return write_bytes(self.path(name), data)
@@ -153,24 +177,106 @@ class OutputSet:
 
     def __exit__(self, exc_type, exc, tb) -> None:
         if exc_type is not None:
-            for name in self._names:
+            for name in {*self._owned, *self._names}:
                 (self.folder / name).unlink(missing_ok=True)
+            (self.folder / self.manifest).unlink(missing_ok=True)
             remove_stale_temps(self.folder)
             if self._created and not any(self.folder.iterdir()):
                 self.folder.rmdir()
             return
         names = [p.name for p in self.written]
-        doc = {"format": MANIFEST_FORMAT, "files": names}
-        write_text(self.folder / self.manifest, json.dumps(doc, indent=1) + "\n")
+        stale = [n for n in {*self._owned, *self._names} if n not in names]
+        if stale:
+            self._claim()
+            for name in stale:
+                (self.folder / name).unlink(missing_ok=True)
+        _write_manifest(self.folder / self.manifest, names, [])
 
 
-def previous_files(folder: str | os.PathLike[str], manifest: str = MANIFEST) -> list[str]:
-    """The file names the manifest in ``folder`` lists (none when it is missing or broken)."""
+def _write_manifest(path: Path, files: list[str], pending: list[str]) -> None:
+    doc: dict = {"format": MANIFEST_FORMAT, "files": files}
+    if pending:
+        doc["pending"] = pending
+    write_text(path, json.dumps(doc, indent=1) + "\n")
+
+
+def _manifest_names(folder: Path, manifest: str, keys: tuple[str, ...]) -> list[str]:
+    try:
+        doc = json.loads((folder / manifest).read_text(encoding="utf-8"))
+    except (OSError, ValueError, RecursionError):
+        return []
+    if not isinstance(doc, dict) or doc.get("format") != MANIFEST_FORMAT:
+        return []
+    names: list[str] = []
+    for key in keys:
+        listed = doc.get(key, [])
+        if isinstance(listed, list):
+            names += [n for n in listed if _plain_name(n, manifest) and n not in names]
+    return names
+
+
+def _plain_name(name: object, manifest: str) -> bool:
+    return isinstance(name, str) and bool(name) and Path(name).name == name and name != manifest
+
+
+def is_own_manifest(folder: str | os.PathLike[str], manifest: str = MANIFEST) -> bool:
+    """Whether ``folder/manifest`` is a manifest of asmplan's own format and version."""
     try:
         doc = json.loads((Path(folder) / manifest).read_text(encoding="utf-8"))
     except (OSError, ValueError, RecursionError):
+        return False
+    return isinstance(doc, dict) and doc.get("format") == MANIFEST_FORMAT
+
+
+def previous_files(folder: str | os.PathLike[str], manifest: str = MANIFEST) -> list[str]:
+    """The complete run the manifest in ``folder`` lists (none when it is missing, broken
+    or not asmplan's own format)."""
+    return _manifest_names(Path(folder), manifest, ("files",))
+
+
+def owned_files(folder: str | os.PathLike[str], manifest: str = MANIFEST) -> list[str]:
+    """Every file asmplan's manifest in ``folder`` names: the complete run and the pending."""
+    return _manifest_names(Path(folder), manifest, ("files", "pending"))
+
+
+def foreign_files(folder: str | os.PathLike[str], manifest: str = MANIFEST) -> list[str]:
+    """The entries of ``folder`` asmplan did not write, sorted: neither named by its
+    manifest, nor the manifest itself (when of asmplan's format), nor a temporary file."""
+    folder = Path(folder)
+    if not folder.is_dir():
         return []
-    files = doc.get("files") if isinstance(doc, dict) else None
-    if not isinstance(files, list):
-        return []
-    return [n for n in files if isinstance(n, str) and n and Path(n).name == n and n != manifest]
+    ours = set(owned_files(folder, manifest))
+    if is_own_manifest(folder, manifest):
+        ours.add(manifest)
+    return sorted(
+        entry.name
+        for entry in folder.iterdir()
+        if entry.name not in ours and not _TEMP_NAME.match(entry.name)
+    )
+
+
+def check_output_folder(
+    folder: str | os.PathLike[str], *, force: bool = False, manifest: str = MANIFEST
+) -> None:
+    """Refuse an output folder holding files asmplan did not write, unless ``force``.
+
+    Raises :class:`ForeignFilesError` (a ``FileExistsError``) naming the folder and one
+    such file (and, even with ``force``, a folder whose ``manifest`` is someone else's:
+    writing ours would overwrite it); a folder that does not exist, is empty, or holds only
+    asmplan's own files passes. Commands call it before any work so a refusal costs nothing.
+    """
+    folder = Path(folder)
+    if folder.exists() and not folder.is_dir():
+        raise NotADirectoryError(f"{folder}: exists and is not a folder")
+    if (folder / manifest).exists() and not is_own_manifest(folder, manifest):
+        raise ForeignFilesError(
+            f"{folder}: holds a {manifest!r} that is not asmplan's (format "
+            f"{MANIFEST_FORMAT!r}); choose another folder (even --force would overwrite it)"
+        )
+    others = [] if force else foreign_files(folder, manifest)
+    if others:
+        more = f" and {len(others) - 1} more" if len(others) > 1 else ""
+        raise ForeignFilesError(
+            f"{folder}: holds {others[0]!r}{more}, not written by asmplan; choose an empty "
+            "or new folder, or pass --force to write beside them (they are never deleted)"
+        )

@@ -24,6 +24,7 @@ from asmplan.cli.options import (
     tolerance_option,
     turn_model_option,
 )
+from asp.atomic import check_output_folder
 from asp.schedule.assembly_makespan import AUTO_PATIENCE, AUTO_TIME_LIMIT
 
 AUTO_TIME_LIMIT_HELP = (
@@ -152,12 +153,20 @@ def plan_command(
     ),
     contact_tol: float | None = tolerance_option("contact_tol"),
     penetration_tol: float | None = tolerance_option("penetration_tol"),
+    force: bool = typer.Option(
+        False,
+        "--force",
+        help="Write into an --output folder that holds files asmplan did not write (they are "
+        "kept; without it such a folder is refused).",
+    ),
 ) -> None:
     """Plan an assembly end to end: relations, state graph, game, robust plan, CP-SAT."""
     from asmplan import pipeline
 
     t0 = time.perf_counter()
     check_output(output, folder=True)
+    if output is not None:
+        check_output_folder(output, force=force)
     result = pipeline.plan(
         assembly,
         cost=None if cost is None else cost.value,
@@ -176,6 +185,6 @@ def plan_command(
         typer.echo(line)
     if output is not None:
         say("[5/5] writing plan.json and the figures ...")
-        written = pipeline.write_plan(result, output, on_step=say)
+        written = pipeline.write_plan(result, output, on_step=say, force=force)
         typer.echo("wrote " + " and ".join(str(p) for p in written))
     say(f"done in {time.perf_counter() - t0:.1f} s")

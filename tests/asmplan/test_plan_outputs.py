@@ -59,13 +59,13 @@ def test_a_failure_mid_write_leaves_no_mixed_folder(pump_plan, tmp_path, monkeyp
 
     monkeypatch.setattr(plot, "draw_dag", killed)
     with pytest.raises(OSError, match="No space"):
-        pipeline.write_plan(pump_plan, tmp_path)
+        pipeline.write_plan(pump_plan, tmp_path, force=True)
     names = sorted(p.name for p in tmp_path.iterdir())
     assert names == ["mine.txt"], "no half run, no old run, the user's file kept"
     assert old_png  # the previous picture existed before the failed run
 
     monkeypatch.undo()
-    pipeline.write_plan(pump_plan, tmp_path)
+    pipeline.write_plan(pump_plan, tmp_path, force=True)
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
         ["mine.txt", "plan.json", "dag.png", "report.html", MANIFEST]
     )
@@ -106,10 +106,11 @@ def test_a_kill_inside_an_atomic_write_leaves_a_temp_file_the_next_run_removes(
     assert sorted(p.name for p in tmp_path.iterdir()) == [MANIFEST, "plan.json"]
 
 
-def test_a_folder_written_before_manifests_loses_its_old_picture(pump_plan, tmp_path):
-    (tmp_path / "dag.png").write_bytes(b"old")
-    (tmp_path / "plan.json").write_text("{}")
-    with OutputSet(tmp_path, owns=pipeline.PLAN_FILES) as out:
+def test_a_rerun_that_writes_fewer_files_removes_its_own_old_ones(tmp_path):
+    with OutputSet(tmp_path) as out:
+        out.write_text("plan.json", "{}")
+        out.write_bytes("dag.png", b"old")
+    with OutputSet(tmp_path) as out:
         out.write_text("plan.json", "{}")  # a run too large to draw writes no dag.png
     assert sorted(p.name for p in tmp_path.iterdir()) == [MANIFEST, "plan.json"]
 
@@ -143,3 +144,62 @@ def test_a_plan_that_lets_its_game_go_writes_the_same_files(pump_plan, tmp_path)
     pipeline.write_plan(lean, tmp_path / "lean")
     png = [(tmp_path / name / "dag.png").read_bytes() for name in ("kept", "lean")]
     assert png[0] == png[1]
+
+
+def test_plan_refuses_a_foreign_manifest_and_keeps_the_thesis(tmp_path):
+    """Issue 26 item 4: ``echo keep > D/thesis.tex`` and a ``manifest.json`` of another
+    format naming it; ``plan -o D`` (with or without --force) refuses and deletes nothing."""
+    (tmp_path / "thesis.tex").write_text("keep\n")
+    foreign = '{"format": "other/1", "files": ["thesis.tex"]}'
+    (tmp_path / MANIFEST).write_text(foreign)
+    for extra in ([], ["--force"]):
+        result = CliRunner().invoke(app, ["plan", str(PUMP), "-o", str(tmp_path), *extra])
+        assert result.exit_code == 2
+        assert f"{tmp_path}: holds a 'manifest.json' that is not asmplan's" in result.output
+    assert (tmp_path / "thesis.tex").read_text() == "keep\n"
+    assert (tmp_path / MANIFEST).read_text() == foreign
+
+
+def test_plan_refuses_a_folder_of_other_files_unless_forced(tmp_path):
+    (tmp_path / "robustness.png").write_bytes(b"mine")  # not written by asmplan
+    refused = CliRunner().invoke(app, ["plan", str(PUMP), "-o", str(tmp_path)])
+    assert refused.exit_code == 2
+    line = refused.output.strip()
+    assert "\n" not in line and f"{tmp_path}: holds 'robustness.png'" in line
+    forced = CliRunner().invoke(
+        app, ["plan", str(PUMP), "-o", str(tmp_path), "--force", "--time-limit", "1"]
+    )
+    assert forced.exit_code == 0, forced.output
+    assert (tmp_path / "robustness.png").read_bytes() == b"mine"
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        [MANIFEST, "plan.json", "dag.png", "report.html", "robustness.png"]
+    )
+
+
+def test_a_sigkill_right_after_step_5_leaves_a_folder_the_next_run_takes(tmp_path):
+    """Issue 26 item 5: ``asmplan plan`` killed (SIGKILL) as it prints ``[5/5]``: the
+    manifest never names a deleted file, and the next run needs no --force."""
+    import signal
+    import subprocess
+    import sys
+
+    command = [sys.executable, "-c", "from asmplan.cli import main; main()", "plan", str(PUMP)]
+    command += ["-o", str(tmp_path), "--time-limit", "1"]
+    (tmp_path / "old.png").write_bytes(b"old")  # a file of the previous run, not of this one
+    (tmp_path / MANIFEST).write_text(
+        json.dumps({"format": "asmplan-manifest/1", "files": ["old.png"]})
+    )
+    proc = subprocess.Popen(command, stderr=subprocess.PIPE, stdout=subprocess.DEVNULL, text=True)
+    for line in proc.stderr:
+        if line.startswith("[5/5]"):
+            proc.send_signal(signal.SIGKILL)
+            break
+    proc.wait(timeout=120)
+    assert proc.returncode == -signal.SIGKILL
+    doc = json.loads((tmp_path / MANIFEST).read_text())
+    assert all((tmp_path / name).is_file() for name in doc["files"]), doc
+    again = CliRunner().invoke(app, ["plan", str(PUMP), "-o", str(tmp_path), "--time-limit", "1"])
+    assert again.exit_code == 0, again.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
+        [MANIFEST, "plan.json", "dag.png", "report.html"]
+    )
