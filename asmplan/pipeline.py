@@ -256,7 +256,9 @@ class AssemblyPlan:
 # --------------------------------------------------------------------------- steps
 
 
-def load_assembly(source: str | os.PathLike[str]) -> AssemblySpec:
+def load_assembly(
+    source: str | os.PathLike[str], *, units: str | None = None, gravity: str | None = None
+) -> AssemblySpec:
     """Read and validate an assembly specification.
 
     Parameters
@@ -265,6 +267,8 @@ def load_assembly(source: str | os.PathLike[str]) -> AssemblySpec:
         A folder holding ``assembly.yaml``, the YAML itself, a Scholl ``.IN2`` graph, or a
         CAD file (STEP, glTF/GLB, 3MF, 3DXML) or folder of part meshes, whose spec is
         generated (``spec.generated``; :mod:`asp.generate`).
+    units, gravity : str, optional
+        ``--units`` (of mesh files that declare none) and ``--gravity``: replace the spec's.
 
     Returns
     -------
@@ -279,7 +283,7 @@ def load_assembly(source: str | os.PathLike[str]) -> AssemblySpec:
     """
     from asp.fromcad.generate import load_any
 
-    return load_any(source)
+    return load_any(source, units=units, gravity=gravity)
 
 
 def relations(spec: AssemblySpec, *, progress: bool = False) -> Relations | None:
@@ -308,6 +312,8 @@ def load(
     on_step: Progress | None = None,
     contact_tol: float | None = None,
     penetration_tol: float | None = None,
+    units: str | None = None,
+    gravity: str | None = None,
 ) -> Assembly:
     """:func:`load_assembly` and, when the spec has meshes, its :func:`relations`.
 
@@ -315,12 +321,16 @@ def load(
     warning; the decisions that need its relations (:func:`asp.generate.decide_generated`:
     build frame, gravity, base part, ``held`` placements of parts nothing can keep from
     falling) are each said in a note. ``contact_tol`` and
-    ``penetration_tol`` (mm) replace the spec's tolerances when given.
+    ``penetration_tol`` (mm) replace the spec's tolerances when given; ``units`` and
+    ``gravity`` replace the spec's (a given gravity is kept, not chosen). An assembly
+    implausibly small or large for its unit gets a note (:func:`cad.unit_hints.size_hint`).
     """
     from asp.fromcad.generate import decide_generated, spec_geometry
     from asp.graph.feasibility import load_relations
+    from cad.unit_hints import size_hint
 
-    spec = with_tolerances(load_assembly(source), contact_tol, penetration_tol)
+    spec = load_assembly(source, units=units, gravity=gravity)
+    spec = with_tolerances(spec, contact_tol, penetration_tol)
 
     def note(text: str) -> None:
         if on_step is not None:
@@ -341,8 +351,12 @@ def load(
         if on_step is not None:
             on_step(f"computing part relations of {len(spec.parts)} parts ...")
         geometry = spec_geometry(spec)
+        if size_hint(geometry):
+            note(f"units: {size_hint(geometry)}")
         rel = load_relations(spec, progress=progress, geometry=geometry)
-        decided = decide_generated(spec, rel, geometry, say=on_step, progress=progress)
+        decided = decide_generated(
+            spec, rel, geometry, say=on_step, progress=progress, given_gravity=bool(gravity)
+        )
         spec, rel = decided.spec, decided.relations
         for line in decided.notes():
             note(line)
@@ -661,6 +675,8 @@ def plan(
     contact_tol: float | None = None,
     penetration_tol: float | None = None,
     keep_game: bool = True,
+    units: str | None = None,
+    gravity: str | None = None,
 ) -> AssemblyPlan:
     """Plan an assembly end to end, as ``asmplan plan`` does.
 
@@ -689,6 +705,8 @@ def plan(
     contact_tol, penetration_tol : float, optional
         Tolerances in mm for every pair (default: the spec's, else the per-part rule of
         :mod:`cad.tolerances`); ignored when ``source`` is an :class:`Assembly`.
+    units, gravity : str, optional
+        ``--units`` and ``--gravity`` (:func:`load`); ignored for an :class:`Assembly`.
     keep_game : bool
         Keep the game DAG and its solution in the result. ``False`` (``asmplan plan``):
         once solved, what the outputs need of them is taken (:class:`PlayedGame`) and they
@@ -715,6 +733,8 @@ def plan(
             on_step=say,
             contact_tol=contact_tol,
             penetration_tol=penetration_tol,
+            units=units,
+            gravity=gravity,
         )
     )
     summary = relations_summary(assembly.relations) if assembly.relations is not None else []

@@ -168,8 +168,10 @@ def load_parts(
 
 
 def _record_mesh(row: PartRecord, base: Path, units: str | None):
-    """``(mesh in file units, unit, source text)`` of one record."""
-    name, _, node = str(row.file).partition("#")
+    """``(mesh in file units, unit, source text)`` of one record (``file#node``: one node
+    of a scene, unless a file of that whole name exists: ``bearing#1.stl``)."""
+    whole = (base / str(row.file)).is_file()
+    name, _, node = (str(row.file), "", "") if whole else str(row.file).partition("#")
     file = base / name
     if not file.exists():
         raise FileNotFoundError(f"mesh file of part {row.id!r} not found: {file}")

@@ -32,6 +32,16 @@ def unit_hint(assembly: Assembly, a: int, b: int) -> str:
         hint = part_scale_hint(assembly, k, other=b if k == a else a)
         if hint:
             return hint
+    return size_hint(assembly)
+
+
+def size_hint(assembly: Assembly) -> str:
+    """A sentence naming the unit that would fit when the whole assembly is implausibly
+    small (under :data:`MIN_PLAUSIBLE_MM` across: metres or inches read as millimetres)
+    or large (over :data:`MAX_PLAUSIBLE_MM`: millimetres declared as metres), else ``""``.
+    """
+    if not assembly.parts:
+        return ""
     lo = np.min([p.mesh.bounds[0] for p in assembly.parts], axis=0)
     hi = np.max([p.mesh.bounds[1] for p in assembly.parts], axis=0)
     size = float(np.linalg.norm(hi - lo))
@@ -43,7 +53,8 @@ def unit_hint(assembly: Assembly, a: int, b: int) -> str:
     if size > MAX_PLAUSIBLE_MM:
         return (
             f"the whole assembly is {size / 1000:.3g} m across: if its numbers are "
-            "millimetres, declare mm (export STL/OBJ and set units: mm)"
+            "millimetres, declare mm (--units mm for files that declare none, or export "
+            "it in mm)"
         )
     return ""
 

@@ -7,7 +7,7 @@ from pathlib import Path
 import typer
 
 from asmplan.cli.app import app
-from asmplan.cli.options import check_output, tolerance_option
+from asmplan.cli.options import check_output, gravity_option, tolerance_option, units_option
 
 
 @app.command("init")
@@ -21,6 +21,8 @@ def init_command(
     force: bool = typer.Option(False, "--force", help="Overwrite an existing spec file."),
     contact_tol: float | None = tolerance_option("contact_tol"),
     penetration_tol: float | None = tolerance_option("penetration_tol"),
+    units: str | None = units_option(),
+    gravity: str | None = gravity_option(),
 ) -> None:
     """Generate assembly.yaml from CAD: parts, a default cell (H, R1), one placement each."""
     import yaml
@@ -43,6 +45,8 @@ def init_command(
         penetration_tol=penetration_tol,
         on_note=lambda line: typer.echo(line, err=True),
         decide_units=cad_units,
+        units=units,
+        gravity=gravity,
     )
     # the text must read back as a valid spec before it is written
     spec = spec_from_dict(yaml.load(text, Loader=DecimalsAsText), source=str(output))  # noqa: S506

@@ -102,3 +102,23 @@ def check_output(path: Path | None, *, folder: bool) -> None:
             if not parent.is_dir():
                 raise NotADirectoryError(f"{path}: --output lies under {parent}, a file")
             return
+
+
+def units_option():
+    """``--units``: the length unit of mesh files that declare none (STL, OBJ, PLY)."""
+    return typer.Option(
+        None,
+        "--units",
+        help="Unit of mesh files that declare none (STL, OBJ, PLY): mm, cm, m, in, ... "
+        "(default: the spec's, else mm).",
+    )
+
+
+def gravity_option():
+    """``--gravity``: the direction of gravity in the build frame, overruling the choice."""
+    return typer.Option(
+        None,
+        "--gravity",
+        help="Direction of gravity (+x -x +y -y +z -z) in the build frame; overrules the "
+        "spec's, and the choice a generated spec makes from the geometry.",
+    )

@@ -19,10 +19,12 @@ from asmplan.cli.options import (
     TurnModel,
     check_output,
     finite_or_none,
+    gravity_option,
     seed_option,
     time_limit_option,
     tolerance_option,
     turn_model_option,
+    units_option,
 )
 from asp.atomic import check_output_folder
 from asp.schedule.assembly_makespan import AUTO_PATIENCE, AUTO_TIME_LIMIT
@@ -159,6 +161,8 @@ def plan_command(
         help="Write into an --output folder that holds files asmplan did not write (they are "
         "kept; without it such a folder is refused).",
     ),
+    units: str | None = units_option(),
+    gravity: str | None = gravity_option(),
 ) -> None:
     """Plan an assembly end to end: relations, state graph, game, robust plan, CP-SAT."""
     from asmplan import pipeline
@@ -179,6 +183,8 @@ def plan_command(
         max_states=max_states,
         contact_tol=contact_tol,
         penetration_tol=penetration_tol,
+        units=units,
+        gravity=gravity,
         keep_game=False,  # let the game go once solved: less memory for CP-SAT and the files
     )
     for line in plan_summary(result):

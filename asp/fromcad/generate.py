@@ -53,6 +53,7 @@ import numpy as np
 from asp.errors import SpecError
 from asp.numbers import json_number
 from asp.spec import SPEC_FILE, AssemblySpec, load_spec, spec_from_dict, with_subassemblies
+from cad.yamlfile import DecimalsAsText
 
 HUMAN_BASE_S = 3.0
 HUMAN_S_PER_MM = 1.0 / 25.0
@@ -205,17 +206,18 @@ def spec_hierarchy(spec: AssemblySpec) -> tuple[tuple[str, tuple[str, ...]], ...
     return tuple(out)
 
 
-def cad_assembly(path: str | Path):
+def cad_assembly(path: str | Path, units: str | None = None):
     """The geometry of a CAD file or a folder of part meshes (``cad.load_assembly``).
 
     A ``bom.csv``/``bom.yaml`` beside a scene file adds or overrides part data
-    (:func:`cad.loading.apply_bom`); in a folder of meshes it names the parts.
+    (:func:`cad.loading.apply_bom`); in a folder of meshes it names the parts. ``units``:
+    the unit of files that declare none (default mm).
     """
     from cad.bom import read_bom
     from cad.loading import BOM_NAMES, apply_bom, load_assembly
 
     path = Path(path)
-    assembly = load_assembly(path)
+    assembly = load_assembly(path, units=units)
     bom = next((path.parent / n for n in BOM_NAMES if (path.parent / n).is_file()), None)
     if path.is_file() and bom is not None:
         assembly = apply_bom(assembly, read_bom(bom), path.parent)
@@ -227,13 +229,15 @@ def spec_data(
     spec_folder: str | Path | None = None,
     gravity: str | None = None,
     frame=None,
+    units: str | None = None,
 ) -> tuple[dict, object]:
     """The generated spec of a CAD file or folder, as the YAML mapping, and its geometry.
 
     Part files are written relative to ``spec_folder`` (default: the CAD file's folder,
     or the folder of meshes itself); ``gravity`` defaults to the format's own down
     (:func:`asp.gravity.default_down`); ``frame`` (a rotation, :mod:`cad.frame`; None: the
-    file's own) is the build frame the parts are turned into, and written as ``frame:``.
+    file's own) is the build frame the parts are turned into, and written as ``frame:``;
+    ``units`` is the unit of mesh files that declare none (default mm; ``--units``).
 
     Returns
     -------
@@ -247,7 +251,7 @@ def spec_data(
 
     path = Path(path)
     gravity = gravity or default_down(path)
-    assembly = rotated(cad_assembly(path), frame)
+    assembly = rotated(cad_assembly(path, units), frame)
     shapes = shape_classes(assembly.parts)
     counts = Counter(shapes)
     if spec_folder is None:
@@ -289,7 +293,7 @@ def spec_data(
         )
     data = {
         "name": path.stem if path.is_file() else path.name,
-        "units": "mm",  # for files without a declared unit (the generated ones are read so)
+        "units": units or "mm",  # for files without a declared unit
         "parts": parts,
         "agents": {
             "H": {"side": "human", "description": "operator"},
@@ -319,21 +323,46 @@ def is_cad_input(path: str | os.PathLike[str]) -> bool:
     return path.is_file() and path.suffix.lower() in MESH_SUFFIXES
 
 
-def load_any(path: str | os.PathLike[str]) -> AssemblySpec:
+def load_any(
+    path: str | os.PathLike[str], *, units: str | None = None, gravity: str | None = None
+) -> AssemblySpec:
     """The spec of ``path``: generated for a CAD file or a folder of part meshes without an
-    ``assembly.yaml`` (:func:`generated_spec`), else read (:func:`asp.spec.load_spec`)."""
-    return generated_spec(path) if is_cad_input(path) else load_spec(path)
+    ``assembly.yaml`` (:func:`generated_spec`), else read (:func:`asp.spec.load_spec`).
+
+    ``units`` (the unit of mesh files that declare none) and ``gravity`` (``--units``,
+    ``--gravity``) replace the spec's own when given; a generated spec's gravity given so
+    is kept (:func:`decide_generated` is told by the caller).
+    """
+    check_overrides(units, gravity)
+    if is_cad_input(path):
+        return generated_spec(path, gravity=gravity, units=units)
+    spec = load_spec(path)
+    changes = {"units": units, "gravity": gravity}
+    return replace(spec, **{k: v for k, v in changes.items() if v is not None})
 
 
-def generated_spec(path: str | Path, gravity: str | None = None, frame=None) -> AssemblySpec:
+def check_overrides(units: str | None, gravity: str | None) -> None:
+    """One-line errors for an unknown ``--units`` or a ``--gravity`` that is no direction."""
+    from asp.spec import DIRECTIONS
+    from cad.units import unit_scale
+
+    if units is not None:
+        unit_scale(units)
+    if gravity is not None and gravity not in DIRECTIONS:
+        raise SpecError(f"--gravity: expected one of {' '.join(DIRECTIONS)}, got {gravity!r}")
+
+
+def generated_spec(
+    path: str | Path, gravity: str | None = None, frame=None, units: str | None = None
+) -> AssemblySpec:
     """The spec generated from a CAD file or a folder of part meshes (``generated=True``).
 
     Its ``source`` is the spec file it stands for (``assembly.yaml`` beside the CAD file,
-    which need not exist), so that part files resolve as in the written spec. ``gravity``
-    and ``frame``: as :func:`spec_data` takes them.
+    which need not exist), so that part files resolve as in the written spec. ``gravity``,
+    ``frame`` and ``units``: as :func:`spec_data` takes them.
     """
     path = Path(path)
-    data, _ = spec_data(path, gravity=gravity, frame=frame)
+    data, _ = spec_data(path, gravity=gravity, frame=frame, units=units)
     folder = path if path.is_dir() else path.parent
     spec = spec_from_dict(data, source=str(folder / SPEC_FILE))
     return replace(spec, generated=True, source=str(path))
@@ -348,20 +377,26 @@ def gravity_choice(relations, geometry, default: str):
     return choose_gravity(relations, bounds, default)
 
 
-def orient_generated(spec: AssemblySpec, relations, geometry, turn=None):
+def orient_generated(spec: AssemblySpec, relations, geometry, turn=None, given: bool = False):
     """A generated spec with the gravity :mod:`asp.gravity` chooses, and the choice.
 
     When the choice differs from the spec's (the format's own down), the spec is
     generated again along it (base part and operation order follow gravity) by
     ``turn(gravity, frame)`` (default: :func:`generated_spec` of the spec's source), in the
-    spec's build frame. A user's spec, or one without relations, is returned unchanged
-    with None.
+    spec's build frame. ``given``: the spec's gravity was given (``--gravity``): it is
+    kept, and the choice says what the geometry would have chosen. A user's spec, or one
+    without relations, is returned unchanged with None.
     """
     import warnings
 
     if not spec.generated or relations is None or getattr(relations, "sp", None) is None:
         return spec, None
-    choice = gravity_choice(relations, geometry, spec.gravity)
+    from asp.fromcad.gravity import default_down
+
+    own = default_down(spec.source) if given else spec.gravity  # the format's down
+    choice = gravity_choice(relations, geometry, own)
+    if given:
+        return spec, replace(choice, given=spec.gravity)
     if choice.gravity == spec.gravity:
         return spec, choice
     with warnings.catch_warnings():  # the same files again: their warnings were given
@@ -374,7 +409,9 @@ def orient_generated(spec: AssemblySpec, relations, geometry, turn=None):
 def _regenerate(spec: AssemblySpec):
     """``turn(gravity, frame)``: ``spec``'s source generated again along another gravity
     or in another build frame (tolerances are kept by the callers)."""
-    return lambda gravity, frame: generated_spec(spec.source, gravity=gravity, frame=frame)
+    return lambda gravity, frame: generated_spec(
+        spec.source, gravity=gravity, frame=frame, units=spec.units
+    )
 
 
 @dataclass(frozen=True)
@@ -418,7 +455,7 @@ class Decisions:
         if self.frame is not None:
             out.append(f"generated spec: frame: {self.frame.text}")
         if self.gravity is not None:
-            out.append(f"generated spec: gravity {self.gravity.gravity}: {self.gravity.reason}")
+            out.append(f"generated spec: gravity {self.spec.gravity}: {self.gravity.reason}")
         if self.rebased:
             out.append(self.rebased)
         if self.held and self.spec.generated:
@@ -427,7 +464,14 @@ class Decisions:
 
 
 def decide_generated(
-    spec: AssemblySpec, relations, geometry, turn=None, *, say=None, progress: bool = False
+    spec: AssemblySpec,
+    relations,
+    geometry,
+    turn=None,
+    *,
+    say=None,
+    progress: bool = False,
+    given_gravity: bool = False,
 ) -> Decisions:
     """The decisions of a generated spec that need its relations, in this order: the build
     frame (:func:`asp.framing.choose_frame`: only when some pair of parts can never be
@@ -440,11 +484,12 @@ def decide_generated(
     along another gravity or in another frame (default: from the spec's source). Use the
     returned ``relations`` (in the chosen frame) from then on. ``say`` is called with a line
     before each candidate frame's relations are computed (``progress``: their bars).
+    ``given_gravity``: the spec's gravity was given (``--gravity``) and is kept.
     """
     from asp.fromcad.framing import choose_frame
 
     turn = turn or _regenerate(spec)
-    decided = _decide_in_frame(spec, relations, geometry, turn)
+    decided = _decide_in_frame(spec, relations, geometry, turn, given_gravity)
 
     def in_frame(rotation) -> Decisions:
         """The decisions in another build frame (its relations computed afresh)."""
@@ -461,16 +506,18 @@ def decide_generated(
             progress=progress,
         )
         tolerances = {"contact_tol": spec.contact_tol, "penetration_tol": spec.penetration_tol}
-        framed = replace(turn(None, rotation), **tolerances)
-        return _decide_in_frame(framed, rel, geo, turn)
+        framed = replace(turn(spec.gravity if given_gravity else None, rotation), **tolerances)
+        return _decide_in_frame(framed, rel, geo, turn, given_gravity)
 
     choice, chosen = choose_frame(decided, geometry, in_frame)
     return replace(chosen or decided, frame=choice)
 
 
-def _decide_in_frame(spec: AssemblySpec, relations, geometry, turn) -> Decisions:
+def _decide_in_frame(
+    spec: AssemblySpec, relations, geometry, turn, given_gravity: bool = False
+) -> Decisions:
     """Gravity, base part and ``held`` of a generated spec, its frame as given."""
-    oriented, choice = orient_generated(spec, relations, geometry, turn)
+    oriented, choice = orient_generated(spec, relations, geometry, turn, given_gravity)
     decided, rebased = workable_base(oriented, relations)
     return Decisions(decided, choice, rebased, relations, geometry)
 
@@ -483,6 +530,8 @@ def spec_text(
     penetration_tol: float | None = None,
     on_note=None,
     decide_units=None,
+    units: str | None = None,
+    gravity: str | None = None,
 ) -> str:
     """The generated spec of a CAD file or folder as a commented ``assembly.yaml``.
 
@@ -493,13 +542,19 @@ def spec_text(
     gravity, base part, ``held``). ``decide_units(spec,
     relations)`` (:func:`asp.units.cad_units`, given by the caller: it sits above this
     module) decides which of the file's sub-assemblies are written as ``subassemblies:``;
-    without it they are all written commented.
+    without it they are all written commented. ``units`` (of mesh files that declare
+    none) and ``gravity`` (kept, not chosen): ``--units`` and ``--gravity``.
     """
     from dataclasses import replace
 
     import cad
+    from cad.unit_hints import size_hint
 
-    data, assembly = spec_data(path, spec_folder)
+    check_overrides(units, gravity)
+    data, assembly = spec_data(path, spec_folder, gravity=gravity, units=units)
+    size_note = size_hint(assembly)
+    if size_note and on_note is not None:
+        on_note(f"units: {size_note}")
     relations = cad.compute_relations(
         assembly, contact_tol=contact_tol, penetration_tol=penetration_tol
     )
@@ -507,13 +562,13 @@ def spec_text(
 
     def turn(gravity: str | None, frame) -> AssemblySpec:
         """The spec along another gravity or in another frame, keeping its records."""
-        records = spec_data(path, spec_folder, gravity=gravity, frame=frame)
+        records = spec_data(path, spec_folder, gravity=gravity, frame=frame, units=units)
         turned[(records[0]["gravity"], frame)] = records
         return replace(spec_from_dict(records[0], source=str(path)), generated=True)
 
     tolerances = {"contact_tol": contact_tol, "penetration_tol": penetration_tol}
     generated = replace(spec_from_dict(data, source=str(path)), generated=True, **tolerances)
-    decided = decide_generated(generated, relations, assembly, turn)
+    decided = decide_generated(generated, relations, assembly, turn, given_gravity=bool(gravity))
     spec, relations = decided.spec, decided.relations
     # the records along the chosen gravity, in the chosen frame
     data, assembly = turned.get((spec.gravity, spec.frame), (data, assembly))
@@ -539,6 +594,7 @@ def spec_text(
         f"name: {_scalar(data['name'])}",
         f"units: {data['units']}   # of mesh files that declare none (STL, OBJ, PLY); "
         "STEP, glTF, 3MF declare their own",
+        *([f"#   {size_note}"] if size_note else []),
         "",
         "parts:   # id: used in operations; file: the mesh (file#part: one part of a scene);",
         "         # shape: shared by identical parts (the same shape up to a rigid motion)",
@@ -559,7 +615,7 @@ def spec_text(
         "  H: {side: human, description: operator}",
         "  R1: {side: robot, description: robot arm with a gripper}",
         "",
-        f"base_part: {data['base_part']}      # placed first: "
+        f"base_part: {_scalar(data['base_part'])}      # placed first: "
         + (
             f"no complete sequence starts from {generated.base_part}, the lowest large part"
             if decided.rebased
@@ -583,7 +639,8 @@ def spec_text(
             lines.append(f"    # held: {HELD_REASON}")
         lines.append(
             f"  - {{id: {_scalar(op.id)}, description: {_scalar(op.description)}, "
-            f"agents: {{{agents}}}, part: {op.parts[0]}" + (", held: true}" if op.held else "}")
+            f"agents: {{{agents}}}, part: {_scalar(op.parts[0])}"
+            + (", held: true}" if op.held else "}")
         )
     return "\n".join(lines) + "\n"
 
@@ -598,7 +655,7 @@ def _hierarchy_lines(data: dict, assembly, relations, spec_folder, decide) -> li
             "# The file's sub-assemblies: uncomment to build each on its own",
             "# subassemblies:",
         ]
-        return lines + [f"#   {gid}: [{', '.join(ms)}]" for gid, ms in assembly.groups]
+        return lines + [f"#   {_scalar(gid)}: {_id_list(ms)}" for gid, ms in assembly.groups]
     folder = os.path.abspath(spec_folder)  # it may not exist yet: join the paths as text
     parts = []
     for record in data["parts"]:
@@ -618,11 +675,11 @@ def _hierarchy_lines(data: dict, assembly, relations, spec_folder, decide) -> li
     ]
     turned, loose = _unit_ways(spec, relations, used)
     for u in choices:
-        entry = f"{u.id}: [{', '.join(u.members)}]"
+        entry = f"{_scalar(u.id)}: {_id_list(u.members)}"
         if u.id in turned or u.id in loose:
             more = f", gravity: {turned[u.id]}" if u.id in turned else ""
             more += ", held: true" if u.id in loose else ""
-            entry = f"{u.id}: {{parts: [{', '.join(u.members)}]{more}}}"
+            entry = f"{_scalar(u.id)}: {{parts: {_id_list(u.members)}{more}}}"
             if u.id in turned:
                 entry += "   # built upside down, then turned over and inserted"
             if u.id in loose:
@@ -680,18 +737,43 @@ def _tolerance_line(key: str, value: float | None, meaning: str) -> str:
 
 
 def _scalar(value) -> str:
-    """A YAML flow scalar: plain when safe, else double-quoted."""
+    """A YAML flow scalar that reads back as ``value``: plain when safe, else double-quoted.
+
+    A string is written plain only when YAML reads it back as that same string (not
+    ``01``, ``yes``, ``null``, ``1e3``, ``1.10``: those would come back as numbers,
+    booleans or None) and it holds no flow or comment syntax; every id written goes
+    through here.
+    """
     import json
 
+    import yaml
+
+    if isinstance(value, int | float) and not isinstance(value, bool):
+        return str(value) if math.isfinite(value) else json.dumps(str(value))
     text = str(value)
     plain = (
         text
         and text[0].isalpha()
         and all(c.isalnum() or c in " _-./()#" for c in text)
-        and text.lower() not in ("yes", "no", "true", "false", "null", "on", "off", "y", "n")
+        and text.isascii()
         and not text.endswith(" ")
         and " #" not in text
+        and _reads_as(text, yaml.SafeLoader)
+        and _reads_as(text, DecimalsAsText)
     )
-    if isinstance(value, int | float) and not isinstance(value, bool):
-        return str(value) if not math.isnan(value) else json.dumps(text)
     return text if plain else json.dumps(text)
+
+
+def _reads_as(text: str, loader) -> bool:
+    """Whether ``text`` written plain reads back as the string ``text`` under ``loader``."""
+    import yaml
+
+    try:
+        return yaml.load(f"k: {text}", Loader=loader) == {"k": text}  # noqa: S506
+    except yaml.YAMLError:
+        return False
+
+
+def _id_list(ids) -> str:
+    """A YAML flow list of ids, each quoted where needed (``[a, "01"]``)."""
+    return "[" + ", ".join(_scalar(i) for i in ids) + "]"

@@ -74,6 +74,8 @@ class GravityChoice:
         Along the default no order exists even with every part held: a part is blocked
         whatever the gravity (two helical gears on their shafts), so a switch says it builds
         the product lying on its side, not that the file is another axis up.
+    given : str
+        The gravity the user gave (``--gravity``; ``""``: none); it overrules the choice.
     """
 
     gravity: str
@@ -82,10 +84,13 @@ class GravityChoice:
     held_large: dict[str, int]
     feasible: dict[str, bool | None]
     blocked_anyway: bool = False
+    given: str = ""
 
     @property
     def reason(self) -> str:
         """Why this direction, in one line (stderr and ``asmplan init``'s comment)."""
+        if self.given:
+            return f"given (--gravity); from the geometry alone: {self.gravity}"
         g, d = self.gravity, self.default
         own = "glTF is +y up by its specification" if d == "-y" else "z up"
         if g == d:
