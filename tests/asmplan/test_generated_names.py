@@ -109,7 +109,9 @@ def test_units_option_on_init_and_plan(tmp_path):
     result = init(folder, tmp_path / "a.yaml", "--units", "m")
     assert "units: m " in (tmp_path / "a.yaml").read_text()
     assert "mm across" not in result.stderr
-    planned = CliRunner().invoke(app, ["plan", str(folder), "--units", "m", "-o", str(tmp_path / "p")])
+    planned = CliRunner().invoke(
+        app, ["plan", str(folder), "--units", "m", "-o", str(tmp_path / "p")]
+    )
     assert planned.exit_code == 0, planned.output
     assert "mm across" not in planned.stderr
     bad = CliRunner().invoke(app, ["plan", str(folder), "--units", "parsec"])
