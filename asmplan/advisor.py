@@ -39,7 +39,8 @@ in ``alike_parts``). The bound is the plan's: a symmetry keeps every cost.
 Advice that explains itself (both turn models): each option carries the robots' reply to it
 (``reply``), the worst line it leads to (``line``: every operation still to come, with its
 start and end, when the person then does the worst she can) and a sentence saying so
-(``why``); ``ahead`` is the line from now on when the person follows the instructions (the
+(``why``), and so does each completion the person may let the cell run to (concurrent:
+``finishes``); ``ahead`` is the line from now on when the person follows the instructions (the
 Gantt chart of the plan ahead). The lines are the plan file's own (:func:`line_moves`).
 """
 
@@ -84,6 +85,28 @@ def option_why(option: dict, cost: str | None) -> str:
         f"If you {verb} {option['operation']} now, {then}; the worst that can still happen is "
         f"{worst}."
     )
+
+
+def finish_why(finish: dict, cost: str | None) -> str:
+    """The sentence that explains a completion the person may let the cell run to: what the
+    robots do then and the worst that can still happen (``If you let R1 finish 6 at 12 s,
+    R1 starts 7; the worst that can still happen is 52 s.``)."""
+    at = quantity(finish["time"], cost)
+    reply = finish.get("reply")
+    if reply is None:
+        then = "the robots go on as planned"
+    elif not reply["robots"]:
+        then = "the robots wait"
+    else:
+        then = " and ".join(f"{r['agent']} starts {r['operation']}" for r in reply["robots"])
+    op = finish["operation"]
+    when = (
+        f"If you finish {op} at {at} ({finish['agent']}) and start nothing more"
+        if finish.get("side") == "human"
+        else f"If you let {finish['agent']} finish {op} at {at} and start nothing more"
+    )
+    worst = quantity(finish["worst"], cost)
+    return f"{when}, {then}; the worst that can still happen is {worst}."
 
 
 def placed_parts(operations: dict[str, dict], done: list[str]) -> list[str]:
@@ -187,8 +210,9 @@ class Advice:
         "description"}``, ``operation`` None: wait).
     finishes : list of dict
         Concurrent: the completions the plan can explain next, given the people's starts so
-        far (``{"operation", "agent", "time", "worst"}``: the operation finishing, at which
-        time, and the guaranteed makespan after it); empty while a free person must still
+        far (``{"operation", "agent", "side", "time", "worst"}``: the operation finishing,
+        by whom, at which time, and the guaranteed makespan after it; explained, also
+        ``reply``, ``line`` and ``why`` as an option's); empty while a free person must still
         start something.
     budget : int or None
         Concurrent: deviations the person may still make (None: unbounded).
@@ -293,7 +317,11 @@ class Advisor:
         so :meth:`observe` answers :meth:`advice` and a page asks for this one."""
         advice = self._physical(self._canonical_advice(explain=True))
         cost = self.plan.get("cost")
-        return replace(advice, options=[{**o, "why": option_why(o, cost)} for o in advice.options])
+        return replace(
+            advice,
+            options=[{**o, "why": option_why(o, cost)} for o in advice.options],
+            finishes=[{**f, "why": finish_why(f, cost)} for f in advice.finishes],
+        )
 
     # ------------------------------------------------------------------ explanations
     def _explained(self, i: int, j: int, elapsed: float) -> dict:
@@ -720,7 +748,7 @@ class ConcurrentAdvisor(Advisor):
             deviations=self._deviations,
             turn_model="concurrent",
             instructions=instructions,
-            finishes=self._finishes(),
+            finishes=self._finishes(explain),
             budget=states["budget"][i],
             ahead=self._ahead(b) if explain else [],
         )
@@ -773,16 +801,18 @@ class ConcurrentAdvisor(Advisor):
             out.append(item)
         return out
 
-    def _finishes(self) -> list[dict]:
-        """The completions the plan can explain next (every branch, given the starts)."""
+    def _finishes(self, explain: bool = False) -> list[dict]:
+        """The completions the plan can explain next (every branch, given the starts), each
+        with the worst case after it (``explain``: and :meth:`Advisor._explained` of the move
+        that leads to it: the robots' reply when it comes, the worst line from there)."""
         moves, states = self._policy["moves"], self._policy["states"]
         out: dict = {}
         for br in self._branches:
             pending = set(br.pending)
             for o, a in br.unreported:
-                out[(o, a, br.elapsed)] = max(
-                    out.get((o, a, br.elapsed), -math.inf), br.elapsed + self._bound(br.state)
-                )
+                key, w = (o, a, br.elapsed), br.elapsed + self._bound(br.state)
+                if w > out.get(key, (-math.inf, None))[0]:
+                    out[key] = (w, None)
             if br.unreported:
                 continue
             running = self._running(br.state) | pending
@@ -790,11 +820,20 @@ class ConcurrentAdvisor(Advisor):
                 t = br.elapsed + moves["cost"][m]
                 after = t + states["bound"][moves["next"][m]]
                 for o, a in running - self._running(moves["next"][m]):
-                    out[(o, a, t)] = max(out.get((o, a, t), -math.inf), after)
-        return [
-            {"operation": self._ops[o], "agent": self._agents[a], "time": t, "worst": w}
-            for (o, a, t), w in sorted(out.items(), key=lambda kv: (kv[0][2], kv[0][:2]))
-        ]
+                    if after > out.get((o, a, t), (-math.inf, None))[0]:
+                        out[(o, a, t)] = (after, (br, m))
+        items = []
+        for (o, a, t), (w, where) in sorted(out.items(), key=lambda kv: (kv[0][2], kv[0][:2])):
+            item = {"operation": self._ops[o], "agent": self._agents[a]}
+            item.update(side="robot" if self._robot[a] else "human", time=t, worst=w)
+            if explain:
+                item.update(
+                    {"reply": None, "line": []}
+                    if where is None
+                    else self._explained(where[0].state, where[1], where[0].elapsed)
+                )
+            items.append(item)
+        return items
 
     # ------------------------------------------------------------------ observing
     def _take(self, ev: Event) -> None:

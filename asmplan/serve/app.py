@@ -256,8 +256,8 @@ def create_app(
     add_docs(app, "asmplan advisor")
     add_explain_routes(app, store, store.plans)
     app.state.store = store
-    _page_routes(app, by_id, store.plans)
     speed = study.speed if study is not None and realtime is None else realtime
+    _page_routes(app, by_id, store.plans, speed)
     _session_routes(app, store, items, study, speed)
     if study is not None:
         from asmplan.study.routes import add_study_routes
@@ -271,9 +271,10 @@ def create_app(
     return app
 
 
-def _page_routes(app: FastAPI, by_id: dict[str, dict], served: dict) -> None:
+def _page_routes(app: FastAPI, by_id: dict[str, dict], served: dict, speed) -> None:
     """The page, its files and the plans (read only; ``served``: ``(plan id, condition)``
-    -> plan document, a study's conditions included)."""
+    -> plan document, a study's conditions included; ``speed``: the real-time clock's
+    speed of new sessions, None: the game waits for events)."""
     meshes: dict[str, dict] = {}
     static_dir = resources.files("asmplan.serve").joinpath("static")
 
@@ -304,7 +305,8 @@ def _page_routes(app: FastAPI, by_id: dict[str, dict], served: dict) -> None:
     @app.get("/api/plans/{pid}")
     def get_plan(pid: str, condition: str | None = None) -> dict:
         """One plan: metrics, operations, parts, agents, the principal and worst lines (of a
-        study's ``condition``: that robot's)."""
+        study's ``condition``: that robot's), and ``realtime``: the speed of its sessions'
+        clock (game seconds per wall-clock second; null: the game waits for events)."""
         plan = _plan(pid) if condition is None else served.get((pid, condition))
         if plan is None:
             raise HTTPException(404, f"unknown plan {pid!r} or condition {condition!r}")
@@ -318,6 +320,7 @@ def _page_routes(app: FastAPI, by_id: dict[str, dict], served: dict) -> None:
             operations=plan.get("operations", {}),
             robust_plan=plan.get("robust_plan", []),
             worst_line=plan.get("worst_line", []),
+            realtime=speed,
         )
         return out
 

@@ -13,7 +13,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from asmplan.advisor import Advisor, option_why, quantity
+from asmplan.advisor import Advisor, finish_why, option_why, quantity
 from tests.asmplan.plans import CHOICES, alike_plan, cell_plan, concurrent_plan, with_ranges
 from tests.asp.helpers_assembly import pin_roller_ring
 
@@ -90,6 +90,29 @@ def _check_options(doc, advisor):
     return advice
 
 
+def _check_finishes(doc, advisor):
+    """Each completion the person may let the cell run to: the robots' reply then, the
+    worst line (ending at its worst case) and the sentence saying both."""
+    advice = advisor.explain()
+    plain = advisor.advice()
+    strip = [{k: v for k, v in f.items() if k not in EXPLAINED} for f in advice.finishes]
+    assert strip == plain.finishes
+    for f in advice.finishes:
+        assert f["why"] == finish_why(f, doc.get("cost"))
+        assert quantity(f["worst"], doc.get("cost")) in f["why"] and f["agent"] in f["why"]
+        if not f["line"]:  # a completion at this very instant, not reported yet
+            continue
+        running = [advice.elapsed + r["remaining"] for r in advice.running]
+        assert max([e["end"] for e in f["line"]] + running) == pytest.approx(f["worst"])
+        reply = f["reply"]
+        robots = [_move(e) for e in f["line"] if e["side"] == "robot" and e["start"] == f["time"]]
+        if reply is not None:
+            assert reply["time"] == f["time"]
+            assert [_move(r) for r in reply["robots"]] == robots
+            said = " and ".join(f"{r['agent']} starts {r['operation']}" for r in reply["robots"])
+            assert (said or "the robots wait") in f["why"]
+
+
 @pytest.mark.parametrize("name", sorted(PLANS))
 @settings(max_examples=25, deadline=None)
 @given(data=st.data())
@@ -103,6 +126,8 @@ def test_every_option_explains_itself_in_random_games(name, data):
             continue
         if advice.options:
             _check_options(doc, advisor)
+        if advice.finishes:
+            _check_finishes(doc, advisor)
         if advice.options and (not advice.finishes or data.draw(st.booleans())):
             option = data.draw(st.sampled_from(advice.options))
             event = {"kind": "started", **_move(option)}

@@ -6,7 +6,9 @@
 
 const state = { plan: null, condition: null, planInfo: null, meshes: {}, session: null,
                 advice: null, bars: [], lastParts: [], busy: false, open: {},
-                deviated: new Set(), study: null, participant: null, block: null };
+                deviated: new Set(), study: null, participant: null, block: null,
+                speed: null, clock: null, clockAt: 0, seen: -1, poll: null, logged: new Set() };
+const POLL_MS = 300;  // real time: how often the page asks the service for its clock
 
 // Plotly with nothing that leaves the machine: no "Share chart" (plotly.js 4 uploads the
 // chart, meshes included, to Plotly's cloud), no link to plotly's site, no server to send to.
@@ -125,8 +127,14 @@ async function openPlan(plan, condition, title) {
   document.getElementById("concurrent-panel").hidden = !isConcurrent();
   document.getElementById("finishes-panel").hidden = !isConcurrent();
   state.meshes = await api("GET", `/api/plans/${encodeURIComponent(plan)}/meshes`);
+  stopPoll();
   Object.assign(state, { session: null, advice: null, bars: [], lastParts: [], open: {},
-                         deviated: new Set() });
+                         deviated: new Set(), speed: state.planInfo.realtime || null,
+                         clock: null, seen: -1, logged: new Set() });
+  document.getElementById("realtime").hidden = !state.speed;
+  document.getElementById("finishes-title").textContent = state.speed
+    ? "If you start nothing: what the cell does next (the clock finishes operations)"
+    : "Next completion (what happens next in the cell)";
   delete document.body.dataset.session;
   document.getElementById("robot-log").replaceChildren();
   document.getElementById("last-move").textContent = "";
@@ -146,25 +154,65 @@ async function resume(sid, title) {
   const view = await api("GET", `/api/sessions/${encodeURIComponent(sid)}`);
   await openPlan(view.plan, view.condition || null, title);
   useSession(view.id);
+  rebuild(view);
+  document.getElementById("last-move").textContent =
+    `Resumed: ${view.events.length} event(s) so far.`;
+  if (view.advice.finished) return show(view.advice);
+  if (state.speed) startPoll();
+  return show(await explained(view.advice));
+}
+
+// The Gantt chart's bars and the robots' log from a session's events (a reload, or the
+// real-time clock, whose completions come between the page's looks): a completion with no
+// start seen ends a bar that began its duration earlier (the robots' starts are not events
+// in the concurrent game).
+function rebuild(view) {
+  const bars = [], open = {};
   let last = 0;
   for (const e of view.events) {
     const who = e.by === "robot" ? "robot" : "human";
     if (e.kind === "started") {
-      state.open[e.operation] = { agent: e.agent, operation: e.operation, start: e.elapsed, who,
-                                  deviation: !!e.deviation };
-    } else if (state.open[e.operation]) {
-      state.bars.push({ ...state.open[e.operation], end: e.elapsed });
-      delete state.open[e.operation];
+      open[e.operation] = { agent: e.agent, operation: e.operation, start: e.elapsed, who,
+                            deviation: !!e.deviation };
+      if (e.deviation) state.deviated.add(e.operation);
+    } else if (open[e.operation]) {
+      bars.push({ ...open[e.operation], end: e.elapsed });
+      delete open[e.operation];
     } else {
-      state.bars.push({ agent: e.agent, operation: e.operation, start: last, end: e.elapsed, who,
-                        deviation: !!e.deviation });
+      const d = duration(e.operation, e.agent);
+      const start = d === null ? last : Math.max(0, e.elapsed - d);
+      bars.push({ agent: e.agent, operation: e.operation, start, end: e.elapsed, who,
+                  deviation: !!e.deviation });
     }
     last = e.elapsed;
   }
-  document.getElementById("last-move").textContent =
-    `Resumed: ${view.events.length} event(s) so far.`;
-  if (view.advice.finished) return show(view.advice);
-  return show(await explained(view.advice));
+  for (const r of view.advice.running || []) {  // started by the robots' commitment
+    if (open[r.operation]) continue;
+    const d = duration(r.operation, r.agent);
+    open[r.operation] = { agent: r.agent, operation: r.operation, who: sideOf(r.agent),
+                          start: d === null ? view.advice.elapsed
+                            : view.advice.elapsed - (d - r.remaining),
+                          deviation: state.deviated.has(r.operation) };
+  }
+  state.bars = bars;
+  state.open = open;
+  state.seen = view.events.length;
+  const robots = [...bars, ...Object.values(open)].filter((b) => b.who === "robot")
+    .sort((a, b) => a.start - b.start);
+  for (const b of robots) {
+    const key = `${b.operation}|${b.agent}`;
+    if (state.logged.has(key)) continue;
+    state.logged.add(key);
+    logRobot({ "data-op": b.operation, "data-agent": b.agent, "data-time": b.start },
+      `t = ${qty(b.start)}: ${b.agent} starts ${b.operation} (${describe(b.operation)})`);
+  }
+}
+
+// An agent's duration for an operation in the plan (null: not known).
+function duration(op, agent) {
+  const info = (state.planInfo.operations || {})[op];
+  const d = info && info.agents ? info.agents[agent.split(":")[0]] : undefined;
+  return typeof d === "number" ? d : null;
 }
 
 function useSession(sid) {
@@ -233,13 +281,16 @@ async function explained(advice) {
   return api("GET", `/api/sessions/${state.session}/explain`);
 }
 
-// An event: the session's next, or the first move, which makes the session.
+// An event: the session's next, or the first move, which makes the session (real time,
+// robots first: no event, the clock makes their moves).
 async function send(event) {
   if (state.session) return api("POST", `/api/sessions/${state.session}/events`, event);
-  const body = state.study ? { participant: state.participant, block: state.block, event }
-    : { plan: state.plan, event };
+  const body = state.study ? { participant: state.participant, block: state.block }
+    : { plan: state.plan };
+  if (event) body.event = event;
   const view = await api("POST", "/api/sessions", body);
   useSession(view.id);
+  if (state.speed) startPoll();
   return view.advice;
 }
 
@@ -262,6 +313,12 @@ async function show(advice) {
   const options = document.getElementById("options");
   options.replaceChildren();
   if (advice.finished) return finish(advice);
+  if (state.speed) showClock();
+  if (advice.turn === "robot" && state.speed) {  // the clock starts and finishes them
+    setStatus("the robots are working: the clock runs");
+    if (!state.session) await send(null);
+    return ready();
+  }
   if (advice.turn === "robot") {
     setStatus("the robots are working ...");
     const move = advice.robots[0];
@@ -270,12 +327,19 @@ async function show(advice) {
     await record(move, "robot");
     return;
   }
-  setStatus("your turn: choose what you do next (marked: what the plan asks)");
+  if (state.speed && advice.running.length) {
+    const r = advice.running[0];
+    setStatus(`you (${r.agent}) are doing ${r.operation}: the clock runs until it is done`);
+    return ready();
+  }
+  setStatus(state.speed ? "your turn: choose what you do next; the clock waits for you"
+    : "your turn: choose what you do next (marked: what the plan asks)");
   for (const opt of advice.options) {
     const asked = advice.instruction !== null && advice.instruction.operation === opt.operation &&
       advice.instruction.agent === opt.agent;
     options.append(optionBlock(opt, asked, (op) => {
       noteMove(opt, op, asked);
+      if (state.speed) return post({ kind: "started", operation: op, agent: opt.agent });
       return record({ ...opt, operation: op }, "human");
     }));
   }
@@ -330,9 +394,10 @@ function labelled(text, control) {
 }
 
 // The line behind an option's worst case, step by step (opened on request).
-function lineDetails(opt) {
+function lineDetails(opt, after) {
   const details = el("details", { class: "line", "data-op": opt.operation });
-  details.append(el("summary", {}, `why ${qty(opt.worst)}? the worst line after ${opt.operation}`));
+  details.append(el("summary", {},
+    `why ${qty(opt.worst)}? the worst line after ${after || opt.operation}`));
   const list = el("ol");
   for (const s of opt.line) {
     const who = s.side === "robot" ? s.agent : `${s.agent} (person)`;
@@ -430,12 +495,14 @@ async function showConcurrent(advice) {
   const fresh = state.advice === null || state.advice.state !== advice.state ||
     state.advice.elapsed !== advice.elapsed;
   state.advice = advice;
-  trackBars(advice);
+  if (!state.speed) trackBars(advice);
   showNumbers(advice);
   document.getElementById("clock").textContent = qty(advice.elapsed);
   drawView(advice);
   drawGantt();
-  if (fresh && !advice.finished) {  // a new event: the robots' commitment
+  if (state.speed) {
+    showClock();
+  } else if (fresh && !advice.finished) {  // a new event: the robots' commitment
     if (!advice.robots.length) {
       logRobot({ "data-time": advice.elapsed, class: "wait" },
         `t = ${qty(advice.elapsed)}: the robots wait`);
@@ -445,10 +512,7 @@ async function showConcurrent(advice) {
         `t = ${qty(advice.elapsed)}: ${r.agent} starts ${r.operation} (${r.description})`);
     }
   }
-  const running = document.getElementById("running");
-  running.replaceChildren(...advice.running.map((r) =>
-    el("li", { "data-op": r.operation, "data-agent": r.agent },
-      `${r.agent}: ${r.operation} ${describe(r.operation)} (${qty(r.remaining)} left)`)));
+  showRunning(advice.elapsed);
   const told = advice.instructions.map((i) => i.operation === null
     ? `${i.agent}: wait` : `${i.agent}: ${i.operation} ${i.description}${alikeNote(i)}`);
   document.getElementById("instruction").textContent = told.length
@@ -470,20 +534,133 @@ async function showConcurrent(advice) {
       return post({ kind: "started", operation: op, agent: opt.agent, duration });
     }));
   }
-  for (const f of advice.finishes) {
-    const button = el("button", { type: "button", "data-kind": "finish", "data-op": f.operation,
-                                  "data-agent": f.agent, "data-time": f.time,
-                                  "data-worst": f.worst });
-    button.append(el("span", {}, `${f.agent} finishes ${f.operation} at ${qty(f.time)}: `));
-    button.append(el("span", { class: "worst" }, `worst case ${qty(f.worst)}`));
-    button.addEventListener("click", () =>
-      post({ kind: "finished", operation: f.operation, agent: f.agent, time: f.time }));
-    finishes.append(button);
+  for (const f of advice.finishes) finishes.append(finishBlock(f));
+  if (state.speed) {
+    setStatus(advice.finishes.length
+      ? "the cell runs: start an operation when you choose, or let it run"
+      : "the clock waits for you: start an operation");
+  } else {
+    setStatus(advice.finishes.length
+      ? "start an operation, or let the cell run to its next completion"
+      : "start an operation (you do not idle while you have something to do)");
   }
-  setStatus(advice.finishes.length
-    ? "start an operation, or let the cell run to its next completion"
-    : "start an operation (you do not idle while you have something to do)");
   ready();
+}
+
+// A completion the person may let the cell run to: what it is and the worst case after
+// it, the robots' reply then (why), and the line behind the worst case on request. In real
+// time the clock makes it (no button: it says what happens if she starts nothing).
+function finishBlock(f) {
+  const block = el("div", { class: "option finish" });
+  const attrs = { "data-kind": "finish", "data-op": f.operation, "data-agent": f.agent,
+                  "data-time": f.time, "data-worst": f.worst };
+  const who = f.side === "human" ? `you (${f.agent}) finish` : `${f.agent} finishes`;
+  const what = el("span", { class: "what" }, `${who} ${f.operation} at ${qty(f.time)}`);
+  what.append(el("span", { class: "worst" }, `worst case ${qty(f.worst)}`));
+  let node;
+  if (state.speed) {
+    node = el("div", { ...attrs, class: "upcoming" });
+  } else {
+    node = el("button", { ...attrs, type: "button", class: "move" });
+    node.addEventListener("click", () =>
+      post({ kind: "finished", operation: f.operation, agent: f.agent, time: f.time }));
+  }
+  node.append(what);
+  if (f.why) node.append(el("span", { class: "why" }, f.why));
+  block.append(node);
+  if (f.line && f.line.length) {
+    block.append(lineDetails(f, `${f.agent} finishes ${f.operation} at ${qty(f.time)}`));
+  }
+  return block;
+}
+
+// ---------------------------------------------------------------- real time
+// The service's clock finishes operations (asmplan serve --realtime): the page looks at
+// /api/sessions/{id}/advice every POLL_MS and, when events came, reads the session again.
+
+function startPoll() {
+  if (state.poll || !state.session) return;
+  let busy = false;
+  state.poll = setInterval(async () => {
+    if (busy || state.busy) return;
+    busy = true;
+    try {
+      const look = await api("GET", `/api/sessions/${state.session}/advice`);
+      state.clock = look.clock;
+      state.clockAt = performance.now();
+      if (look.events !== state.seen || look.finished) await refresh();
+      else showClock();
+    } catch (err) {
+      setError(err.message);
+    } finally {
+      busy = false;
+    }
+  }, POLL_MS);
+}
+
+function stopPoll() {
+  if (state.poll) clearInterval(state.poll);
+  state.poll = null;
+}
+
+// The session read again (its events: the bars and the log), then shown explained.
+async function refresh() {
+  const view = await api("GET", `/api/sessions/${state.session}`);
+  state.clock = view.clock;
+  state.clockAt = performance.now();
+  rebuild(view);
+  if (view.advice.finished) {
+    stopPoll();
+    return show(view.advice);
+  }
+  return show(await explained(view.advice));
+}
+
+// The game time now: the clock's, running on between looks unless it waits for the person.
+function gameNow() {
+  const c = state.clock;
+  if (!c) return state.advice ? state.advice.elapsed : 0;
+  if (c.holding || !state.session) return c.game_time;
+  const t = c.game_time + (performance.now() - state.clockAt) / 1000 * c.speed;
+  return c.next ? Math.min(t, c.next.time) : t;
+}
+
+function showClock() {
+  const node = document.getElementById("realtime");
+  const c = state.clock;
+  const now = gameNow();
+  node.dataset.time = String(now);
+  node.dataset.holding = c && c.holding ? "1" : "0";
+  let text = `clock ${qty(Math.round(now * 10) / 10)}, running at ${fmt(state.speed)} s of ` +
+    "cell time per second";
+  if (!state.session || (c && c.holding)) text += "; it waits for you to start something";
+  else if (c && c.next) {
+    const verb = c.next.kind === "started" ? "starts" : "finishes";
+    const wait = Math.max(0, (c.next.time - now) / state.speed);
+    text += `; next: ${c.next.agent} ${verb} ${c.next.operation} at ${qty(c.next.time)}` +
+      ` (in ${wait.toFixed(1)} s)`;
+  }
+  node.textContent = text;
+  if (isConcurrent() && state.advice) {
+    document.getElementById("clock").textContent = qty(Math.round(now * 10) / 10);
+    showRunning(now);
+  }
+  const gd = document.getElementById("gantt");
+  if (gd.layout && gd.layout.shapes && gd.layout.shapes.length) {
+    Plotly.relayout(gd, { "shapes[0].x0": now, "shapes[0].x1": now, "annotations[0].x": now,
+                          "annotations[0].text": `now ${qty(Math.round(now * 10) / 10)}` });
+  }
+}
+
+// What runs, each with the time it has left at game time `now`.
+function showRunning(now) {
+  const advice = state.advice;
+  const running = document.getElementById("running");
+  running.replaceChildren(...advice.running.map((r) => {
+    const left = Math.max(0, Math.round((r.remaining - (now - advice.elapsed)) * 10) / 10);
+    return el("li", { "data-op": r.operation, "data-agent": r.agent },
+      `${r.agent}: ${r.operation} ${describe(r.operation)} (${qty(left)} left)`);
+  }));
 }
 
 function describe(op) {
@@ -498,7 +675,7 @@ function describe(op) {
 function ready() {
   document.body.dataset.ready = "1";
   const target = document.querySelector("#options button.move.asked") ||
-    document.querySelector("#finishes button") ||
+    document.querySelector("#finishes button.move") ||
     document.querySelector("#options button.move");
   if (target) target.focus();
 }
@@ -510,6 +687,12 @@ async function post(event, then) {
   document.body.dataset.ready = "0";
   try {
     const plain = await send(event);
+    if (state.speed) {  // the record is the session's events (the clock's among them)
+      setError("");
+      await refresh();
+      state.busy = false;
+      return;
+    }
     if (then) then(plain);
     const advice = await explained(plain);
     setError("");
@@ -555,10 +738,10 @@ function drawView(advice) {
 // The Gantt chart: what was done, what runs, and the plan ahead if the person follows it,
 // with a "now" line and a legend.
 function drawGantt() {
-  const now = state.advice.elapsed;
+  const now = state.speed ? Math.max(state.advice.elapsed, gameNow()) : state.advice.elapsed;
   const left = Object.fromEntries((state.advice.running || []).map((r) => [r.operation, r.remaining]));
   const running = Object.values(state.open).map((b) =>
-    ({ ...b, end: now + (left[b.operation] || 0) }));
+    ({ ...b, end: state.advice.elapsed + (left[b.operation] || 0) }));
   const ahead = (state.advice.ahead || []).map((s) =>
     ({ agent: s.agent, operation: s.operation, start: s.start, end: s.end, who: s.side,
        deviation: s.deviation, description: s.description }));
@@ -623,7 +806,14 @@ function setNumber(id, x) {
 }
 
 async function finish(advice) {
+  stopPoll();
   setStatus("the assembly is complete");
+  if (state.speed) {
+    const node = document.getElementById("realtime");
+    node.textContent = `the clock stopped at ${qty(advice.elapsed)}: the assembly is complete`;
+    node.dataset.time = String(advice.elapsed);
+    node.dataset.holding = "0";
+  }
   const session = await api("GET", `/api/sessions/${state.session}`);
   const out = session.outcome;
   setNumber("final-cost", out.cost);
