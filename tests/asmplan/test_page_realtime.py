@@ -101,6 +101,16 @@ def test_each_completion_explains_itself(browser, tmp_path):  # noqa: F811
         wait_ready(page)
         page.locator("#options button.move").first.click()
         wait_ready(page)
+        # no meshes: no 3D view, and the moves take the whole width
+        assert not page.locator("#view-panel").is_visible()
+        assert page.locator("#play-panel").bounding_box()["width"] > 0.9 * 1200
+        # what runs is drawn once: not again in the plan ahead
+        traces = page.evaluate(
+            "() => Object.fromEntries(document.getElementById('gantt').data.map("
+            "(t) => [t.name, (t.hovertext || []).map((h) => h.split(':')[0])]))"
+        )
+        now = set(traces["running (to its planned end)"])
+        assert now and not now & set(traces["the plan ahead (if you follow it)"])
         finishes = page.locator("#finishes .finish")
         assert finishes.count() >= 1
         first = finishes.first

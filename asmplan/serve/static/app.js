@@ -742,7 +742,7 @@ function drawGantt() {
   const left = Object.fromEntries((state.advice.running || []).map((r) => [r.operation, r.remaining]));
   const running = Object.values(state.open).map((b) =>
     ({ ...b, end: state.advice.elapsed + (left[b.operation] || 0) }));
-  const ahead = (state.advice.ahead || []).map((s) =>
+  const ahead = (state.advice.ahead || []).filter((s) => !state.open[s.operation]).map((s) =>
     ({ agent: s.agent, operation: s.operation, start: s.start, end: s.end, who: s.side,
        deviation: s.deviation, description: s.description }));
   // [legend, bars, fill (per side when an object), text colour, pattern]
@@ -792,7 +792,7 @@ function drawGantt() {
                     showarrow: false, font: { size: 11, color: DEVIATION_COLOUR } }],
   };
   plot("gantt", traces, layout);
-  const last = ahead.length ? Math.max(...ahead.map((b) => b.end)) : now;
+  const last = Math.max(now, ...ahead.map((b) => b.end), ...running.map((b) => b.end));
   document.getElementById("gantt-note").textContent =
     `now: ${qty(now)}; if you follow the plan from here the assembly is done at ${qty(last)}; ` +
     `the worst that can still happen: ${qty(state.advice.total_bound)}.`;
