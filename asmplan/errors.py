@@ -15,18 +15,24 @@ from asp.errors import (
     AsmplanError,
     FormatError,
     GameError,
+    GameLimit,
     GeometryError,
     GraphError,
+    InfeasibleAssembly,
     ScheduleError,
     SpecError,
+    StateLimit,
 )
 
 __all__ = [
     "AsmplanError",
     "FormatError",
     "GameError",
+    "GameLimit",
     "GeometryError",
     "GraphError",
+    "InfeasibleAssembly",
     "ScheduleError",
     "SpecError",
+    "StateLimit",
 ]

@@ -490,7 +490,7 @@ def state_graph(
     -------
     asp.state_graph.StateGraph
     """
-    from asp.errors import SpecError
+    from asp.errors import InfeasibleAssembly
     from asp.graph.symmetry import reduced_state_graph
     from asp.subassemblies import (
         build_with_units,
@@ -517,9 +517,8 @@ def state_graph(
             for line in [*map(hierarchy_line, choices), *turned]:
                 say(line)
             return graph
-    except SpecError as exc:
-        if "infeasible assembly" not in str(exc):
-            raise
+    except InfeasibleAssembly:
+        pass
     return build_with_units(
         spec,
         rel,

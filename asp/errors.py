@@ -8,7 +8,14 @@ class                  raised for
 ``GameError``          a move, policy or session request the game does not allow
 ``ScheduleError``      a scheduling problem (``.sm``, CP-SAT baseline) that cannot be built
 ``FormatError``        a file in one of the readers' formats that does not parse
+``InfeasibleAssembly`` (a ``SpecError``) an assembly with no complete sequence
+``StateLimit``         (a ``SpecError``) a state graph over ``max_states``
+``GameLimit``          (a ``GameError``) a game over its node limit
 =====================  ====================================================================
+
+The three limits and failures are typed so that a caller decides by type (build
+subassemblies, stop a curve early), never by reading the message; each keeps its parent, so
+the command line still answers with the same one line and exit code 2.
 """
 
 from __future__ import annotations
@@ -36,12 +43,27 @@ class FormatError(AsmplanError):
     """A data file (``.IN2``, ``.sm``, JSON, GraphML) that does not parse."""
 
 
+class InfeasibleAssembly(SpecError):
+    """An assembly with no complete sequence (the message names the root cause)."""
+
+
+class StateLimit(SpecError):
+    """A state graph that would exceed ``max_states`` (the message says how to raise it)."""
+
+
+class GameLimit(GameError):
+    """A game that would exceed its node limit (the message names the flag that bounds it)."""
+
+
 __all__ = [
     "AsmplanError",
     "FormatError",
     "GameError",
     "GeometryError",
+    "GameLimit",
     "GraphError",
+    "InfeasibleAssembly",
     "ScheduleError",
     "SpecError",
+    "StateLimit",
 ]

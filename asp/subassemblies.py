@@ -32,7 +32,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from asp.errors import SpecError
+from asp.errors import InfeasibleAssembly, SpecError, StateLimit
 from asp.spec import AssemblySpec, with_subassemblies
 
 MAX_ROUNDS = 8
@@ -176,9 +176,7 @@ def build_with_units(
             cap = min(kwargs.get("max_states") or PROVED_ROUND_STATES, PROVED_ROUND_STATES)
             try:
                 graph = build_state_graph(with_units, relations, **{**unchecked, "max_states": cap})
-            except SpecError as exc:
-                if "raise max_states" not in str(exc):
-                    raise
+            except StateLimit:
                 view = _Round(with_units, operation_model(with_units, relations))
                 groups = units_of(view, [with_units.op_index(proof.operation)])
                 if drop or groups is not None:
@@ -205,8 +203,8 @@ def build_with_units(
             current = prepared_units(current, relations, say)
             try:
                 return build(current)
-            except ValueError as exc:
-                if relations is None or "infeasible assembly" not in str(exc):
+            except InfeasibleAssembly as exc:
+                if relations is None:
                     raise
                 first_error = first_error or exc
                 proof = exc.proof if isinstance(exc, _Proved) else None
@@ -428,7 +426,7 @@ def _stuck_units(spec: AssemblySpec, stuck: list[int], optional: dict[str, set[s
     return out
 
 
-class _Proved(SpecError):
+class _Proved(InfeasibleAssembly):
     """No complete sequence, proved by the derived precedences without a state graph."""
 
     def __init__(self, spec: AssemblySpec, proof):

@@ -21,7 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from asp.concurrent.model import UNBOUNDED, WAIT, ConcurrentModel
-from asp.errors import GameError
+from asp.errors import GameError, GameLimit
 from asp.game.dag import HUMAN, ROBOT, GameDAG, from_arrays
 
 DEFAULT_MAX_NODES = 3_000_000
@@ -122,7 +122,7 @@ def build_game(
         if k < 0:
             raise GameError(f"k: expected a deviation budget >= 0, got {k}")
         levels = list(range(k + 1))
-    too_big = GameError(
+    too_big = GameLimit(
         f"{where}: the concurrent game exceeds {max_nodes:,} nodes (budgets "
         f"{'inf' if levels == [UNBOUNDED] else f'{levels[0]}..{levels[-1]}'}); bound the "
         "deviation budget with --max-k, coarsen the human duration grid (--duration-step), "

@@ -19,7 +19,7 @@ import numpy as np
 
 from asp.concurrent.build import DEFAULT_MAX_NODES, ConcurrentGame, build_game
 from asp.concurrent.model import UNBOUNDED, WAIT, ConcurrentModel
-from asp.errors import GameError
+from asp.errors import GameError, GameLimit
 from asp.game.dag import HUMAN, ROBOT
 from asp.game.rules import costs_close
 from asp.game.solve import Solution, evaluate_policy, solve
@@ -107,7 +107,7 @@ def robustness(
     while True:
         try:
             bigger = build_game(model, k, max_nodes=max_nodes, progress=progress)
-        except GameError:
+        except GameLimit:
             if game is None:
                 raise
             break  # the curve so far stands; ``flat`` stays False and the report says so

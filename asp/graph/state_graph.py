@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from asp.errors import SpecError
+from asp.errors import InfeasibleAssembly, StateLimit
 from asp.graph.feasibility import (
     OperationModel,
     blocked_text,
@@ -307,7 +307,7 @@ def build_state_graph(
         op=_join(op_l, op_type(n_ops)),
     )
     if check and not graph.complete.any():
-        raise SpecError(infeasibility_report(graph))
+        raise InfeasibleAssembly(infeasibility_report(graph))
     return graph
 
 
@@ -622,7 +622,7 @@ def _too_many(model: OperationModel, keys: np.ndarray, limit: int, reached: str)
     names = list(dict.fromkeys(names))
     shown = ", ".join(names[:8]) + (f" and {len(names) - 8} more" if len(names) > 8 else "")
     per_state = 8 * model.n_words + 8 * model.oracle.n_words + 8
-    return SpecError(
+    return StateLimit(
         f"{spec.source}: the state graph exceeds the limit of {limit:,} states: {reached}; "
         f"the free order of {len(names)} parts or "
         f"operations multiplies them ({shown or 'none'}); raise max_states (the command line's "

@@ -1,0 +1,104 @@
+"""Typed failures: each is raised where it happens, caught by its type, and keeps its parent
+(so the command line still answers with one line and exit code 2)."""
+
+from __future__ import annotations
+
+import pytest
+
+import asp.subassemblies as subassemblies
+from asp.concurrent.build import build_game
+from asp.concurrent.model import concurrent_model
+from asp.concurrent.robustness import robustness
+from asp.errors import (
+    AsmplanError,
+    GameError,
+    GameLimit,
+    InfeasibleAssembly,
+    SpecError,
+    StateLimit,
+)
+from asp.graph.state_graph import build_state_graph
+from asp.spec import spec_from_dict
+from tests.asp.helpers_assembly import precedence_spec, relations
+
+
+def _lonely_part():
+    """Part K touches nothing: no complete sequence."""
+    data = {
+        "parts": [{"id": "B", "file": "b"}, {"id": "K", "file": "k"}],
+        "agents": {"R": {"side": "robot"}},
+        "base_part": "B",
+        "operations": [{"id": "k", "agents": {"R": 1}, "part": "K"}],
+    }
+    return spec_from_dict(data, source="k.yaml"), relations(("B", "K"))
+
+
+def _two_jobs():
+    data = {
+        "name": "job",
+        "agents": {"H": {"side": "human"}, "R": {"side": "robot"}},
+        "operations": [
+            {"id": "a", "agents": {"H": 2, "R": 3}},
+            {"id": "b", "agents": {"H": 2, "R": 3}},
+        ],
+    }
+    spec = spec_from_dict(data)
+    return concurrent_model(spec, build_state_graph(spec))
+
+
+@pytest.mark.parametrize(
+    ("kind", "parent"),
+    [(InfeasibleAssembly, SpecError), (StateLimit, SpecError), (GameLimit, GameError)],
+)
+def test_each_kind_keeps_its_family(kind, parent):
+    assert issubclass(kind, parent) and issubclass(kind, AsmplanError)
+    assert issubclass(kind, ValueError)
+
+
+def test_no_complete_sequence_is_infeasible_assembly():
+    spec, rel = _lonely_part()
+    with pytest.raises(InfeasibleAssembly) as info:
+        build_state_graph(spec, rel)
+    assert "part K" in str(info.value) and "\n" not in str(info.value)
+
+
+def test_too_many_states_is_state_limit():
+    with pytest.raises(StateLimit) as info:
+        build_state_graph(precedence_spec(10, []), max_states=100)
+    assert "raise max_states" in str(info.value)
+
+
+def test_too_many_nodes_is_game_limit():
+    with pytest.raises(GameLimit, match="--max-k"):
+        build_game(_two_jobs(), None, max_nodes=2)
+    with pytest.raises(GameLimit):  # the curve has nothing to show: the limit stands
+        robustness(_two_jobs(), max_k=2, max_nodes=2)
+
+
+def test_units_decide_by_type_not_by_text(monkeypatch):
+    """An infeasible assembly whose message says nothing known still starts the rounds of
+    subassemblies; a plain SpecError with the old words does not."""
+    spec, rel = _lonely_part()
+    calls = []
+
+    def failing(message, kind):
+        def build(*args, **kwargs):
+            calls.append(kind)
+            raise kind(message)
+
+        return build
+
+    monkeypatch.setattr(
+        "asp.graph.symmetry.reduced_state_graph", failing("no words", InfeasibleAssembly)
+    )
+    monkeypatch.setattr("asp.graph.symmetry.refutation", lambda *a: None)
+    with pytest.raises(InfeasibleAssembly):
+        subassemblies.build_with_units(spec, rel, reduce=True)
+    assert calls == [InfeasibleAssembly]  # given up after the rounds, the first error raised
+    monkeypatch.setattr(
+        "asp.graph.symmetry.reduced_state_graph",
+        failing("infeasible assembly, raise max_states", SpecError),
+    )
+    with pytest.raises(SpecError) as info:
+        subassemblies.build_with_units(spec, rel, reduce=True)
+    assert type(info.value) is SpecError
