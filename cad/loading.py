@@ -34,11 +34,11 @@ from cad.assembly import Assembly, prepare_part
 from cad.bom import PartRecord, read_bom
 from cad.errors import GeometryError
 from cad.frame import Rotation, rotated
-from cad.scene import SCENE_SUFFIXES, empty_scene_error, read_scene
+from cad.readers import MESH_SUFFIXES
+from cad.scene import empty_scene_error, read_scene
 from cad.unit_hints import part_scale_hint
 from cad.units import unit_scale
 
-MESH_SUFFIXES = (".stl", ".obj", ".ply", ".off", *SCENE_SUFFIXES)
 BOM_NAMES = ("bom.csv", "bom.yaml", "bom.yml")
 METRES_ONLY = ((1000.0, "metres"),)
 """Size ratios warned about on load (small parts are often 10-60 times smaller)."""

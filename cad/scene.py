@@ -26,35 +26,18 @@ import numpy as np
 import trimesh
 
 from cad.errors import GeometryError
+from cad.readers import (  # noqa: F401  (re-exported: cad.scene is where callers look)
+    MAX_GLTF_ASSEMBLY_M,
+    MAX_INCH_ASSEMBLY_M,
+    SCENE_SUFFIXES,
+    STEP_CHORD_MM,
+    is_format,
+    is_step,
+    reader_for,
+)
+from cad.step import external_references
 from cad.units import canonical_unit, unit_scale
 
-SCENE_SUFFIXES = (".glb", ".gltf", ".3mf", ".step", ".stp", ".3dxml")
-"""Files that hold several parts (one per mesh node)."""
-DECLARED_METRES = (".glb", ".gltf", ".step", ".stp")
-"""Formats whose unit is the metre (STEP through cascadio, glTF by definition)."""
-STEP_CHORD_MM = 0.01
-"""Largest distance (mm) between a STEP surface and its triangles: cascadio's (OCCT's)
-linear deflection ``tol_linear``, in millimetres whatever the file's unit (OCCT reads a
-STEP into millimetres; 0.01 mm is cascadio's default, its angular deflection 0.5 rad stays).
-Passed explicitly and recorded in a plan (``geometry.step_chord``) so that a checker
-tessellates the file into the same triangles.
-
-The rule: an absolute 0.01 mm, well inside the tolerances the relations are computed with
-(:mod:`cad.tolerances`): at most 0.2 x the smallest default pair penetration tolerance
-(0.05 mm, two parts at the 0.025 mm shrink floor). A gap or overlap between two
-tessellated surfaces moves by at most the chord error of the concave one (a hole's facets
-cut into the hole). Not coarser: at 0.02 mm (1.7 times faster on the 26-part APLAN
-clutch, 140 s -> 83 s) OCCT meshes some faces of the clutch's two disc springs as fans
-across their holes (each spring's area grows by 39 %: triangles of 470 square mm on a
-2 mm wide flat ring), and the stacked springs then "interpenetrate by 4.3 mm"; every
-other part of the clutch and of the ten other STEP files measured keeps its area within
-0.5 %."""
-MAX_INCH_ASSEMBLY_M = 3.0
-"""A STEP declaring inches whose parts span more than this (metres, 118 in) has millimetre
-numbers under an inch label (Pro/E exports of metric models do this); it is read in mm."""
-MAX_GLTF_ASSEMBLY_M = 20.0
-"""A glTF (metres by its specification) whose parts span more than this has millimetre
-numbers (converters that keep a CAD model's numbers, e.g. COLLADA2GLTF); read in mm."""
 MAX_ID_LENGTH = 32
 _EXTENSIONS = r"\.(stp|step|sldprt|sldasm|ipt|iam|prt|asm|stl|obj|glb|gltf|3mf)$"
 
@@ -201,24 +184,19 @@ class SceneParts:
 
 
 def load_scene_file(path: Path) -> trimesh.Scene:
-    """Load a mesh or scene file as a trimesh scene; one-line errors for bad files."""
+    """Load a mesh or scene file as a trimesh scene (its reader, :mod:`cad.readers`);
+    one-line errors for bad files."""
     if not path.is_file():
         raise FileNotFoundError(f"mesh file not found: {path}")
-    if path.suffix.lower() in (".step", ".stp"):
-        try:
-            import cascadio  # noqa: F401
-        except ImportError:
-            raise GeometryError(
-                f"cannot read STEP file {path}: install the optional extra "
-                "'asmplan[step]' (cascadio)"
-            ) from None
+    reader = reader_for(path)
     if path.stat().st_size == 0:
         raise GeometryError(f"empty mesh file {path}")
     try:
-        try:
-            scene = trimesh.load(str(path), force="scene", **load_options(path))
-        except KeyError:  # trimesh cannot merge primitives without a material
-            scene = trimesh.load(str(path), force="scene")
+        scene = reader.load(path)
+    except GeometryError:
+        if external_references(path):  # OCCT read nothing: the parts live elsewhere
+            raise empty_scene_error(path) from None
+        raise
     except Exception as exc:  # trimesh raises many types for bad files
         if external_references(path):
             raise empty_scene_error(path) from None
@@ -229,19 +207,8 @@ def load_scene_file(path: Path) -> trimesh.Scene:
 
 
 def load_options(path: Path) -> dict:
-    """Keywords for ``trimesh.load`` of a scene file: an OBJ's objects (``o name``) are its
-    parts (one file may hold a whole assembly); a glTF mesh's primitives (one per material,
-    as CAD exporters write a part of several colours) are one part, under its node's own
-    name (unmerged, trimesh makes each a node named with a random suffix); a STEP is
-    tessellated to within :data:`STEP_CHORD_MM` of its surfaces."""
-    suffix = path.suffix.lower()
-    if suffix in (".step", ".stp"):
-        return {"tol_linear": STEP_CHORD_MM}
-    if suffix == ".obj":
-        return {"split_objects": True}
-    if suffix in (".glb", ".gltf"):
-        return {"merge_primitives": True}
-    return {}
+    """Keywords for ``trimesh.load`` of a file (its reader's, :data:`cad.readers.READERS`)."""
+    return dict(reader_for(path).options)
 
 
 def empty_scene_error(path: Path) -> GeometryError:
@@ -258,23 +225,10 @@ def empty_scene_error(path: Path) -> GeometryError:
     return GeometryError(f"unreadable mesh file {path}: no triangles could be read (empty mesh)")
 
 
-def external_references(path: Path) -> tuple[str, ...]:
-    """The files a STEP file's ``DOCUMENT_FILE`` entities name, in order, without repeats
-    (empty for other formats)."""
-    if path.suffix.lower() not in (".step", ".stp"):
-        return ()
-    try:
-        text = path.read_text(encoding="latin-1")
-    except OSError:
-        return ()
-    found = re.findall(r"DOCUMENT_FILE\s*\(\s*'([^']+)'", text, flags=re.IGNORECASE)
-    return tuple(dict.fromkeys(found))
-
-
 def declared_units(path: Path, scene: trimesh.Scene) -> str | None:
     """The unit the file format declares (short name), or None."""
-    suffix = path.suffix.lower()
-    if suffix not in (".3mf", ".3dxml", *DECLARED_METRES):
+    reader = reader_for(path)
+    if not reader.declares_unit:
         return None
     declared = scene.units
     if declared is None:
@@ -282,14 +236,8 @@ def declared_units(path: Path, scene: trimesh.Scene) -> str | None:
             declared = geom.units or geom.metadata.get("units")
             if declared:
                 break
-    if declared is None:
-        if suffix in DECLARED_METRES:
-            declared = "m"
-        elif suffix == ".3mf":
-            declared = "mm"
-        else:
-            return None
-    return canonical_unit(declared)
+    declared = declared or reader.default_unit
+    return None if declared is None else canonical_unit(declared)
 
 
 def read_scene(path: str | Path) -> SceneParts:
@@ -337,7 +285,7 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
     # a node over every part is the product itself: its name is no part's name while a
     # part has a plain name of its own (a pen's ``body_001``, a mold's item ``3_001``)
     whole = {g for g, below in group_nodes if len(below) == len(part_nodes) > 1}
-    if file.suffix.lower() == ".3dxml":  # trimesh flattens the tree into the node names
+    if is_format(file, "3DXML"):  # trimesh flattens the tree into the node names
         group_nodes = _3dxml_groups(file, [node for node, _ in part_nodes])
     # the node holding every part (the product itself) is not a group
     group_nodes = [(g, b) for g, b in group_nodes if len(b) < len(part_nodes)]
@@ -395,7 +343,7 @@ def step_length_unit(path: Path) -> str | None:
     ``SI_UNIT(prefix, .METRE.)``, among the context's units the one that is a
     ``LENGTH_UNIT``.
     """
-    if path.suffix.lower() not in (".step", ".stp"):
+    if not is_step(path):
         return None
     try:
         text = path.read_text(encoding="latin-1")
@@ -425,18 +373,14 @@ def _millimetre_numbers(path: Path, scene: trimesh.Scene) -> float:
     :data:`MAX_INCH_ASSEMBLY_M`: 1 / 25.4; a glTF/GLB in metres (glTF's default: it
     declares no other unit) spanning more than :data:`MAX_GLTF_ASSEMBLY_M`: 1 / 1000.
     """
-    suffix = path.suffix.lower()
-    if scene.bounds is None or suffix not in (".step", ".stp", ".glb", ".gltf"):
+    mislabel = reader_for(path).mislabel
+    if scene.bounds is None or mislabel is None:
         return 1.0
     size = float(np.linalg.norm(np.ptp(scene.bounds, axis=0)))  # metres (cascadio, glTF)
-    if suffix in (".glb", ".gltf"):
-        if declared_units(path, scene) != "m":
-            return 1.0  # the file says its unit (trimesh's extras): no default to doubt
-        label, limit, factor = "metres (glTF)", MAX_GLTF_ASSEMBLY_M, 1e-3
-    elif step_length_unit(path) == "in":
-        label, limit, factor = "inches", MAX_INCH_ASSEMBLY_M, 1.0 / 25.4
-    else:
-        return 1.0
+    declared = step_length_unit(path) if is_step(path) else declared_units(path, scene)
+    if declared != mislabel.unit:
+        return 1.0  # the file says another unit: no default to doubt
+    label, limit, factor = mislabel.label, mislabel.limit_m, mislabel.factor
     if size <= limit:
         return 1.0
     import warnings
