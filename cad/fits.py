@@ -37,7 +37,7 @@ from cad.freedom import (
     eroded_meshes,
     interpenetration_error,
     intersects,
-    overlapping_pairs,
+    overlaps,
     translational_freedom,
 )
 from cad.offset import offset_mesh
@@ -87,14 +87,18 @@ def find_fits(assembly: Assembly, tols: Tolerances, eroded) -> list[Fit]:
     Raises
     ------
     ValueError
-        A pair that is not a fit: ``parts 'a' and 'b' interpenetrate by about X mm ...``.
+        Pairs that are not fits, all in one line: ``parts 'a' and 'b' interpenetrate by
+        about X mm ...`` (or ``N pairs of parts interpenetrate ...``).
     """
-    fits = []
-    for a, b in overlapping_pairs(assembly, tols, eroded, first=tols.explicit):
-        fit = None if tols.explicit else as_fit(assembly, tols, eroded, a, b)
+    fits, wrong = [], []
+    for overlap in overlaps(assembly, tols, eroded):
+        fit = None if tols.explicit else as_fit(assembly, tols, eroded, overlap.a, overlap.b)
         if fit is None:
-            raise interpenetration_error(assembly, tols, a, b)
-        fits.append(fit)
+            wrong.append(overlap)
+        else:
+            fits.append(fit)
+    if wrong:
+        raise interpenetration_error(assembly, tols, wrong)
     return fits
 
 

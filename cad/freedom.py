@@ -36,6 +36,8 @@ and each pair is computed once per axis.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import trimesh
 
@@ -45,7 +47,7 @@ from cad.faces import FaceSet, axis_face_sets, bounds_overlap, crop_pair, unit_n
 from cad.offset import offset_vertices
 from cad.progress import progress_bar
 from cad.projection import box_pair_chunks, height_gap_range, overlap_share
-from cad.tolerances import resolve_tolerances
+from cad.tolerances import part_thickness, resolve_tolerances
 from cad.unit_hints import unit_hint
 
 _PARALLEL = 1e-9
@@ -223,34 +225,80 @@ def _intersect(a: trimesh.Trimesh, b: trimesh.Trimesh, obj_a=None, obj_b=None) -
     return False
 
 
+MAX_NAMED = 10
+"""Overlapping pairs an error names (all are counted)."""
+ERODE_SHARE = 0.4
+"""The depth measurement erodes a part by at most this share of its thickness
+(:func:`cad.tolerances.part_thickness`): deeper, a thin part turns inside out and its
+eroded mesh crosses everything around it."""
+_BISECTIONS = 14
+
+
+@dataclass(frozen=True)
+class Overlap:
+    """Two parts sharing volume deeper than their tolerance, with the depth measured.
+
+    Attributes
+    ----------
+    a, b : int
+        Part indices, ``a < b``.
+    depth : float
+        Measured overlap (mm): the sum of the equal erosions of the two raw meshes
+        (each capped at :data:`ERODE_SHARE` of its thickness) that part them.
+    at_least : bool
+        The meshes still share volume at the largest erosion tried: ``depth`` is a lower
+        bound.
+    """
+
+    a: int
+    b: int
+    depth: float
+    at_least: bool = False
+
+    def text(self) -> str:
+        """``about 0.5 mm`` or ``at least 2.5 mm``."""
+        return f"{'at least' if self.at_least else 'about'} {self.depth:.3g} mm"
+
+
 def check_interpenetration(
     assembly: Assembly,
     *,
     penetration_tol=None,
     eroded: list[trimesh.Trimesh] | None = None,
 ) -> None:
-    """Raise if two parts overlap deeper than their tolerance in the assembled pose.
+    """Raise if parts overlap deeper than their tolerance in the assembled pose.
 
-    Parts eroded by their shrinks (:mod:`cad.tolerances`; ``penetration_tol / 2`` each if
-    a number is given) must be disjoint (FCL triangle tests for crossing surfaces, a
-    point-in-mesh test for one part inside another).
+    A pair overlaps (:func:`overlaps`) iff its raw meshes share volume (FCL finds their
+    surfaces crossing, or one holds the other), its parts eroded by their shrinks
+    (:mod:`cad.tolerances`; ``penetration_tol / 2`` each if a number is given) still do,
+    and the depth measured on the raw meshes (:func:`measured_overlap`) exceeds the pair's
+    tolerance. The depth does not depend on the tolerance, so a larger tolerance never
+    flags more pairs.
 
     Raises
     ------
     ValueError
-        One line: ``parts 'a' and 'b' interpenetrate by about X mm (penetration tolerance
-        of this pair Y mm)``.
+        One line naming every overlapping pair (the first :data:`MAX_NAMED`) and its depth.
     """
     tols = resolve_tolerances(assembly, None, penetration_tol)
-    for a, b in overlapping_pairs(assembly, tols, eroded, first=True):
-        raise interpenetration_error(assembly, tols, a, b)
+    found = overlaps(assembly, tols, eroded)
+    if found:
+        raise interpenetration_error(assembly, tols, found)
 
 
 def overlapping_pairs(
     assembly: Assembly, tols, eroded: list[trimesh.Trimesh] | None = None, *, first: bool = False
 ) -> list[tuple[int, int]]:
-    """Pairs ``(a, b)``, ``a < b``, whose parts eroded by their shrinks still share volume
-    (overlap deeper than the pair's tolerance); only the first one if ``first``."""
+    """Pairs ``(a, b)``, ``a < b``, that overlap deeper than their tolerance
+    (:func:`overlaps`); only the first one if ``first``."""
+    return [(o.a, o.b) for o in overlaps(assembly, tols, eroded, first=first)]
+
+
+def overlaps(
+    assembly: Assembly, tols, eroded: list[trimesh.Trimesh] | None = None, *, first: bool = False
+) -> list[Overlap]:
+    """Every pair whose parts eroded by their shrinks share volume, whose raw meshes share
+    volume, and whose measured depth exceeds the pair's tolerance, in pair order."""
     if eroded is None:
         eroded = eroded_meshes(assembly, tols.shrink)
     objects = [_collision_object(m) for m in eroded]
@@ -261,45 +309,79 @@ def overlapping_pairs(
         for b in range(a + 1, n):
             if not bounds_overlap(bounds[a], bounds[b]):
                 continue
-            if _intersect(eroded[a], eroded[b], objects[a], objects[b]):
-                found.append((a, b))
+            if not _intersect(eroded[a], eroded[b], objects[a], objects[b]):
+                continue
+            raw_a, raw_b = _centred(assembly.parts[a].mesh, assembly.parts[b].mesh)
+            if not _intersect(raw_a, raw_b):
+                continue  # the erosion slid a vertex across: the surfaces do not cross
+            overlap = measured_overlap(raw_a, raw_b, a, b)
+            if overlap.depth > tols.pair(a, b):
+                found.append(overlap)
                 if first:
                     return found
     return found
 
 
-def interpenetration_error(assembly: Assembly, tols, a: int, b: int) -> GeometryError:
-    """The one-line error for parts ``a`` and ``b`` overlapping deeper than their tolerance."""
-    pa, pb = assembly.parts[a], assembly.parts[b]
-    ptol = tols.pair(a, b)
-    depth = _depth_estimate(pa.mesh, pb.mesh, ptol)
-    hint = unit_hint(assembly, a, b)
+def measured_overlap(mesh_a: trimesh.Trimesh, mesh_b: trimesh.Trimesh, a: int, b: int) -> Overlap:
+    """How deep two raw meshes that share volume overlap: bisection on an equal erosion of
+    both (each capped at :data:`ERODE_SHARE` of its thickness) for the least that parts
+    them; the depth is the sum of the two erosions there."""
+    caps = [ERODE_SHARE * part_thickness(m) for m in (mesh_a, mesh_b)]
+    sizes = np.concatenate([np.ptp(mesh_a.bounds, axis=0), np.ptp(mesh_b.bounds, axis=0)])
+    hi = float(sizes.min()) / 4.0
+
+    def amount(e: float) -> float:
+        return min(e, caps[0]) + min(e, caps[1])
+
+    def still(e: float) -> bool:
+        ea = trimesh.Trimesh(offset_vertices(mesh_a, -min(e, caps[0])), mesh_a.faces, process=False)
+        eb = trimesh.Trimesh(offset_vertices(mesh_b, -min(e, caps[1])), mesh_b.faces, process=False)
+        return _intersect(ea, eb)
+
+    if hi <= 0 or still(hi):
+        return Overlap(a, b, amount(max(hi, 0.0)), at_least=True)
+    lo = 0.0
+    for _ in range(_BISECTIONS):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if still(mid) else (lo, mid)
+    return Overlap(a, b, amount(lo))
+
+
+def _centred(a: trimesh.Trimesh, b: trimesh.Trimesh) -> tuple[trimesh.Trimesh, trimesh.Trimesh]:
+    """Both meshes moved by the same shift to put their joint box's centre at the origin
+    (FCL and the erosion lose digits on coordinates far from it, e.g. near 1e9)."""
+    centre = 0.5 * (np.minimum(a.bounds[0], b.bounds[0]) + np.maximum(a.bounds[1], b.bounds[1]))
+    if not np.any(np.abs(centre) > 1e3):
+        return a, b
+    return tuple(
+        trimesh.Trimesh(np.asarray(m.vertices) - centre, m.faces, process=False) for m in (a, b)
+    )
+
+
+def interpenetration_error(assembly: Assembly, tols, found: list[Overlap]) -> GeometryError:
+    """The one-line error for every pair in ``found`` (the first :data:`MAX_NAMED` named)."""
+    parts = assembly.parts
+    first = found[0]
+    hint = unit_hint(assembly, first.a, first.b)
+    tail = f"; {hint}" if hint else ""
+    if len(found) == 1:
+        return GeometryError(
+            f"parts {parts[first.a].id!r} and {parts[first.b].id!r} interpenetrate by "
+            f"{first.text()} (penetration tolerance of this pair {tols.pair(first.a, first.b):.3g}"
+            f" mm){tail}"
+        )
+    named = "; ".join(
+        f"{parts[o.a].id!r} and {parts[o.b].id!r} by {o.text()} (tolerance "
+        f"{tols.pair(o.a, o.b):.3g} mm)"
+        for o in found[:MAX_NAMED]
+    )
+    more = f"; and {len(found) - MAX_NAMED} more" if len(found) > MAX_NAMED else ""
     return GeometryError(
-        f"parts {pa.id!r} and {pb.id!r} interpenetrate by {depth} "
-        f"(penetration tolerance of this pair {ptol:.3g} mm)" + (f"; {hint}" if hint else "")
+        f"{len(found)} pairs of parts interpenetrate deeper than their tolerance: {named}{more}"
+        + tail
     )
 
 
 def intersects(a: trimesh.Trimesh, b: trimesh.Trimesh) -> bool:
     """Whether closed meshes ``a`` and ``b`` share volume (crossing surfaces or nesting)."""
     return _intersect(a, b)
-
-
-def _depth_estimate(a: trimesh.Trimesh, b: trimesh.Trimesh, ptol: float) -> str:
-    """Overlap thickness: twice the largest equal erosion that leaves a and b intersecting."""
-    sizes = np.concatenate([np.ptp(a.bounds, axis=0), np.ptp(b.bounds, axis=0)])
-    lo, hi = 0.0, float(sizes.min()) / 4.0
-
-    def still(depth: float) -> bool:
-        ea = trimesh.Trimesh(offset_vertices(a, -depth), a.faces, process=False)
-        eb = trimesh.Trimesh(offset_vertices(b, -depth), b.faces, process=False)
-        return _intersect(ea, eb)
-
-    if hi <= ptol / 2.0 or still(hi):
-        return f"at least {2 * max(hi, ptol / 2.0):.3g} mm"
-    for _ in range(14):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if still(mid) else (lo, mid)
-    if lo == 0.0:  # any erosion parts them: say the bound, never "about 0 mm"
-        return f"less than {2 * hi:.2g} mm"
-    return f"about {2 * lo:.3g} mm"
