@@ -35,7 +35,7 @@ from cad.readers import (  # noqa: F401  (re-exported: cad.scene is where caller
     is_step,
     reader_for,
 )
-from cad.step import external_references
+from cad.step import document_files
 from cad.units import canonical_unit, unit_scale
 
 MAX_ID_LENGTH = 32
@@ -223,6 +223,11 @@ def empty_scene_error(path: Path) -> GeometryError:
             "export the assembly as one STEP file with its parts embedded"
         )
     return GeometryError(f"unreadable mesh file {path}: no triangles could be read (empty mesh)")
+
+
+def external_references(path: Path) -> tuple[str, ...]:
+    """The files a STEP file's ``DOCUMENT_FILE`` entities name (empty for other formats)."""
+    return document_files(path) if is_step(path) else ()
 
 
 def declared_units(path: Path, scene: trimesh.Scene) -> str | None:

@@ -117,13 +117,8 @@ def check_step_text(path: Path, data: bytes, body: bytes) -> None:
         )
 
 
-def external_references(path: Path) -> tuple[str, ...]:
-    """The files a STEP file's ``DOCUMENT_FILE`` entities name, in order, without repeats
-    (empty for other formats)."""
-    from cad.readers import is_step
-
-    if not is_step(path):
-        return ()
+def document_files(path: Path) -> tuple[str, ...]:
+    """The files a STEP file's ``DOCUMENT_FILE`` entities name, in order, without repeats."""
     try:
         text = path.read_text(encoding="latin-1")
     except OSError:
