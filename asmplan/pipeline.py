@@ -351,8 +351,8 @@ def load(
         if on_step is not None:
             on_step(f"computing part relations of {len(spec.parts)} parts ...")
         geometry = spec_geometry(spec)
-        if size_hint(geometry):
-            note(f"units: {size_hint(geometry)}")
+        if hint := size_hint(geometry):
+            note(f"units: {hint}")
         rel = load_relations(spec, progress=progress, geometry=geometry)
         decided = decide_generated(
             spec, rel, geometry, say=on_step, progress=progress, given_gravity=bool(gravity)
@@ -755,7 +755,7 @@ def plan(
     )
     from asp.subassemblies import units_report
 
-    units = units_report(assembly.spec, assembly.relations, graph.spec.subassemblies)
+    unit_rows = units_report(assembly.spec, assembly.relations, graph.spec.subassemblies)
     if graph.spec is not assembly.spec:  # subassemblies found: their insertions are operations
         assembly = Assembly(graph.spec, assembly.relations)
     sequences = graph.count_sequences()
@@ -797,7 +797,7 @@ def plan(
         summary,
         sched,
         concurrent,
-        units,
+        unit_rows,
         played,
     )
 
