@@ -1140,3 +1140,9 @@ def solve_curve(
         positions=search.positions,
         seconds=time.perf_counter() - t0,
     )
+
+
+# Public names for the certificate of any robot policy (asp.concurrent.certify).
+node_row = _node_row
+as_policy_game = _as_game
+commit_bound = _estimate

@@ -1,0 +1,114 @@
+"""The certificate of any robot policy: the full enumeration's best response (the oracle)."""
+
+from __future__ import annotations
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from asp.concurrent.build import build_game
+from asp.concurrent.certify import certify
+from asp.concurrent.model import concurrent_model
+from asp.concurrent.robustness import certified_worst_case
+from asp.concurrent.rules import Position, concurrent_rules
+from asp.concurrent.search import GREEDY, Search
+from asp.errors import GameError, GameLimit
+from tests.asp.concurrent.test_rules import job, random_jobs
+
+SETTINGS = settings(max_examples=15, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+
+
+def hashed_policy(salt: int):
+    """A fixed robot policy that looks at the position but not its budget: the commitment of
+    least hash of (salt, state, running, ops), so it does not depend on the list's order."""
+
+    def choose(pos: Position, commits) -> int:
+        scores = [hash((salt, pos.state, pos.running, c.ops)) for c in commits]
+        return scores.index(min(scores))
+
+    return choose
+
+
+def oracle(rules, spec, graph, choose, top: int) -> list[float]:
+    """The policy's worst case per budget ``0..top`` in the fully enumerated game."""
+    model = concurrent_model(spec, graph)
+    game = build_game(model, top)
+
+    def rule(game, v, edges):
+        _, state, running, budget, _ = game.nodes[v]
+        pos = Position(state, min(budget, rules.budget_cap(Position(state, 0, running))), running)
+        commits = rules.commits(pos)
+        want = commits[choose(pos, commits)].ops
+        return next(e for e in edges if game.actions[e].ops == want)
+
+    return [certified_worst_case(game, rule, k) for k in range(top + 1)]
+
+
+@SETTINGS
+@given(random_jobs(humans=(1, 2), ranges=True), st.integers(0, 3))
+def test_certificate_is_the_full_enumerations_best_response(data, salt):
+    ops, agents = data
+    spec, graph = job(ops, agents=agents)
+    rules = concurrent_rules(spec, graph)
+    top = min(3, sum(1 for a in agents.values() if a["side"] == "human") * len(ops))
+    choose = hashed_policy(salt)
+    cert = certify(rules, choose, [*range(top + 1), None])
+    got = [cert.worst[k] for k in range(top + 1)]
+    assert got == oracle(rules, spec, graph, choose, top)
+    # A policy blind to the budget: never falls as k grows, k = inf at the top.
+    assert got == sorted(got)
+    assert cert.worst[None] >= got[-1]
+    # No policy beats the game's value.
+    search = Search(rules)
+    for k in range(top + 1):
+        assert cert.worst[k] * rules.scale >= search.value(k)
+
+
+@SETTINGS
+@given(random_jobs(humans=(1, 2)))
+def test_certificate_agrees_with_the_searchs_greedy_policy_game(data):
+    from asp.concurrent.search import commit_bound
+    from asp.game.solve import solve
+
+    ops, agents = data
+    spec, graph = job(ops, agents=agents)
+    rules = concurrent_rules(spec, graph)
+    budgets = [None, 0, 1]
+
+    def greedy(pos, commits):  # the search's greedy rule, written on the public moves
+        bounds = [commit_bound(rules.tables, pos.row(), _row(rules, c)) for c in commits]
+        return bounds.index(min(bounds))
+
+    cert = certify(rules, greedy, budgets)
+    game = Search(rules).policy_game(budgets, GREEDY)
+    sol = solve(game.dag)
+    for b, s in game.starts.items():
+        assert cert.worst[None if b < 0 else b] == float(sol.value[s, 0])
+
+
+def _row(rules, commit):
+    import numpy as np
+
+    from asp.concurrent.rules import NONE
+
+    return np.array([NONE if o is None else o for o in commit.ops], dtype=np.int64)
+
+
+def test_bad_choice_and_limits_are_errors():
+    spec, graph = job(
+        [
+            {"id": "a", "agents": {"H1": 2, "R1": 3}, "after": []},
+            {"id": "b", "agents": {"H1": 2, "R1": 1}, "after": ["a"]},
+        ],
+        agents={"H1": {"side": "human"}, "R1": {"side": "robot"}},
+    )
+    rules = concurrent_rules(spec, graph)
+    with pytest.raises(GameError, match="commitment index"):
+        certify(rules, lambda pos, commits: len(commits), [0])
+    with pytest.raises(GameLimit, match="exceeds 2 nodes"):
+        certify(rules, lambda pos, commits: 0, [0], max_nodes=2)
+    with pytest.raises(GameError, match="budget"):
+        certify(rules, lambda pos, commits: 0, [-1])
+    cert = certify(rules, lambda pos, commits: 0, [0, None])
+    assert [row["k"] for row in cert.to_list()] == [0, None]
+    assert cert.nodes == cert.game.dag.n_nodes
