@@ -458,18 +458,18 @@ def state_graph(
 ) -> StateGraph:
     """The assembly state graph: every feasible partial assembly and operation.
 
-    A spec generated from a CAD file builds the file's sub-assemblies that can be built
-    and inserted as units (:func:`asp.units.cad_units`), except those the derived
-    precedences prove leave no complete sequence (:func:`asp.units.refuted_units`: given up
-    in milliseconds, said on ``on_step``). The spec, with those units, is first
-    reduced (:func:`asp.symmetry.reduced_state_graph`: the precedences every complete
+    One call of :func:`asp.subassemblies.build_with_units`: a spec generated from a CAD
+    file builds the file's sub-assemblies that can be built and inserted as units
+    (:func:`asp.subassemblies.cad_units`), except those the derived precedences prove leave
+    no complete sequence (:func:`asp.subassemblies.refuted_units`: given up in
+    milliseconds, said on ``on_step``). The spec, with those units, is reduced
+    (:func:`asp.graph.symmetry.reduced_state_graph`: the precedences every complete
     sequence keeps, interchangeable parts in a fixed order or, for blocks of parts that
     cannot be, only the first of equal blocks moving; same TCT and W*, far fewer states;
     a unit is one body of the main assembly there, and the alike parts of its workspace
     are reduced in it). When that has no complete sequence and a part can never be
-    inserted alone, subassemblies are added automatically
-    (:func:`asp.units.build_with_units`, each round reduced alike); the graph's ``spec``
-    holds all of it.
+    inserted alone, subassemblies are added automatically, each round reduced alike; the
+    graph's ``spec`` holds all of it. An infeasible assembly's graph is built once.
 
     Parameters
     ----------
@@ -490,43 +490,15 @@ def state_graph(
     -------
     asp.state_graph.StateGraph
     """
-    from asp.errors import InfeasibleAssembly
-    from asp.graph.symmetry import reduced_state_graph
-    from asp.subassemblies import (
-        build_with_units,
-        hierarchy_line,
-        prepared_units,
-        refuted_units,
-        with_cad_units,
-    )
+    from asp.subassemblies import build_with_units
 
-    spec, rel = assembly.spec, assembly.relations
-    say = on_step or (lambda _line: None)
-    given_up = refuted_units(spec, rel, on_unit=say) if spec.generated else set()
-    first, choices = with_cad_units(spec, rel, given_up) if spec.generated else (spec, ())
-    turned: list[str] = []  # said with the file's units, once the graph uses them
-    try:
-        graph = reduced_state_graph(
-            prepared_units(first, rel, turned.append),
-            rel,
-            concurrent=concurrent,
-            progress=progress,
-            max_states=max_states,
-        )
-        if graph is not None:
-            for line in [*map(hierarchy_line, choices), *turned]:
-                say(line)
-            return graph
-    except InfeasibleAssembly:
-        pass
     return build_with_units(
-        spec,
-        rel,
-        hierarchy=spec.generated,
+        assembly.spec,
+        assembly.relations,
+        hierarchy=assembly.spec.generated,
         reduce=True,
         concurrent=concurrent,
         on_unit=on_step,
-        given_up=given_up,
         progress=progress,
         max_states=max_states,
     )

@@ -13,6 +13,7 @@ from asp.game.io import save_dag
 from tests.asp.figures import figure4
 from tests.cad import shapes
 from tests.cad.test_loading import write_folder
+from tests.cad.test_subassemblies import rod_tower, tower_spec
 from tests.conftest import REPO
 
 PUMP = REPO / "examples" / "vacuum_pump"
@@ -32,6 +33,41 @@ def test_steps_one_by_one_agree_with_the_whole_plan():
     data = whole.to_dict()
     assert data["format"] == pipeline.PLAN_FORMAT and data["cost"] == "time"
     assert [s["operation"] for s in data["robust_plan"]] == [s.operation for s in steps]
+
+
+@pytest.mark.parametrize("proved", [True, False])
+def test_an_infeasible_assembly_graph_is_built_once(monkeypatch, proved):
+    """Issue 22 B2: ``state_graph`` is one call of ``build_with_units``. The rod tower's
+    holders never go in alone: each spec of the rounds (without units, then with the
+    holders' units) is reduced once and its graph built once checked, once unchecked at
+    most, never again by a first round of the pipeline's own; ``proved=False``: the
+    derived precedences prove nothing, the state graph finds the stuck parts itself."""
+    import asp.graph.state_graph
+    import asp.graph.symmetry
+    from cad import Assembly, compute_relations
+
+    rel = compute_relations(Assembly.from_meshes(rod_tower()))
+    calls = []
+
+    def spy(module, name):
+        real = getattr(module, name)
+
+        def counted(spec, *args, **kwargs):
+            calls.append((name, spec.subassemblies, kwargs.get("check", True)))
+            return real(spec, *args, **kwargs)
+
+        monkeypatch.setattr(module, name, counted)
+
+    spy(asp.graph.state_graph, "build_state_graph")
+    spy(asp.graph.symmetry, "symmetry_reduction")
+    if not proved:
+        monkeypatch.setattr(asp.graph.symmetry, "refutation", lambda *_args, **_kw: None)
+    lines = []
+    graph = pipeline.state_graph(pipeline.Assembly(tower_spec(rel), rel), on_step=lines.append)
+    assert len(graph.spec.subassemblies) == 2
+    assert len(calls) == len(set(calls)), calls
+    assert ("build_state_graph", (), False) in calls
+    assert sum("trying subassemblies" in line for line in lines) == 1
 
 
 def test_values_are_frozen():
