@@ -346,6 +346,8 @@ def load(
             "placement each, agents H and R1, durations from part size); "
             f"`asmplan init {source} -o assembly.yaml` writes it for editing"
         )
+    if len(spec.parts) == 1:
+        note(f"one part only ({spec.parts[0].id}): the plan places it; nothing is assembled")
     rel = None
     if spec.has_geometry:
         if on_step is not None:

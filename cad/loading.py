@@ -179,6 +179,9 @@ def _record_mesh(row: PartRecord, base: Path, units: str | None):
     unit = scene.units or units or "mm"
     if node:
         k = scene.find(node)
+        entire = scene.whole(node)
+        if entire is not None:  # a part split into its bodies, named whole
+            return entire, unit, f"{file}#{node}"
         if k is None:
             raise GeometryError(
                 f"part {row.id!r}: no part {node!r} in {file} (its parts: "

@@ -12,6 +12,11 @@ Part ids are the names the file gives, cleaned into short unique ids (:func:`cle
 reference labels ``=>[0:1:1:7]`` that cascadio gives the shape nodes of Pro/E and Creo
 exports) give way to the mesh's name or the nearest named parent (``L-BRACKET`` ->
 ``l_bracket_1``), else ``part``. A part's display name comes from the same node.
+
+A file of one part whose mesh is several closed bodies (a product fused into one solid)
+gives one part per body, ``<part>_body_<n>`` (:func:`cad.bodies.closed_bodies`; said in a
+warning); a spec part whose file names the whole part (``truck.stp#truck``) keeps it one
+rigid part.
 """
 
 from __future__ import annotations
@@ -25,6 +30,7 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
+from cad.bodies import closed_bodies
 from cad.errors import GeometryError
 from cad.readers import (  # noqa: F401  (re-exported: cad.scene is where callers look)
     MAX_GLTF_ASSEMBLY_M,
@@ -165,6 +171,9 @@ class SceneParts:
     rescale : float
         Factor from the coordinates trimesh reads to ``meshes`` (1.0 unless the file holds
         millimetre numbers under a wrong unit label, :func:`_millimetre_numbers`).
+    split : tuple of (str, tuple of str)
+        A part of the file split into its closed bodies: its id -> the ids of its bodies
+        (``truck`` -> ``truck_body_1``, ...; a one-part file only, :mod:`cad.bodies`).
     """
 
     ids: tuple[str, ...]
@@ -174,6 +183,7 @@ class SceneParts:
     units: str | None
     nodes: tuple[str, ...] = ()
     rescale: float = 1.0
+    split: tuple[tuple[str, tuple[str, ...]], ...] = ()
 
     def find(self, node: str) -> int | None:
         """Index of the part whose id, name or scene-graph node is ``node`` (None if none)."""
@@ -181,6 +191,13 @@ class SceneParts:
             if node in (pid, name):
                 return k
         return self.nodes.index(node) if node in self.nodes else None
+
+    def whole(self, node: str) -> trimesh.Trimesh | None:
+        """The mesh of a part split into bodies, whole (``node``: its id; None if none)."""
+        for pid, bodies in self.split:
+            if node == pid:
+                return trimesh.util.concatenate([self.meshes[self.ids.index(b)] for b in bodies])
+        return None
 
 
 def load_scene_file(path: Path) -> trimesh.Scene:
@@ -310,6 +327,12 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
         names.append(display_name(original(node) if raw is None else raw))
         bases.append("part" if raw is None else part_id(raw))
     ids = unique_ids(bases)
+    split = ()
+    if len(meshes) == 1 and (bodies := closed_bodies(meshes[0])) is not None:
+        split = ((ids[0], tuple(f"{ids[0]}_body_{n}" for n in range(1, len(bodies) + 1))),)
+        _warn_split(file, ids[0], len(bodies))
+        meshes, names = list(bodies), [f"{names[0]} body {n}" for n in range(1, len(bodies) + 1)]
+        part_nodes, ids = part_nodes * len(bodies), list(split[0][1])
     id_of = {node: pid for (node, _), pid in zip(part_nodes, ids, strict=True)}
     group_ids = unique_ids(
         [best_name([original(g)], fallback="group") for g, _ in group_nodes], taken=set(ids)
@@ -326,6 +349,19 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
         units=declared_units(file, scene),
         nodes=tuple(str(node) for node, _ in part_nodes),
         rescale=rescale,
+        split=split,
+    )
+
+
+def _warn_split(file: Path, part: str, count: int) -> None:
+    """Say that the one part of ``file`` is planned as its ``count`` closed bodies."""
+    import warnings
+
+    warnings.warn(
+        f"{file.name}: its one part {part} is {count} separate closed bodies: planned as "
+        f"{count} parts {part}_body_1..{count} (cad/bodies.py); a spec part with "
+        f"file: {file.name}#{part} keeps it one rigid part",
+        stacklevel=3,
     )
 
 

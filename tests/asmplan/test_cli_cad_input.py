@@ -177,3 +177,28 @@ def test_the_commented_subassemblies_of_init_are_a_valid_spec(tmp_path):
         "pillar_unit_2": ("cap_2", "pillar_2"),
     }
     assert pipeline.state_graph(assembly).count_sequences() > 0
+
+
+def test_a_one_part_file_says_so_and_a_fused_one_is_split(tmp_path):
+    one = trimesh.Scene()
+    one.add_geometry(
+        shapes.box_between((0, 0, 0), (10, 10, 10)).apply_scale(0.001), node_name="cube"
+    )
+    _, said = plan(write_named_glb_of(one, tmp_path / "cube.glb"), tmp_path / "one")
+    assert "one part only (cube)" in said
+    two = trimesh.Scene()
+    lower, upper = (
+        shapes.box_between((0, 0, 0), (10, 10, 10)),
+        shapes.box_between((2, 2, 10), (7, 7, 20)),
+    )
+    fused = trimesh.util.concatenate([lower, upper]).apply_scale(0.001)  # glTF: metres
+    two.add_geometry(fused, node_name="tower")
+    doc, said = plan(write_named_glb_of(two, tmp_path / "tower.glb"), tmp_path / "two")
+    assert "tower is 2 separate closed bodies" in said
+    assert "one part only" not in said
+    assert [p["id"] for p in doc["parts"]] == ["tower_body_1", "tower_body_2"]
+
+
+def write_named_glb_of(scene: trimesh.Scene, path: Path) -> Path:
+    scene.export(path)
+    return path

@@ -1,0 +1,102 @@
+"""One mesh that is several closed bodies: found, split into parts, kept whole on request."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+import trimesh
+
+from cad import load_assembly, load_parts
+from cad.bodies import closed_bodies
+from cad.bom import PartRecord
+from cad.scene import read_scene
+
+
+def box(extents, at) -> trimesh.Trimesh:
+    return trimesh.creation.box(extents=extents).apply_translation(at)
+
+
+def faces_apart(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+    """``mesh`` with every face's vertices its own (how OCCT tessellates B-rep faces:
+    faces share positions, never vertex indices)."""
+    copy = mesh.copy()
+    copy.unmerge_vertices()
+    return copy
+
+
+def fused(*meshes: trimesh.Trimesh) -> trimesh.Trimesh:
+    return trimesh.util.concatenate(list(meshes))
+
+
+def inside_out(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+    return trimesh.Trimesh(mesh.vertices, np.asarray(mesh.faces)[:, ::-1])
+
+
+def volumes(bodies) -> list[float]:
+    return [round(float(b.volume), 6) for b in bodies]
+
+
+@pytest.mark.parametrize("apart", [False, True])
+def test_disjoint_boxes_are_bodies_in_the_file_order(apart):
+    mesh = fused(box([1, 1, 1], [0, 0, 0]), box([2, 1, 1], [5, 0, 0]), box([1, 1, 3], [0, 5, 0]))
+    bodies = closed_bodies(faces_apart(mesh) if apart else mesh)
+    assert volumes(bodies) == [1.0, 2.0, 3.0]
+
+
+def test_a_cylinder_of_separate_faces_is_one_body():
+    cylinder = faces_apart(trimesh.creation.cylinder(radius=1.0, height=2.0, sections=24))
+    assert closed_bodies(fused(cylinder, box([1, 1, 1], [5, 0, 0]))) is not None
+    assert len(closed_bodies(fused(cylinder, box([1, 1, 1], [5, 0, 0])))) == 2
+    assert closed_bodies(cylinder) is None
+
+
+def test_a_cavity_stays_with_the_body_around_it():
+    hollow = fused(box([4, 4, 4], [0, 0, 0]), inside_out(box([2, 2, 2], [0, 0, 0])))
+    bodies = closed_bodies(fused(hollow, box([1, 1, 1], [10, 0, 0])))
+    assert volumes(bodies) == [56.0, 1.0]
+
+
+def test_a_body_written_inside_out_is_turned():
+    bodies = closed_bodies(fused(box([1, 1, 1], [0, 0, 0]), inside_out(box([2, 1, 1], [5, 0, 0]))))
+    assert volumes(bodies) == [1.0, 2.0]
+
+
+def test_a_mesh_with_an_open_piece_is_not_split():
+    open_box = box([1, 1, 1], [5, 0, 0])
+    open_box.update_faces(np.arange(len(open_box.faces)) > 1)  # one side removed
+    assert closed_bodies(fused(box([1, 1, 1], [0, 0, 0]), open_box)) is None
+
+
+def test_touching_bodies_that_share_a_corner_position_are_one_body():
+    bodies = closed_bodies(fused(box([1, 1, 1], [0, 0, 0]), box([1, 1, 1], [1, 1, 1])))
+    assert bodies is None
+
+
+def write_one_node_glb(path, mesh):
+    scene = trimesh.Scene()
+    scene.add_geometry(mesh, node_name="truck", geom_name="truck")
+    scene.export(path)
+    return path
+
+
+def test_a_one_part_file_of_several_bodies_plans_one_part_per_body(tmp_path):
+    mesh = fused(box([0.01, 0.01, 0.01], [0, 0, 0]), box([0.01, 0.01, 0.02], [0.05, 0, 0]))
+    path = write_one_node_glb(tmp_path / "truck.glb", faces_apart(mesh))
+    with pytest.warns(UserWarning, match=r"truck is 2 separate closed bodies.*truck.glb#truck"):
+        assembly = load_assembly(path)
+    assert [p.id for p in assembly.parts] == ["truck_body_1", "truck_body_2"]
+    assert read_scene(path).split == (("truck", ("truck_body_1", "truck_body_2")),)
+    assert [round(float(p.mesh.volume)) for p in assembly.parts] == [1000, 2000]  # mm^3
+
+
+def test_a_spec_part_naming_the_whole_part_keeps_it_one_rigid_part(tmp_path):
+    mesh = fused(box([0.01, 0.01, 0.01], [0, 0, 0]), box([0.01, 0.01, 0.02], [0.05, 0, 0]))
+    write_one_node_glb(tmp_path / "truck.glb", mesh)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        records = [PartRecord(id="truck", name="truck", file="truck.glb#truck")]
+        assembly = load_parts(records, tmp_path)
+    assert [p.id for p in assembly.parts] == ["truck"]
+    assert round(float(assembly.parts[0].mesh.volume)) == 3000
