@@ -6,7 +6,9 @@ Public API (imported lazily, so that ``import arl`` does not load torch):
 - :func:`arl.evaluate`: exact metrics of a learned policy or run folder;
 - :class:`arl.TrainConfig`, :data:`arl.CONFIGS` (``paper``, ``fast``): :mod:`arl.config`;
 - environments: :class:`arl.RobotEnv`, :class:`arl.HumanEnv`, :class:`arl.GameVecEnv`
-  (:mod:`arl.envs`) and the PettingZoo :class:`arl.GameAEC` (:mod:`arl.pettingzoo_env`).
+  (:mod:`arl.envs`) and the PettingZoo :class:`arl.GameAEC` (:mod:`arl.pettingzoo_env`);
+- the concurrent game played on the fly from its rules: :class:`arl.ConcurrentRobotEnv`,
+  :class:`arl.ConcurrentHumanEnv` (:mod:`arl.concurrent_env`).
 """
 
 from __future__ import annotations
@@ -26,6 +28,8 @@ _EXPORTS = {
     "GameVecEnv": "arl.envs",
     "GameAEC": "arl.pettingzoo_env",
     "GameTables": "arl.moves",
+    "ConcurrentRobotEnv": "arl.concurrent_env",
+    "ConcurrentHumanEnv": "arl.concurrent_env",
 }
 
 __all__ = sorted(_EXPORTS)
