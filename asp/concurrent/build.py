@@ -13,6 +13,8 @@ is its own DAG (no instructions).
 
 from __future__ import annotations
 
+import functools
+import os
 import sys
 import time
 from collections.abc import Sequence
@@ -26,6 +28,64 @@ from asp.game.dag import HUMAN, ROBOT, GameDAG, from_arrays
 
 DEFAULT_MAX_NODES = 3_000_000
 """Above this many game nodes the build stops with a ``ValueError``."""
+NODE_BYTES, EDGE_BYTES = 200, 110
+"""Peak bytes of the compiled build per game node and per edge, the DAG made from it
+included (measured on ``examples/vacuum_pump_ranges``: 3.1 M edges and 180 k nodes peaked
+at 0.32 GB over the interpreter, 103 bytes per edge, nodes included)."""
+PY_NODE_BYTES, PY_EDGE_BYTES = 1000, 400
+"""The same for the Python builder (tuples in a dict, one dataclass per edge)."""
+DEFAULT_MEMORY = 2 << 30
+MEMORY_SHARE = 0.75
+"""The default memory limit of a build: :data:`DEFAULT_MEMORY` bytes (2 GiB), or this share
+of the memory available when it starts if that is less (:func:`default_memory`)."""
+
+
+def default_memory() -> int:
+    """The default memory limit of a build, in bytes (:data:`MEMORY_SHARE`)."""
+    return min(DEFAULT_MEMORY, int(MEMORY_SHARE * available_memory()))
+
+
+def available_memory() -> int:
+    """Bytes of memory available now (``MemAvailable`` of ``/proc/meminfo``; else the free
+    physical pages; else 8 GiB)."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    try:
+        return int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_AVPHYS_PAGES"))
+    except (AttributeError, ValueError, OSError):
+        return 8 << 30
+
+
+def game_bytes(n_nodes: int, n_edges: int, *, compiled: bool = True) -> int:
+    """The estimated peak bytes of building a game of ``n_nodes`` nodes and ``n_edges``
+    edges (:data:`NODE_BYTES`, :data:`EDGE_BYTES`; the Python builder's when not
+    ``compiled``)."""
+    if compiled:
+        return int(n_nodes) * NODE_BYTES + int(n_edges) * EDGE_BYTES
+    return int(n_nodes) * PY_NODE_BYTES + int(n_edges) * PY_EDGE_BYTES
+
+
+def memory_limit_error(where: str, counts: tuple, limit: int, *, compiled: bool = True):
+    """The :class:`asp.errors.GameLimit` of a build stopped at ``limit`` bytes: what it had
+    built (``counts``: nodes expanded, nodes, edges) and its estimate (:func:`game_bytes`,
+    a lower bound of the whole game's: the build was still growing), the limit and the
+    memory available, and the flags that make the game smaller or the limit larger."""
+    _, nodes, edges = (int(x) for x in counts)
+    now = game_bytes(nodes, edges, compiled=compiled)
+    gb = 2**30
+    free = available_memory() / gb
+    return GameLimit(
+        f"{where}: the concurrent game needs more than {now / gb:.2f} GB (estimated from the "
+        f"{nodes:,} nodes and {edges:,} edges built when it passed the limit), over the "
+        f"--max-memory limit of {limit / gb:.2f} GB ({free:.1f} GB available); coarsen the "
+        "human duration grid (--duration-step), bound the deviation budget (--max-k), or "
+        "raise --max-memory"
+    )
 
 
 @dataclass(frozen=True)
@@ -97,11 +157,15 @@ def build_game(
     max_nodes: int = DEFAULT_MAX_NODES,
     progress: bool = False,
     compiled: bool | None = None,
+    max_memory: int | None = None,
 ) -> ConcurrentGame:
     """Build the concurrent game for the budgets ``0..K`` (``budgets=K``) or unbounded (``None``).
 
     Parameters
     ----------
+    max_memory : int, optional
+        Bytes the build may use (:func:`game_bytes` of what it has built, checked at every
+        node and edge); default :func:`default_memory` (2 GiB at most).
     compiled : bool, optional
         Use the numba builder (:mod:`asp.concurrent_kernel`); default whenever its packed
         state key fits. ``False``: the Python builder (the same game, slower).
@@ -110,6 +174,9 @@ def build_game(
     ------
     ValueError
         A negative budget, or more than ``max_nodes`` nodes (the message names ``--max-k``).
+    asp.errors.GameLimit
+        Over ``max_nodes`` nodes, or over ``max_memory`` bytes (the message gives the
+        estimate of the whole game, the limit and the memory available, and names the flags).
     """
     from asp.concurrent import kernel
 
@@ -132,6 +199,7 @@ def build_game(
         (d + int(model.succ_change_max) for row in model.choices for c in row for d in c),
         default=0,
     )
+    limit = default_memory() if max_memory is None else int(max_memory)
     fits = kernel.fits(len(model.workers), model.n_ops, longest, model.graph.n_states, levels[-1])
     if compiled is None:
         compiled = fits
@@ -139,8 +207,17 @@ def build_game(
         if not fits:
             raise GameError(f"{where}: the compiled builder's packed state key does not fit")
         arrays = model.kernel_arrays()
-        out = kernel.build_kernel(*arrays, np.array(levels, dtype=np.int64), int(max_nodes))
-        overflow, rows, starts_a, src, dst, cost, side, e_ops, e_dur, e_dev = out
+        out = kernel.build_kernel(
+            *arrays,
+            np.array(levels, dtype=np.int64),
+            int(max_nodes),
+            int(limit),
+            NODE_BYTES,
+            EDGE_BYTES,
+        )
+        overflow, counts, rows, starts_a, src, dst, cost, side, e_ops, e_dur, e_dev = out
+        if overflow == kernel.OVER_MEMORY:
+            raise memory_limit_error(where, tuple(counts), limit)
         if overflow:
             raise too_big
         order = np.argsort(src, kind="stable")
@@ -150,8 +227,9 @@ def build_game(
         starts = {b: int(starts_a[i]) for i, b in enumerate(levels)}
         end = 0
     else:
+        over_memory = functools.partial(memory_limit_error, where, limit=limit, compiled=False)
         nodes, actions, starts, end, src, dst, cost, side = _build_python(
-            model, levels, max_nodes, too_big, progress
+            model, levels, max_nodes, too_big, progress, (limit, over_memory)
         )
     return game_of(model, levels, nodes, actions, starts, end, (src, dst, cost, side), t0)
 
@@ -250,8 +328,11 @@ class ActionRows(Sequence):
         )
 
 
-def _build_python(model: ConcurrentModel, levels, max_nodes, too_big, progress):
-    """The Python builder: a depth-first search over the game's nodes (dict of tuples)."""
+def _build_python(model: ConcurrentModel, levels, max_nodes, too_big, progress, memory):
+    """The Python builder: a depth-first search over the game's nodes (dict of tuples).
+    ``memory``: the limit in bytes and the error for ``(expanded, nodes, edges)`` past it."""
+    limit, over_memory = memory
+    expanded = 0
     nw = len(model.workers)
     idle = tuple((WAIT, 0) for _ in range(nw))
     index: dict = {}
@@ -275,6 +356,9 @@ def _build_python(model: ConcurrentModel, levels, max_nodes, too_big, progress):
     node(end_key)
     while todo:
         v = todo.pop()
+        expanded += 1
+        if game_bytes(len(nodes), len(src), compiled=False) > limit:
+            raise over_memory((expanded, len(nodes), len(src)))
         key = nodes[v]
         if key[0] == "R":
             for commit, target in _robot_moves(model, key):

@@ -36,6 +36,9 @@ MAX_REMAINING = 65_535
 MAX_STATES = 2**31 - 1
 KEY = types.UniTuple(types.int64, 4)
 MEMO_KEY = types.UniTuple(types.int64, 2)
+OVER_NODES, OVER_MEMORY = 1, 2
+"""Why :func:`build_kernel` stopped: a node past ``max_nodes``, or its bytes past
+``max_bytes``."""
 
 
 def fits(n_workers: int, n_ops: int, longest: int, n_states: int, budget: int) -> bool:
@@ -117,8 +120,26 @@ def _has_candidate(  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def build_kernel(
-    indptr, dst, op, change, dur, ndur, conflict, complete, side, budgets, max_nodes
+    indptr,
+    dst,
+    op,
+    change,
+    dur,
+    ndur,
+    conflict,
+    complete,
+    side,
+    budgets,
+    max_nodes,
+    max_bytes,
+    node_bytes,
+    edge_bytes,
 ):  # pragma: no cover - compiled
+    """The game from the starts of ``budgets`` (module docstring). It stops (``overflow``
+    :data:`OVER_NODES`) before a node past ``max_nodes``, and (:data:`OVER_MEMORY`) once
+    its nodes and edges, at ``node_bytes`` and ``edge_bytes`` each, pass ``max_bytes``.
+    Returns ``(overflow, [nodes expanded, nodes, edges], node rows, start nodes, edge
+    arrays...)``, the arrays empty when it stopped."""
     nw = side.shape[0]
     width = 3 + 3 * nw
     cap = 1024
@@ -180,8 +201,11 @@ def build_kernel(
     seen_t = np.empty(4096, np.int64)
     seen_c = np.empty(4096, np.int64)
     overflow = False
+    over = OVER_NODES
+    expanded = 0
     while top > 0:
         top -= 1
+        expanded += 1
         v = stack[top]
         cur = rows[v].copy()
         kind, s, budget = cur[0], cur[1], cur[2]
@@ -271,6 +295,9 @@ def build_kernel(
                         break
                     edges = _append_edge(edges, m_edges, v, t, 0, 0, 0, deciders, chosen, nd)
                     m_edges += 1
+                    if m_edges * edge_bytes + n * node_bytes > max_bytes:
+                        overflow, over = True, OVER_MEMORY
+                        break
             elif ok and kind == 1 and m > 0:
                 dev = 0
                 if instruct:
@@ -359,6 +386,9 @@ def build_kernel(
                                 e_dur[m_edges, w] = dur[w, chosen[d], sd[j]]
                                 e_dur[m_edges, w] += change[edge(s, chosen[d], indptr, op)]
                             m_edges += 1
+                            if m_edges * edge_bytes + n * node_bytes > max_bytes:
+                                overflow, over = True, OVER_MEMORY
+                                break
                         # Next durations.
                         j = ns - 1
                         while j >= 0:
@@ -386,8 +416,12 @@ def build_kernel(
         if overflow:
             break
     e_src, e_dst, e_cost, e_side, e_dev, e_ops, e_dur = edges
+    counts = np.array([expanded, n, m_edges], np.int64)
+    if overflow:  # what was built is dropped: only the counts are returned
+        n = m_edges = 0
     return (
-        overflow,
+        over if overflow else 0,
+        counts,
         rows[:n].copy(),
         starts,
         e_src[:m_edges].copy(),
