@@ -1,0 +1,331 @@
+"""Alternating PPO on the concurrent game played on the fly, certified by an exact best response.
+
+The paper's learner (``../shared/DESIGN.md``, "Alternating PPO") where the exact solver
+does not reach: the game is never compiled, both sides play it from its rules
+(:mod:`arl.concurrent_env`), and each sees the position's features, so the policy network
+generalises across states it has not visited.
+
+The loop (:func:`train_concurrent`), per cycle:
+
+1. the robot (sb3-contrib ``MaskablePPO``) trains ``phase_steps`` steps against the human
+   model as it is (frozen for the phase, sampling its policy);
+2. the human trains ``phase_steps`` steps against the robot model, frozen;
+3. the robot's greedy policy is certified: the exact best response of the human side to it
+   (:func:`asp.concurrent.certify.certify`) for every budget asked, in spec units. The
+   policy of least certified worst case so far (at the largest budget, ``k = inf``, then
+   the others) is the run's answer, saved as ``robot.zip``.
+
+The certificate is exact whatever the network learned: it is a third candidate for the
+upper bound ``U(k)`` beside the greedy and the CP-SAT schedule policies
+(:mod:`asp.concurrent.search`).
+
+Seeds: ``seed`` fixes torch, numpy and both models; every phase reseeds its model (and so
+its environment) from ``(seed, cycle, side)``. Torch runs on one thread on the CPU, so a
+seed gives the same log.
+
+The run folder: ``config.json``, ``log.json`` (a record per cycle), ``robot.zip`` (the
+best robot), ``human.zip`` (the last human), each written atomically after every cycle.
+:func:`load_robot` reads the robot back; :func:`learned_policy` makes it a robot policy
+for :func:`asp.concurrent.certify.certify`.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import io
+import json
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from stable_baselines3.common.callbacks import BaseCallback
+
+from arl.concurrent_env import ConcurrentHumanEnv, ConcurrentRobotEnv, robot_choose
+from asp.concurrent.certify import certify
+from asp.concurrent.rules import Rules
+
+LOG_VERSION = 1
+
+
+@dataclass(frozen=True)
+class ConcurrentConfig:
+    """A training run on the concurrent game (the seed aside).
+
+    Attributes
+    ----------
+    name : str
+    net_arch : tuple of int
+        Hidden layers of the policy and value networks.
+    learning_rate, n_steps, batch_size, n_epochs, gamma, gae_lambda, clip_range, ent_coef
+        PPO's (``MaskablePPO``); ``gamma`` 1: the robot's return is minus the makespan.
+    phase_steps : int
+        Steps each side trains per cycle.
+    cycles : int
+        Cycles of the run.
+    train_budgets : tuple of int or None
+        Budgets the training games start at, drawn uniformly (None: ``k = inf``).
+    """
+
+    name: str = "concurrent"
+    net_arch: tuple[int, ...] = (64, 64)
+    learning_rate: float = 1e-3
+    n_steps: int = 256
+    batch_size: int = 64
+    n_epochs: int = 4
+    gamma: float = 1.0
+    gae_lambda: float = 0.95
+    clip_range: float = 0.2
+    ent_coef: float = 0.01
+    phase_steps: int = 1024
+    cycles: int = 9
+    train_budgets: tuple = (None,)
+
+    def __post_init__(self) -> None:
+        for name in ("n_steps", "batch_size", "n_epochs", "phase_steps", "cycles"):
+            if int(getattr(self, name)) < 1:
+                raise ValueError(f"{name}: expected a positive integer, got {getattr(self, name)}")
+        if not self.train_budgets or any(b is not None and b < 0 for b in self.train_budgets):
+            raise ValueError(
+                f"train_budgets: expected budgets >= 0 or None, got {self.train_budgets}"
+            )
+
+    def replace(self, **changes) -> ConcurrentConfig:
+        return dataclasses.replace(self, **changes)
+
+    def to_dict(self) -> dict:
+        return dataclasses.asdict(self)
+
+    @classmethod
+    def from_dict(cls, data: dict) -> ConcurrentConfig:
+        known = {f.name for f in dataclasses.fields(cls)}
+        unknown = sorted(set(data) - known)
+        if unknown:
+            raise ValueError(f"config: unknown fields {', '.join(unknown)}")
+        values = dict(data)
+        for name in ("net_arch", "train_budgets"):
+            if name in values:
+                values[name] = tuple(values[name])
+        return cls(**values)
+
+
+CONFIGS: dict[str, ConcurrentConfig] = {
+    "concurrent": ConcurrentConfig(),
+    "concurrent-tiny": ConcurrentConfig(
+        name="concurrent-tiny", net_arch=(16,), n_steps=32, batch_size=32, phase_steps=64, cycles=2
+    ),
+}
+"""``concurrent``: 9 cycles of 1,024 steps a side (18,432 steps); ``concurrent-tiny`` for
+tests."""
+
+
+def get_config(config: str | ConcurrentConfig) -> ConcurrentConfig:
+    """The named configuration, or ``config`` itself."""
+    if isinstance(config, ConcurrentConfig):
+        return config
+    if config not in CONFIGS:
+        raise ValueError(f"config: expected one of {', '.join(CONFIGS)}, got {config!r}")
+    return CONFIGS[config]
+
+
+@dataclass(frozen=True, eq=False)
+class ConcurrentTrainResult:
+    """The outcome of :func:`train_concurrent`.
+
+    Attributes
+    ----------
+    robot : sb3_contrib.MaskablePPO
+        The robot model of least certified worst case (of cycle ``best_cycle``).
+    certified : dict
+        Budget (None: ``k = inf``) -> that robot's certified worst case (spec units).
+    cycles : list of dict
+        Per cycle: ``cycle``, ``steps`` (cumulative, both sides), ``seconds`` (cumulative),
+        ``robot_makespan`` (mean makespan of the robot's training games), ``certified``
+        (``[{"k", "bound"}]``).
+    best_cycle : int
+    steps : int
+        Environment steps of both sides.
+    seconds : float
+    config : ConcurrentConfig
+    """
+
+    robot: object
+    certified: dict
+    cycles: list
+    best_cycle: int
+    steps: int
+    seconds: float
+    config: ConcurrentConfig
+
+
+def _phase_seed(seed: int, cycle: int, side: int) -> int:
+    return int(np.random.SeedSequence([seed, cycle, side]).generate_state(1)[0])
+
+
+def _model(env, cfg: ConcurrentConfig, seed: int):
+    from sb3_contrib import MaskablePPO
+
+    return MaskablePPO(
+        "MlpPolicy",
+        env,
+        learning_rate=cfg.learning_rate,
+        n_steps=cfg.n_steps,
+        batch_size=cfg.batch_size,
+        n_epochs=cfg.n_epochs,
+        gamma=cfg.gamma,
+        gae_lambda=cfg.gae_lambda,
+        clip_range=cfg.clip_range,
+        ent_coef=cfg.ent_coef,
+        policy_kwargs={"net_arch": list(cfg.net_arch)},
+        seed=seed,
+        device="cpu",
+        verbose=0,
+    )
+
+
+def _key(certified: dict, budgets: list) -> tuple:
+    """Order of certificates: the worst case at the last budget asked, then the others."""
+    return (certified[budgets[-1]], *(certified[b] for b in budgets))
+
+
+def learned_policy(rules: Rules, robot):
+    """The robot model's greedy moves as a robot policy for
+    :func:`asp.concurrent.certify.certify`."""
+    return robot_choose(rules, robot, deterministic=True)
+
+
+def train_concurrent(
+    rules: Rules,
+    config: str | ConcurrentConfig = "concurrent",
+    *,
+    seed: int = 0,
+    budgets: list[int | None] | None = None,
+    output: Path | None = None,
+    progress: bool = False,
+) -> ConcurrentTrainResult:
+    """Alternating PPO on the concurrent game of ``rules`` (module docstring).
+
+    Parameters
+    ----------
+    budgets : list of int or None
+        The budgets certified after every cycle (default ``[0, 1, 2, None]``); the last one
+        ranks the cycles' robots.
+    output : Path, optional
+        The run folder (written after every cycle).
+    progress : bool
+        A line on stderr per cycle.
+    """
+    import torch
+    from stable_baselines3.common.utils import set_random_seed
+
+    cfg = get_config(config)
+    budgets = list(budgets) if budgets is not None else [0, 1, 2, None]
+    torch.set_num_threads(1)
+    set_random_seed(seed)
+    t0 = time.perf_counter()
+    train_budgets = list(cfg.train_budgets)
+    robot_env = ConcurrentRobotEnv(rules, budgets=train_budgets)
+    human_env = ConcurrentHumanEnv(rules, budgets=train_budgets)
+    robot = _model(robot_env, cfg, _phase_seed(seed, 0, 0))
+    human = _model(human_env, cfg, _phase_seed(seed, 0, 1))
+    robot_env.set_opponent(human)
+    human_env.set_opponent(robot)
+    records: list[dict] = []
+    best, best_cycle, best_bytes = None, 0, b""
+    steps = 0
+    for cycle in range(1, cfg.cycles + 1):
+        makespans: list[float] = []
+        for side, model in ((0, robot), (1, human)):
+            model.set_random_seed(_phase_seed(seed, cycle, side))
+            callback = _Makespans() if side == 0 else None
+            model.learn(cfg.phase_steps, callback=callback, reset_num_timesteps=False)
+            if callback is not None:
+                makespans = callback.makespans
+        steps = int(robot.num_timesteps + human.num_timesteps)
+        cert = certify(rules, learned_policy(rules, robot), budgets)
+        record = {
+            "cycle": cycle,
+            "steps": steps,
+            "seconds": round(time.perf_counter() - t0, 3),
+            "robot_makespan": float(np.mean(makespans)) if makespans else None,
+            "certified": cert.to_list(),
+        }
+        records.append(record)
+        if best is None or _key(cert.worst, budgets) < _key(best, budgets):
+            best, best_cycle, best_bytes = dict(cert.worst), cycle, _model_bytes(robot)
+        if progress:
+            shown = ", ".join(_k_text(r) for r in record["certified"])
+            print(
+                f"  cycle {cycle}/{cfg.cycles}: {steps:,} steps, {record['seconds']:.0f} s, "
+                f"certified {shown}",
+                file=sys.stderr,
+                flush=True,
+            )
+        if output is not None:
+            _save(Path(output), cfg, seed, budgets, records, best_cycle, best_bytes, human)
+    from sb3_contrib import MaskablePPO
+
+    best_robot = MaskablePPO.load(io.BytesIO(best_bytes), device="cpu")
+    return ConcurrentTrainResult(
+        robot=best_robot,
+        certified=best,
+        cycles=records,
+        best_cycle=best_cycle,
+        steps=steps,
+        seconds=time.perf_counter() - t0,
+        config=cfg,
+    )
+
+
+class _Makespans(BaseCallback):
+    """Keeps the makespan of every training game the robot finished."""
+
+    def __init__(self):
+        super().__init__()
+        self.makespans: list[float] = []
+
+    def _on_step(self) -> bool:
+        for info in self.locals.get("infos", []):
+            if "makespan" in info:
+                self.makespans.append(float(info["makespan"]))
+        return True
+
+
+def _k_text(row: dict) -> str:
+    return f"k={'inf' if row['k'] is None else row['k']}: {row['bound']:g}"
+
+
+def _model_bytes(model) -> bytes:
+    buf = io.BytesIO()
+    model.save(buf)
+    return buf.getvalue()
+
+
+def _save(folder: Path, cfg, seed, budgets, records, best_cycle, robot_bytes, human) -> None:
+    from asp.atomic import write_bytes, write_text
+
+    folder.mkdir(parents=True, exist_ok=True)
+    config = {"version": LOG_VERSION, "seed": seed, "budgets": budgets, "config": cfg.to_dict()}
+    write_text(folder / "config.json", json.dumps(config, indent=1) + "\n")
+    log = {"version": LOG_VERSION, "best_cycle": best_cycle, "cycles": records}
+    write_text(folder / "log.json", json.dumps(log, indent=1) + "\n")
+    write_bytes(folder / "robot.zip", robot_bytes)
+    write_bytes(folder / "human.zip", _model_bytes(human))
+
+
+def load_robot(folder: Path):
+    """The best robot model of a run folder written by :func:`train_concurrent`.
+
+    Raises
+    ------
+    ValueError
+        ``folder`` is not such a run folder.
+    """
+    from sb3_contrib import MaskablePPO
+
+    folder = Path(folder)
+    path = folder / "robot.zip"
+    if not (folder / "config.json").is_file() or not path.is_file():
+        raise ValueError(f"{folder}: not a concurrent run folder (no config.json, robot.zip)")
+    return MaskablePPO.load(path, device="cpu")
