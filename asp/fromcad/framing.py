@@ -16,7 +16,9 @@ are computed afresh and the generated spec's decisions taken again (gravity, bas
 refute every sequence (:func:`asp.symmetry.infeasibility`) is taken; else the first in
 which no pair is interlocked; else the file's frame stays (nothing helps; the state graph
 then says which part can never be inserted). Each candidate costs one computation of the
-relations.
+relations. A candidate whose relations cannot be computed (a pair overlaps there that is a
+fit in the file's frame: the toy truck's pins turned 20 degrees off their holes' axes are
+no longer recognised as pins in holes) does not help, and is passed over.
 """
 
 from __future__ import annotations
@@ -24,6 +26,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
+from cad.errors import GeometryError
 from cad.frame import Rotation, candidate_frames, frame_text, interlocked
 
 
@@ -41,12 +44,15 @@ class FrameChoice:
         Why this frame (the shared axis it turns onto a coordinate axis).
     tried : int
         Candidate frames tried.
+    failed : int
+        Candidates passed over because their relations could not be computed.
     """
 
     rotation: Rotation | None
     stuck: tuple[tuple[str, str], ...]
     reason: str
     tried: int
+    failed: int = 0
 
     @property
     def text(self) -> str:
@@ -58,9 +64,14 @@ class FrameChoice:
             f"every axis direction ({shown}{more})"
         )
         if self.rotation is None:
+            failed = (
+                f" ({self.failed} of them: parts overlap there that fit in the file's frame)"
+                if self.failed
+                else ""
+            )
             return (
                 f"the file's frame kept, though {why}: none of {self.tried} frame(s) from "
-                "the parts' own axes helped"
+                f"the parts' own axes helped{failed}"
             )
         return f"{frame_text(self.rotation)}: {why}; {self.reason}, now coordinate axes"
 
@@ -92,17 +103,21 @@ def choose_frame(decided, geometry, in_frame: Callable) -> tuple[FrameChoice | N
     stuck = tuple(interlocked(relations, spec.base_part))
     if not stuck:
         return None, None
-    fallback = None
+    fallback, failed = None, 0
     candidates = candidate_frames(geometry, parts={p for pair in stuck for p in pair})
     for candidate in candidates:
-        framed = in_frame(candidate.rotation)
+        try:
+            framed = in_frame(candidate.rotation)
+        except GeometryError:  # overlaps there that the file's frame has as fits
+            failed += 1
+            continue
         if interlocked(framed.relations, framed.spec.base_part):
             continue
         choice = FrameChoice(candidate.rotation, stuck, candidate.reason, len(candidates))
         if not infeasibility(framed.spec, framed.relations):
             return choice, framed
         fallback = fallback or (choice, framed)
-    return fallback or (FrameChoice(None, stuck, "", len(candidates)), None)
+    return fallback or (FrameChoice(None, stuck, "", len(candidates), failed), None)
 
 
 __all__ = ["FrameChoice", "choose_frame"]
