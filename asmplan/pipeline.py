@@ -51,6 +51,10 @@ PLAN_FORMAT = "asmplan-plan/2"
 GRAPH_SUFFIXES = (".json", ".graphml", ".xml")
 """Suffixes read as a game DAG file rather than an assembly."""
 
+PREVIEW_MAX_STATES = 5_000
+"""Largest state graph whose concurrent game an alternate plan previews (``plan.json``'s
+``concurrent_preview``, drawn in ``report.html``)."""
+
 Progress = Callable[[str], None]
 """A callback that shows one line of progress (e.g. prints it on stderr)."""
 
@@ -178,7 +182,10 @@ class AssemblyPlan:
         certified worst case, the timelines.
     units : list of dict
         Every unit used and every sub-assembly of the CAD file, used or why not
-        (:func:`asp.units.units_report`; ``plan.json``'s ``units``).
+        (:func:`asp.subassemblies.units_report`; ``plan.json``'s ``units``).
+    concurrent_preview : dict or None
+        With the turn model ``alternate``: the concurrent game's preview
+        (:func:`concurrent_preview`; ``plan.json``'s ``concurrent_preview``).
     played : PlayedGame or None
         What the outputs take from the game, made by :func:`plan` (else from ``game`` and
         ``solution`` when first needed: :attr:`played_game`).
@@ -195,6 +202,7 @@ class AssemblyPlan:
     concurrent: ConcurrentPlan | None = None
     units: list[dict] = field(default_factory=list)
     played: PlayedGame | None = None
+    concurrent_preview: dict | None = None
 
     @property
     def dag(self) -> GameDAG:
@@ -225,6 +233,8 @@ class AssemblyPlan:
             "units": self.units,
         }
         if self.concurrent is None:
+            if self.concurrent_preview is not None:
+                extra["concurrent_preview"] = self.concurrent_preview
             played = self.played_game
             return played_document(
                 self.assembly.spec,
@@ -748,8 +758,12 @@ def plan(
     line = [step.operation for step in steps if step.operation]
     sched = schedule(assembly, graph, time_limit=time_limit, seed=seed, sequence=line)
     release_memory()  # CP-SAT's model and the replay tables
-    concurrent = None
-    if turn == "concurrent":
+    concurrent = preview = None
+    if turn != "concurrent":
+        preview = concurrent_preview(
+            assembly.spec, graph, schedule=(sched.result, sched.lower_bound)
+        )
+    else:
         from asp.concurrent.plan import plan_concurrent
         from asp.concurrent.robustness import DEFAULT_MAX_K
 
@@ -773,6 +787,73 @@ def plan(
         concurrent,
         unit_rows,
         played,
+        preview,
+    )
+
+
+def concurrent_preview(spec: AssemblySpec, graph: StateGraph, *, schedule=None) -> dict:
+    """``plan.json``'s ``concurrent_preview`` of an alternate plan: its concurrent game,
+    solved for the report when the state graph is small.
+
+    Parameters
+    ----------
+    spec : asp.spec.AssemblySpec
+    graph : asp.state_graph.StateGraph
+    schedule : (BaselineResult, float), optional
+        The plan's CP-SAT schedule and its lower bound (spares solving it again).
+
+    Returns
+    -------
+    dict
+        The concurrent plan's ``robustness``, ``concurrent`` (without its ``seconds``) and
+        ``schedule`` (its ``objective`` and ``status`` only) keys
+        (:func:`asp.concurrent.plan.plan_entries`) when the graph has at most
+        :data:`PREVIEW_MAX_STATES` states and the game could be solved, else ``{"why":
+        reason}``. No timings: two runs give the same preview.
+    """
+    if graph.n_states > PREVIEW_MAX_STATES:
+        return {
+            "why": f"{graph.n_states:,} assembly states (the report solves the concurrent "
+            f"game up to {PREVIEW_MAX_STATES:,})"
+        }
+    from asp.concurrent.plan import plan_concurrent, plan_entries
+
+    try:
+        preview = plan_concurrent(spec, graph, max_nodes=200_000, schedule=schedule)
+    except (ValueError, MemoryError) as exc:
+        return {"why": str(exc).splitlines()[0]}
+    entries = plan_entries(preview)
+    game = {k: v for k, v in entries["concurrent"].items() if k != "seconds"}
+    sched = {k: entries["schedule"][k] for k in ("objective", "status")}
+    return {"robustness": entries["robustness"], "concurrent": game, "schedule": sched}
+
+
+def build_plan(
+    assembly: str | os.PathLike[str], *, cost: str | None = None, turn_model: str | None = None
+) -> dict:
+    """The plan document of an assembly (folder, ``assembly.yaml`` or ``.IN2``), for a
+    service that plans on start.
+
+    Turn model ``alternate``: the relations, state graph, game and exact solution, then
+    :func:`asmplan.planfile.plan_document`, without the CP-SAT schedule. ``concurrent``
+    (``turn_model``, default the spec's): :func:`plan`, the curve ``W*(k)`` and the CP-SAT
+    comparison included.
+    """
+    from asmplan.planfile import alternate_states, plan_document
+
+    loaded = load(assembly)
+    if (turn_model or loaded.spec.turn_model) == "concurrent":
+        return plan(loaded, cost=cost, turn_model="concurrent").to_dict()
+    graph = state_graph(loaded)
+    dag = game(graph, cost=cost)
+    solution = solve_game(dag)
+    return plan_document(
+        spec=loaded.spec,
+        dag=dag,
+        solution=solution,
+        describe=alternate_states(graph, dag),
+        relations=loaded.relations,
+        interchangeable=graph.model.interchangeable,
     )
 
 
@@ -795,6 +876,7 @@ def write_plan(
     tuple of Path
         The files written (the manifest last).
     """
+    from asmplan.report.html import plan_report
     from asmplan.report.plot import draw_dag
     from asp.atomic import OutputSet
 
@@ -815,26 +897,8 @@ def write_plan(
             write_figures(result.concurrent, out.path)
         if on_step is not None:
             on_step("  writing report.html ...")
-        out.write_text("report.html", plan_report(result, doc, out.path("dag.png").read_bytes()))
+        out.write_text("report.html", plan_report(doc, out.path("dag.png").read_bytes()))
     return out.written
-
-
-def plan_report(result: AssemblyPlan, doc: dict, dag_png: bytes | None = None) -> str:
-    """``report.html`` of a plan (:mod:`asmplan.report.html`), with the concurrent game's
-    curve and Gantt charts (solved for the report when the plan has none and is small)."""
-    from asmplan.report.html import report_figures, report_html
-
-    sched = result.schedule
-    figures = report_figures(
-        doc,
-        result.concurrent,
-        spec=result.assembly.spec,
-        graph=result.graph,
-        schedule=None if sched is None else (sched.result, sched.lower_bound),
-    )
-    if dag_png:
-        figures["dag"] = dag_png
-    return report_html(doc, figures)
 
 
 def path_edges(dag: GameDAG, path: list[int]) -> list[int]:

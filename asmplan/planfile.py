@@ -1201,31 +1201,3 @@ def timed_write(path: str | os.PathLike[str], doc: dict) -> tuple[Path, float, i
     t0 = time.perf_counter()
     out = write_plan(path, doc)
     return out, time.perf_counter() - t0, out.stat().st_size
-
-
-def build_plan(
-    assembly: str | os.PathLike[str], *, cost: str | None = None, turn_model: str | None = None
-) -> dict:
-    """Plan an assembly (folder, ``assembly.yaml`` or ``.IN2``).
-
-    Turn model ``alternate``: the relations, state graph, game and exact solution
-    (:mod:`asmplan.pipeline`), then :func:`plan_document`, without the CP-SAT schedule.
-    ``concurrent`` (``turn_model``, default the spec's): :func:`asmplan.pipeline.plan`, the
-    curve ``W*(k)`` and the CP-SAT comparison included.
-    """
-    from asmplan import pipeline
-
-    loaded = pipeline.load(assembly)
-    if (turn_model or loaded.spec.turn_model) == "concurrent":
-        return pipeline.plan(loaded, cost=cost, turn_model="concurrent").to_dict()
-    graph = pipeline.state_graph(loaded)
-    dag = pipeline.game(graph, cost=cost)
-    solution = pipeline.solve_game(dag)
-    return plan_document(
-        spec=loaded.spec,
-        dag=dag,
-        solution=solution,
-        describe=alternate_states(graph, dag),
-        relations=loaded.relations,
-        interchangeable=graph.model.interchangeable,
-    )

@@ -17,6 +17,7 @@ from asmplan.cli import relations as _relations  # noqa: F401, E402  isort: skip
 from asmplan.cli import graph as _graph  # noqa: F401, E402  isort: skip
 from asmplan.cli import baseline as _baseline  # noqa: F401, E402  isort: skip
 from asmplan.cli import plan as _plan  # noqa: F401, E402  isort: skip
+from asmplan.cli import report as _report  # noqa: F401, E402  isort: skip
 from asmplan.cli import init as _init  # noqa: F401, E402  isort: skip
 from asmplan.cli import train as _train  # noqa: F401, E402  isort: skip
 from asmplan.cli import play as _play  # noqa: F401, E402  isort: skip

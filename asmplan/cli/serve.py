@@ -24,7 +24,8 @@ LOCAL_HOSTS = ("127.0.0.1", "localhost", "::1")
 def load_source(source: Path, turn_model: str | None = None) -> dict:
     """The plan document of a plan folder, a ``plan.json`` or an assembly (planned in
     ``turn_model``, default the spec's)."""
-    from asmplan.planfile import build_plan, read_plan
+    from asmplan.pipeline import build_plan
+    from asmplan.planfile import read_plan
 
     if not source.exists():
         raise FileNotFoundError(f"{source}: no such file or folder")

@@ -5,6 +5,10 @@ game (when it could be solved; drawn by :mod:`asmplan.report.gantt`), the CP-SAT
 chart, the relations table, the principal line as pictures of the assembly growing step by
 step (:mod:`asmplan.report.steps`: rendered from the part meshes, the parts of each step
 highlighted, an arrow for each way in) and the game DAG picture.
+
+The page is a function of the plan document (``plan.json``, whose ``concurrent_preview``
+holds an alternate plan's concurrent game, computed by :mod:`asmplan.pipeline`) and the
+``dag.png`` beside it: nothing is solved here, so ``asmplan report PLAN_DIR`` redraws it.
 """
 
 from __future__ import annotations
@@ -15,9 +19,6 @@ from pathlib import Path
 
 from asmplan.report.steps import assembly_steps
 
-REPORT_MAX_STATES = 5_000
-"""Largest state graph whose concurrent game the report solves itself."""
-
 
 def _img(uri: str, alt: str, width: int | None = None) -> str:
     w = f' width="{width}"' if width else ""
@@ -27,73 +28,85 @@ def _img(uri: str, alt: str, width: int | None = None) -> str:
 # --------------------------------------------------------------------------- figures
 
 
-def report_figures(
-    doc: dict, concurrent_plan=None, *, spec=None, graph=None, schedule=None
-) -> dict[str, bytes]:
-    """The curve and Gantt PNGs of the report (:mod:`asmplan.report.gantt`), by name.
+def concurrent_part(doc: dict) -> dict:
+    """The concurrent game's part of a plan document: the plan's own keys (``robustness``,
+    ``concurrent``, ``schedule``) with the turn model ``concurrent``, else its
+    ``concurrent_preview`` (empty when it has none; ``{"why": ...}`` when not solved)."""
+    if doc.get("turn_model") == "concurrent":
+        return doc
+    return doc.get("concurrent_preview") or {}
 
-    ``concurrent_plan`` (:class:`asp.concurrent_plan.ConcurrentPlan`) gives the curve and
-    the two timelines; without it they are computed here from ``spec`` and ``graph`` when
-    the state graph has at most :data:`REPORT_MAX_STATES` states (else ``"why"`` says why
-    they are missing; ``schedule``, the plan's CP-SAT schedule and its lower bound, spares
-    solving it again). The CP-SAT schedule's Gantt chart comes from ``doc["schedule"]``.
+
+def report_figures(doc: dict) -> dict[str, bytes]:
+    """The curve and Gantt PNGs of the report (:mod:`asmplan.report.gantt`), by name,
+    drawn from the plan document alone (nothing is solved here).
+
+    The curve and the two timelines come from the concurrent game's part of ``doc``
+    (:func:`concurrent_part`); without it, ``"why"`` says why they are missing. The CP-SAT
+    schedule's Gantt chart comes from ``doc["schedule"]``.
     """
     import tempfile
 
     from asmplan.report.gantt import plot_gantt, plot_robustness
-    from asp.concurrent.describe import Bar
 
     out: dict[str, bytes] = {}
+    part = concurrent_part(doc)
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
-        if concurrent_plan is None and spec is not None and graph is not None:
-            if graph.n_states <= REPORT_MAX_STATES:
-                try:
-                    from asp.concurrent.plan import plan_concurrent
-
-                    concurrent_plan = plan_concurrent(
-                        spec, graph, max_nodes=200_000, schedule=schedule
-                    )
-                except (ValueError, MemoryError) as exc:
-                    out["why"] = str(exc).splitlines()[0].encode()
-            else:
-                out["why"] = (
-                    f"{graph.n_states:,} assembly states (the report solves the concurrent "
-                    f"game up to {REPORT_MAX_STATES:,})"
-                ).encode()
-        if concurrent_plan is not None:
-            curve = concurrent_plan.curve.to_list()
+        if "robustness" in part and "concurrent" in part:
+            game = part["concurrent"]
             out["robustness"] = plot_robustness(
-                curve,
+                part["robustness"],
                 folder / "r.png",
-                schedule=concurrent_plan.schedule.objective,
-                schedule_rows=concurrent_plan.schedule_worst,
+                schedule=(part.get("schedule") or {}).get("objective"),
+                schedule_rows=game["schedule_worst_case"],
             ).read_bytes()
-            for name, (bars, makespan) in (
-                ("gantt_cooperative", concurrent_plan.cooperative),
-                ("gantt_worst", concurrent_plan.worst),
-            ):
-                who = "follows the plan" if name == "gantt_cooperative" else "is the worst"
-                out[name] = plot_gantt(
-                    bars,
+            for name in ("cooperative", "worst"):
+                who = "follows the plan" if name == "cooperative" else "is the worst"
+                makespan = game[name]["makespan"]
+                out[f"gantt_{name}"] = plot_gantt(
+                    _bars(game[name]["bars"]),
                     folder / f"{name}.png",
                     makespan=makespan,
                     title=f"concurrent: the person {who}, makespan {makespan:g} s",
                 ).read_bytes()
+        elif "why" in part:
+            out["why"] = str(part["why"]).encode()
         rows = (doc.get("schedule") or {}).get("schedule") or []
         if rows:
-            bars = [
-                Bar(str(r["agent"]), str(r["task"]), float(r["start"]), float(r["end"]))
-                for r in rows
-            ]
             sched = doc["schedule"]
             out["gantt_schedule"] = plot_gantt(
-                bars,
+                _bars(rows, operation="task"),
                 folder / "s.png",
                 title=f"CP-SAT schedule: makespan {sched.get('objective')} s "
                 f"({sched.get('status')})",
             ).read_bytes()
     return out
+
+
+def _bars(rows: list[dict], operation: str = "operation") -> list:
+    """Timeline bars of a plan document's rows (``operation``: the key naming the task)."""
+    from asp.concurrent.describe import Bar
+
+    return [
+        Bar(
+            str(r["agent"]),
+            str(r[operation]),
+            float(r["start"]),
+            float(r["end"]),
+            bool(r.get("deviation", False)),
+        )
+        for r in rows
+    ]
+
+
+def plan_report(doc: dict, dag_png: bytes | None = None) -> str:
+    """``report.html`` of a plan document: :func:`report_html` with :func:`report_figures`
+    and the game DAG picture ``dag_png`` (``dag.png``'s bytes)."""
+    figures = report_figures(doc)
+    if dag_png:
+        figures["dag"] = dag_png
+    return report_html(doc, figures)
 
 
 def _data_uri(png: bytes) -> str:

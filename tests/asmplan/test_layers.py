@@ -26,7 +26,8 @@ def module_name(path: Path) -> str:
 
 
 def imports(path: Path, package: str | None = None) -> list[tuple[int, str]]:
-    """``(line, module)`` of every import in ``path`` (relative imports resolved)."""
+    """``(line, module)`` of every import in ``path`` (relative imports resolved; ``from m
+    import x`` as ``m.x``, the module ``m.x`` or a name of ``m``)."""
     tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
     if package is None:
         package = ".".join(path.relative_to(REPO).with_suffix("").parts[:-1])
@@ -40,7 +41,9 @@ def imports(path: Path, package: str | None = None) -> list[tuple[int, str]]:
                 module = ".".join([*base, node.module] if node.module else base)
             else:
                 module = node.module or ""
-            out.append((node.lineno, module))
+            # ``from asmplan import pipeline`` imports the module asmplan.pipeline (the
+            # graph takes the longest known prefix, so a name from a module stays that module)
+            out += [(node.lineno, f"{module}.{alias.name}") for alias in node.names]
     return out
 
 
@@ -75,7 +78,7 @@ def test_the_reader_sees_function_level_imports(tmp_path):
     probe = tmp_path / "probe.py"
     probe.write_text("def f():\n    from arl import trainer\n    import torch\n")
     found = [m for _, m in imports(probe, package="asp")]
-    assert found == ["arl", "torch"]
+    assert found == ["arl.trainer", "torch"]
 
 
 KNOWN_CYCLES: set[frozenset[str]] = set()

@@ -15,7 +15,7 @@ import httpx
 import pytest
 
 from asmplan.advisor import Advisor
-from asmplan.planfile import build_plan
+from asmplan.pipeline import build_plan
 from tests.asmplan.server import running
 
 PUMP = Path(__file__).resolve().parents[2] / "examples" / "vacuum_pump"

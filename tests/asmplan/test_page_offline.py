@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from asmplan.planfile import build_plan
+from asmplan.pipeline import build_plan
 from tests.asmplan.browser import offline_page, wait_ready
 from tests.asmplan.server import running
 from tests.asmplan.test_page_browser import browser  # noqa: F401 (the fixture)

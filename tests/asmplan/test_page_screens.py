@@ -18,7 +18,7 @@ import httpx
 import pytest
 
 from asmplan import pipeline
-from asmplan.planfile import build_plan
+from asmplan.pipeline import build_plan
 from tests.asmplan.browser import offline_page, wait_ready
 from tests.asmplan.plans import cell_plan
 from tests.asmplan.server import running

@@ -7,9 +7,9 @@ import json
 import numpy as np
 import pytest
 
+from asmplan.pipeline import build_plan
 from asmplan.planfile import (
     FORMAT,
-    build_plan,
     policy_table,
     read_plan,
     validate_plan,

@@ -5,7 +5,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from asmplan.planfile import build_plan
+from asmplan.pipeline import PREVIEW_MAX_STATES, build_plan, concurrent_preview
 from asmplan.report.html import report_figures, report_html
 from tests.asmplan.plans import cell_game, cell_plan
 
@@ -19,9 +19,10 @@ def _external_references(page: str) -> list[str]:
 
 def test_cell_report_is_self_contained_with_curve_and_gantt():
     spec, graph, _, _ = cell_game()
-    figures = report_figures(cell_plan(), spec=spec, graph=graph)
+    doc = {**cell_plan(), "concurrent_preview": concurrent_preview(spec, graph)}
+    figures = report_figures(doc)
     assert {"robustness", "gantt_cooperative", "gantt_worst"} <= set(figures), figures.get("why")
-    page = report_html(cell_plan(), figures)
+    page = report_html(doc, figures)
     assert _external_references(page) == []
     for heading in ("Metrics", "Price of robustness", "The principal line", "The worst line"):
         assert heading in page
@@ -32,6 +33,20 @@ def test_cell_report_is_self_contained_with_curve_and_gantt():
 def test_report_says_why_a_part_is_missing():
     page = report_html(cell_plan(), {"why": b"too large"})
     assert "The concurrent game was not solved: too large" in page
+    assert "not solved: not computed" in report_html(cell_plan(), report_figures(cell_plan()))
+
+
+def test_a_graph_too_large_for_the_preview_says_so(monkeypatch):
+    spec, graph, _, _ = cell_game()
+    assert graph.n_states <= PREVIEW_MAX_STATES
+    monkeypatch.setattr("asmplan.pipeline.PREVIEW_MAX_STATES", graph.n_states - 1)
+    preview = concurrent_preview(spec, graph)
+    assert preview == {
+        "why": f"{graph.n_states} assembly states (the report solves the concurrent game "
+        f"up to {graph.n_states - 1})"
+    }
+    figures = report_figures({**cell_plan(), "concurrent_preview": preview})
+    assert figures == {"why": preview["why"].encode()}
 
 
 def test_pump_report_pictures_each_step_that_places_parts():
