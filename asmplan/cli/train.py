@@ -56,6 +56,42 @@ def load_training_game(source: Path, turn_model: TurnModel | None = None) -> Gam
 
 
 MAX_CYCLES = 100_000
+CONCURRENT_CONFIGS = ("concurrent", "concurrent-tiny")
+"""The ``--config`` names of :mod:`arl.concurrent_trainer` (checked there)."""
+CERTIFIED_BUDGETS = [0, 1, 2, None]
+"""The budgets a concurrent run's robot is certified at (None: ``k = inf``)."""
+
+
+def _train_concurrent(source, turn_model, config, seed, output, max_cycles, progress) -> None:
+    """``train --config concurrent``: alternating PPO on the assembly's concurrent game played
+    from its rules (:func:`arl.concurrent_trainer.train_concurrent`)."""
+    from arl.concurrent_trainer import get_config as concurrent_config
+    from arl.concurrent_trainer import train_concurrent
+    from asmplan import pipeline
+    from asp.concurrent.rules import concurrent_rules
+
+    if source.is_file() and source.suffix.lower() in pipeline.GRAPH_SUFFIXES:
+        raise ValueError(f"{source}: --config {config} needs an assembly, not a game DAG file")
+    if turn_model is TurnModel.alternate:
+        raise ValueError(
+            f"--config {config} trains the concurrent game: use --turn-model concurrent"
+        )
+    cfg = concurrent_config(config)
+    if max_cycles is not None:
+        cfg = cfg.replace(cycles=max_cycles)
+    assembly = pipeline.load(source)
+    rules = concurrent_rules(assembly.spec, pipeline.state_graph(assembly))
+    result = train_concurrent(
+        rules, cfg, seed=seed, budgets=CERTIFIED_BUDGETS, output=output, progress=progress
+    )
+    shown = ", ".join(
+        f"k={'inf' if b is None else b}: {result.certified[b]:g}" for b in CERTIFIED_BUDGETS
+    )
+    typer.echo(
+        f"trained {result.steps:,} steps in {result.seconds:.1f} s; the robot of cycle "
+        f"{result.best_cycle} is certified (exact best response) at {shown}; wrote {output}"
+    )
+
 
 EVALUATE_KEYS = (
     "nodes",
@@ -77,7 +113,12 @@ EVALUATE_KEYS = (
 def train_command(
     graph: Path = typer.Argument(..., help=SOURCE_HELP),
     turn_model: TurnModel | None = turn_model_option(TURN_MODEL_HELP),
-    config: str = typer.Option("paper", "--config", help="Training configuration: paper|fast."),
+    config: str = typer.Option(
+        "paper",
+        "--config",
+        help="Training configuration: paper|fast (on a game DAG), or concurrent (the "
+        "concurrent game played from its rules, never compiled; arl/concurrent_trainer.py).",
+    ),
     seed: int = seed_option("Seed of models, environments and torch."),
     output: Path = typer.Option(..., "--output", "-o", help="Run folder (models, log, plots)."),
     resume: bool = typer.Option(False, "--resume", help="Continue the run saved in --output."),
@@ -99,6 +140,9 @@ def train_command(
     from arl.trainer import train
 
     check_output(output, folder=True)
+    if config in CONCURRENT_CONFIGS:
+        _train_concurrent(graph, turn_model, config, seed, output, max_cycles, progress)
+        return
     get_config(config)  # a bad name fails before any work
     dag = load_training_game(graph, turn_model)
     cfg = get_config(config, dag.metadata.get("turn_model"))

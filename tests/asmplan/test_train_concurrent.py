@@ -85,3 +85,31 @@ def test_concurrent_needs_an_assembly_and_zero_sum_rewards(pump, tmp_path, capsy
             main([*argv.split(), "--output", str(tmp_path / "run"), "--no-progress"])
         assert exit_info.value.code == 2
         assert message in capsys.readouterr().err
+
+
+@pytest.mark.slow
+@pytest.mark.usefixtures("deterministic_torch")
+def test_train_config_concurrent_plays_the_rules_and_certifies(tmp_path, capsys):
+    run = tmp_path / "run"
+    argv = f"train {PUMP} --turn-model concurrent --config concurrent-tiny --max-cycles 1"
+    with pytest.raises(SystemExit) as exit_info:
+        main([*argv.split(), "--output", str(run), "--no-progress"])
+    assert exit_info.value.code == 0
+    out = capsys.readouterr().out
+    assert "certified (exact best response) at k=0: " in out and "k=inf: " in out
+    log = json.loads((run / "log.json").read_text())
+    assert len(log["cycles"]) == 1 and (run / "robot.zip").is_file()
+
+
+def test_train_config_concurrent_needs_the_concurrent_game_of_an_assembly(tmp_path, capsys):
+    from tests.arl.graphs import figure4
+
+    graph = save_dag(figure4(), tmp_path / "g.json")
+    for argv, message in (
+        (f"train {graph} --config concurrent", "needs an assembly"),
+        (f"train {PUMP} --turn-model alternate --config concurrent", "--turn-model concurrent"),
+    ):
+        with pytest.raises(SystemExit) as exit_info:
+            main([*argv.split(), "--output", str(tmp_path / "run"), "--no-progress"])
+        assert exit_info.value.code == 2
+        assert message in capsys.readouterr().err
