@@ -109,12 +109,14 @@ def prepare_part(
     quantity: int = 1,
     type: str = "",
     shape: str = "",
+    warn: bool = True,
 ) -> Part:
     """Validate a mesh, scale it to millimetres and wrap it as a :class:`Part`.
 
     The mesh is copied, duplicate vertices merged and, for a closed mesh with inward
     normals, the winding flipped. An empty mesh is a ValueError; a mesh that is not
-    watertight gives a warning naming the part.
+    watertight gives a warning naming the part (unless ``warn`` is false: a loader of many
+    parts says it once for all, :func:`warn_not_watertight`).
     """
     if not isinstance(mesh, trimesh.Trimesh) or len(mesh.faces) == 0:
         raise ValueError(f"part {pid!r} ({source}): empty mesh")
@@ -129,7 +131,7 @@ def prepare_part(
     if mesh.is_watertight:
         if mesh.volume < 0:
             mesh.invert()
-    else:
+    elif warn:
         warnings.warn(
             f"part {pid!r} ({source}) is not watertight; its relations may be unreliable",
             stacklevel=3,
@@ -142,4 +144,20 @@ def prepare_part(
         type=type,
         source=source,
         shape=shape,
+    )
+
+
+def warn_not_watertight(parts, where: str) -> None:
+    """One warning naming every part of ``where`` whose mesh is not watertight (the first
+    ten); the same parts read again say nothing new (one message text, one place)."""
+    open_ids = [repr(p.id) for p in parts if not p.mesh.is_watertight]
+    if not open_ids:
+        return
+    more = f" and {len(open_ids) - 10} more" if len(open_ids) > 10 else ""
+    which = f"part {open_ids[0]}" if len(open_ids) == 1 else f"{len(open_ids)} parts"
+    verb = "is" if len(open_ids) == 1 else f"({', '.join(open_ids[:10])}{more}) are"
+    its = "its" if len(open_ids) == 1 else "their"
+    warnings.warn(
+        f"{which} ({where}) {verb} not watertight; {its} relations may be unreliable",
+        stacklevel=1,
     )

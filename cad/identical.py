@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
+import trimesh
 
 from cad.assembly import Part
 
@@ -21,7 +22,11 @@ RELATIVE_TOL = 2e-3
 
 def shape_signature(part: Part) -> np.ndarray:
     """Invariants of a part's shape, shape (8,): volume, area, 3 moments, 3 OBB extents."""
-    mesh = part.mesh
+    return mesh_signature(part.mesh)
+
+
+def mesh_signature(mesh: trimesh.Trimesh) -> np.ndarray:
+    """Invariants of a mesh's shape, shape (8,): volume, area, 3 moments, 3 OBB extents."""
     volume = abs(float(mesh.volume)) if mesh.is_watertight else 0.0
     moments = np.sort(np.abs(mesh.principal_inertia_components)) if volume else np.zeros(3)
     try:
@@ -38,24 +43,32 @@ def shape_classes(parts: Sequence[Part]) -> tuple[str, ...]:
     members without their number (``nut_1``, ``nut_2`` -> ``nut``) when they share one,
     else the first member's id.
     """
-    signatures = [shape_signature(p) for p in parts]
-    label = [-1] * len(parts)
-    classes: list[list[int]] = []
-    for i, sig in enumerate(signatures):
-        if parts[i].shape:
-            continue
-        for members in classes:
-            ref = signatures[members[0]]
+    free = [k for k, p in enumerate(parts) if not p.shape]
+    label = dict(zip(free, alike_labels([parts[k].mesh for k in free]), strict=True))
+    members: dict[int, list[str]] = {}
+    for k, cls in label.items():
+        members.setdefault(cls, []).append(parts[k].id)
+    names = {cls: _class_name(ids) for cls, ids in members.items()}
+    return tuple(p.shape if p.shape else names[label[k]] for k, p in enumerate(parts))
+
+
+def alike_labels(meshes: Sequence[trimesh.Trimesh]) -> list[int]:
+    """A class number per mesh: identical shapes share one; classes numbered 0, 1, ... in
+    the order of their first member."""
+    signatures = [mesh_signature(m) for m in meshes]
+    label = []
+    firsts: list[int] = []  # each class's first member
+    for sig in signatures:
+        for cls, first in enumerate(firsts):
+            ref = signatures[first]
             scale = np.maximum(np.abs(ref), np.abs(sig))
             if np.all(np.abs(ref - sig) <= RELATIVE_TOL * scale + 1e-9):
-                members.append(i)
-                label[i] = classes.index(members)
+                label.append(cls)
                 break
         else:
-            label[i] = len(classes)
-            classes.append([i])
-    names = [_class_name([parts[k].id for k in members]) for members in classes]
-    return tuple(p.shape if p.shape else names[label[i]] for i, p in enumerate(parts))
+            label.append(len(firsts))
+            firsts.append(len(label) - 1)
+    return label
 
 
 def _class_name(ids: list[str]) -> str:

@@ -30,7 +30,7 @@ from pathlib import Path
 
 import trimesh
 
-from cad.assembly import Assembly, prepare_part
+from cad.assembly import Assembly, prepare_part, warn_not_watertight
 from cad.bom import PartRecord, read_bom
 from cad.errors import GeometryError
 from cad.frame import Rotation, rotated
@@ -154,8 +154,10 @@ def load_parts(
                 quantity=row.quantity,
                 type=row.type,
                 shape=row.shape,
+                warn=False,
             )
         )
+    warn_not_watertight(parts, str(base))
     _check_unique([p.id for p in parts], base)
     distinct = sorted(set(used))
     combined = distinct[0] if len(distinct) == 1 else ("mixed" if distinct else units or "mm")
@@ -202,9 +204,10 @@ def _scene_assembly(path: Path, units: str | None) -> Assembly:
     unit = scene.units or units or "mm"
     scale = unit_scale(unit)
     parts = tuple(
-        prepare_part(pid, mesh, scale=scale, source=f"{path}#{pid}", name=name)
+        prepare_part(pid, mesh, scale=scale, source=f"{path}#{pid}", name=name, warn=False)
         for pid, name, mesh in zip(scene.ids, scene.names, scene.meshes, strict=True)
     )
+    warn_not_watertight(parts, str(path))
     _check_unique([p.id for p in parts], path)
     return Assembly(parts=parts, units=unit, source=str(path), groups=scene.groups)
 

@@ -61,20 +61,29 @@ def clean_name(raw: str) -> str:
     """A short lowercase id from a CAD name (empty if nothing is left).
 
     Instance suffixes (``#...``, ``:1``, ``<2>``, ``(3)``) and file extensions are cut off,
-    everything but letters and digits becomes ``_``, at most :data:`MAX_ID_LENGTH` chars.
+    everything but letters and digits becomes ``_``, at most :data:`MAX_ID_LENGTH` chars:
+    a longer name loses its leading words (a library's prefix), never its tail (what tells
+    ``XBee-10pin-male`` from ``XBee-Chip-antenna``).
     """
+    name = _full_name(raw)
+    if len(name) > MAX_ID_LENGTH:  # the tail tells variants apart (``..._10pin_male``)
+        words = name.split("_")
+        while len(words) > 1 and len("_".join(words)) > MAX_ID_LENGTH:
+            words.pop(0)
+        name = "_".join(words)[-MAX_ID_LENGTH:].strip("_")
+    if name and name[0].isdigit() and not name.isdigit():
+        name = "p_" + name
+    return name
+
+
+def _full_name(raw: str) -> str:
+    """:func:`clean_name` before its cut to :data:`MAX_ID_LENGTH` (and its ``p_`` prefix)."""
     name = _REFERENCE_LABEL.sub("", str(raw)).strip()
     name = re.split(r"[#<]", name, maxsplit=1)[0]
     name = re.sub(r":\d+$", "", name)
     name = re.sub(r"\(\d+\)$", "", name)
     name = re.sub(_EXTENSIONS, "", name, flags=re.IGNORECASE)
-    name = re.sub(r"[^0-9a-zA-Z]+", "_", name).strip("_").lower()
-    if len(name) > MAX_ID_LENGTH:
-        cut = name[:MAX_ID_LENGTH]
-        name = cut.rsplit("_", 1)[0] if "_" in cut[8:] else cut
-    if name and name[0].isdigit() and not name.isdigit():
-        name = "p_" + name
-    return name
+    return re.sub(r"[^0-9a-zA-Z]+", "_", name).strip("_").lower()
 
 
 def display_name(raw: str) -> str:
@@ -96,7 +105,7 @@ def best_name(candidates: list[str], fallback: str = "part") -> str:
 
 def best_raw(candidates: list[str]) -> str | None:
     """The first of ``candidates`` (raw names) whose cleaned name is meaningful, or None."""
-    return next((raw for raw in candidates if not is_generic(clean_name(raw))), None)
+    return next((raw for raw in candidates if not is_generic(_full_name(raw))), None)
 
 
 _PLAIN = re.compile(r"^(\d+(_\d+)*|(body|solid|part|component)_?\d*)$")
@@ -313,12 +322,14 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
     group_nodes = [(g, b) for g, b in group_nodes if len(b) < len(part_nodes)]
 
     rescale = _millimetre_numbers(file, scene)
-    names, meshes, bases = [], [], []
-    for node, anc in part_nodes:
+    references = _3dxml_reference_names(file) if is_format(file, "3DXML") else {}
+    names, meshes, bases, generic = [], [], [], []
+    for node, graph_anc in part_nodes:
         transform, geom_name = graph[node]
         mesh = scene.geometry[geom_name].copy().apply_transform(transform)
         meshes.append(mesh.apply_scale(rescale) if rescale != 1.0 else mesh)
         own = [original(node), str(geom_name)]
+        anc = _3dxml_ancestors(node, references) if references else graph_anc
         raw = (
             best_raw(own + [original(a) for a in anc if a not in whole])
             or plain_raw(own)
@@ -326,6 +337,8 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
         )
         names.append(display_name(original(node) if raw is None else raw))
         bases.append("part" if raw is None else part_id(raw))
+        generic.append(raw is None or bool(_BODY_WORD.match(clean_name(raw))))
+    bases = _alike_bases(bases, generic, meshes)
     ids = unique_ids(bases)
     split = ()
     if len(meshes) == 1 and (bodies := closed_bodies(meshes[0])) is not None:
@@ -435,13 +448,38 @@ def _millimetre_numbers(path: Path, scene: trimesh.Scene) -> float:
     return factor
 
 
-def _3dxml_groups(file: Path, nodes: list[str]) -> list[tuple[str, list[str]]]:
-    """The sub-assemblies of a 3DXML from its part nodes' paths (``name#1:3:2:9:8:...``).
+_BODY_WORD = re.compile(r"^((body|solid|part|component)_?\d*)$")
+"""A cleaned name that is a CAD tool's default for a body (FreeCAD's ``Body001``)."""
 
-    A path alternates Reference3D and Instance3D ids from the root (``1``) down to the
-    part's own reference (third from last); every reference in between is a
-    sub-assembly, named from the file's ``Reference3D`` elements.
-    """
+
+def _alike_bases(bases: list[str], generic: list[bool], meshes: list) -> list[str]:
+    """Ids for parts the file names generically (a default body name, or none): when two or
+    more are, each is named by its class of identical parts (:mod:`cad.identical`),
+    ``alike_a``, ``alike_b``, ... in the file's order (numbered by :func:`unique_ids`)."""
+    from cad.identical import alike_labels
+
+    which = [k for k, g in enumerate(generic) if g]
+    if len(which) < 2:
+        return bases
+    labels = alike_labels([meshes[k] for k in which])
+    out = list(bases)
+    for k, label in zip(which, labels, strict=True):
+        out[k] = f"alike_{_letters(label)}"
+    return out
+
+
+def _letters(number: int) -> str:
+    """``0`` -> ``a``, ``25`` -> ``z``, ``26`` -> ``aa``: a class's letter."""
+    text = ""
+    number += 1
+    while number:
+        number, rest = divmod(number - 1, 26)
+        text = chr(ord("a") + rest) + text
+    return text
+
+
+def _3dxml_reference_names(file: Path) -> dict[str, str]:
+    """The names of a 3DXML's ``Reference3D`` elements by id (empty if unreadable)."""
     import zipfile
     from xml.etree import ElementTree
 
@@ -456,6 +494,27 @@ def _3dxml_groups(file: Path, nodes: list[str]) -> list[tuple[str, list[str]]]:
                     if element.tag.rsplit("}", 1)[-1] == "Reference3D":
                         names[element.get("id", "")] = element.get("name", "")
     except (OSError, zipfile.BadZipFile, ElementTree.ParseError):
+        return {}
+    return names
+
+
+def _3dxml_ancestors(node: str, references: dict[str, str]) -> list[str]:
+    """The names of the sub-assemblies above a 3DXML part node, nearest first: the
+    references of its path between the root (the product itself, never a part's name)
+    and the part's own (:func:`_3dxml_groups`)."""
+    path = node.rpartition("#")[2].split(":")
+    return [references.get(path[j], "") for j in range(len(path) - 5, 1, -2)]
+
+
+def _3dxml_groups(file: Path, nodes: list[str]) -> list[tuple[str, list[str]]]:
+    """The sub-assemblies of a 3DXML from its part nodes' paths (``name#1:3:2:9:8:...``).
+
+    A path alternates Reference3D and Instance3D ids from the root (``1``) down to the
+    part's own reference (third from last); every reference in between is a
+    sub-assembly, named from the file's ``Reference3D`` elements.
+    """
+    names = _3dxml_reference_names(file)
+    if not names:
         return []
     below: dict[tuple[str, ...], list[str]] = {}
     for node in nodes:

@@ -190,6 +190,16 @@ class StateGraph:
             text += " " + " ".join(f"{k}={v}" for k, v in tools.items())
         return text
 
+    def placed_label(self, state: int, limit: int = 8) -> str:
+        """The parts a state has placed, as a person reads them (``placing a, b and 3
+        more``; never bare operation ids); ``the start`` when none."""
+        spec = self.model.spec
+        parts = [p for op in self.model.done_ops(self.key(state)) for p in spec.operation(op).parts]
+        if not parts:
+            return "the start"
+        more = f" and {len(parts) - limit} more" if len(parts) > limit else ""
+        return f"placing {', '.join(parts[:limit])}{more}"
+
 
 PROGRESS_EVERY_S = 1.0
 """With ``progress``, a layer's line is printed at most this often (seconds)."""
@@ -352,7 +362,7 @@ def infeasibility_report(graph: StateGraph) -> str:
         names = ", ".join(op.parts)
         text = (
             f"part {names} (operation {op.id}) can never be inserted ({detail}), e.g. "
-            f"after {graph.label(best)}"
+            f"after {graph.placed_label(best)}"
         )
         found.append((root, first, text))
     found.sort(key=lambda x: (not x[0], x[1]))
@@ -445,7 +455,7 @@ def _dead_end(graph: StateGraph) -> str:
         )
         why.append(f"part {', '.join(op.parts)} (operation {op.id}) cannot be inserted ({detail})")
     return (
-        f"every order ends in a dead end; the furthest, after {graph.label(last)} "
+        f"every order ends in a dead end; the furthest, after {graph.placed_label(last)} "
         f"({len(graph.layer_ptr) - 2} of {model.n_ops} operations done), leaves "
         + "; ".join(why)
         + (f" and {len(left) - 3} more" if len(left) > 3 else "")

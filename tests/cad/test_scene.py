@@ -38,8 +38,10 @@ DATA = Path(__file__).parent / "data"
         ("=>[0:1:1:7]_1", "1"),
         (
             "a-very-long-name-of-a-part-that-goes-on-and-on-forever",
-            "a_very_long_name_of_a_part_that",
+            "part_that_goes_on_and_on_forever",
         ),
+        ("User Library-XBee-Chip_XBee-10pin-male", "xbee_chip_xbee_10pin_male"),
+        ("User Library-XBee-Chip_XBee-Chip-antenna", "xbee_chip_xbee_chip_antenna"),
     ],
 )
 def test_clean_name(raw, clean):
@@ -411,3 +413,36 @@ def test_a_gltf_mesh_of_several_primitives_is_one_part(tmp_path):
     assert np.allclose(first.meshes[1].extents, [0.04, 0.04, 0.01])
     (tmp_path / "again.gltf").write_bytes(files["model.gltf"])
     assert read_scene(tmp_path / "again.gltf").nodes == first.nodes == ("Gear", "Housing")
+
+
+def test_3dxml_parts_take_names_from_their_sub_assemblies_never_the_root():
+    from cad.scene import _3dxml_ancestors
+
+    references = {"1": "satellite", "2": "Drive", "8": "Cam Stack"}
+    node = "Open CASCADE STEP translator 6.2#1:3:2:9:8:15:14:16:4"
+    assert _3dxml_ancestors(node, references) == ["Cam Stack", "Drive"]
+    assert _3dxml_ancestors("Plate#1:3:2:4", references) == []
+
+
+def test_generic_names_give_way_to_classes_of_alike_parts(tmp_path):
+    """FreeCAD's ``Body``, ``Body001``, ... on a flange coupling: ids by class of identical
+    parts (``alike_a_1..2``, ``alike_b_1..3``), the file's names kept as names; a 3DXML of
+    name-less parts is never named after its root product."""
+    b = shapes.box_between
+    scene = trimesh.Scene()
+    scene.graph.update(frame_from="world", frame_to="Coupling")
+    meshes = [b((0, 0, 0), (40, 40, 5)), b((0, 0, 5), (40, 40, 10))]
+    meshes += [b((5 + 10 * k, 5, -5), (8 + 10 * k, 8, 15)) for k in range(3)]
+    for k, mesh in enumerate(meshes):
+        node = "Body" if k == 0 else f"Body{k:03d}"
+        scene.add_geometry(
+            mesh.apply_scale(0.001), node_name=node, geom_name=node, parent_node_name="Coupling"
+        )
+    scene.export(tmp_path / "coupling.glb")
+    parts = read_scene(tmp_path / "coupling.glb")
+    assert parts.ids == ("alike_a_1", "alike_a_2", "alike_b_1", "alike_b_2", "alike_b_3")
+    assert parts.names == ("Body", "Body001", "Body002", "Body003", "Body004")
+    unnamed = "Open CASCADE STEP translator 6.2 62.6.1.1"
+    alike = {unnamed: b((0, 0, 0), (4, 4, 4)), unnamed + " ": b((9, 0, 0), (13, 4, 4))}
+    path = write_3dxml(tmp_path / "sat.3dxml", alike)
+    assert read_scene(path).ids == ("alike_a_1", "alike_a_2")

@@ -68,6 +68,7 @@ def test_root_cause_not_knock_on():
     assert "no free direction (blocked along +x by P1, P2" in text
     assert "part P4" not in text and "\n" not in text
     assert "4 more operation(s) never done, knock-on" in text
+    assert "e.g. after placing P1, P2;" in text and "{" not in text  # parts, not op ids
 
 
 def test_precedence_named_as_the_cause():
@@ -92,7 +93,7 @@ def test_dead_end_is_named_never_an_empty_list():
     with pytest.raises(ValueError) as info:
         build_state_graph(tower_spec(parts), rel)
     text = str(info.value)
-    assert "every order ends in a dead end" in text
+    assert "every order ends in a dead end; the furthest, after placing A (" in text
     assert "cannot be inserted (" in text and "no free direction" in text
     assert not text.rstrip().endswith("operations")
 
