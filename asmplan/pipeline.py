@@ -217,10 +217,20 @@ class AssemblyPlan:
 
     def to_dict(self) -> dict[str, Any]:
         """The ``asmplan-plan/2`` object written as ``plan.json`` (:mod:`asmplan.planfile`;
-        computed once)."""
-        return self._document
+        computed once), without the timings (:meth:`timings`)."""
+        return self._documents[0]
+
+    def timings(self) -> dict[str, Any]:
+        """The times measured while planning, written as ``timings.json``
+        (:func:`asmplan.planfile.split_timings`)."""
+        return self._documents[1]
 
     @functools.cached_property
+    def _documents(self) -> tuple[dict[str, Any], dict[str, Any]]:
+        from asmplan.planfile import split_timings
+
+        return split_timings(self._document())
+
     def _document(self) -> dict[str, Any]:
         from asmplan.planfile import plan_document, played_document
 
@@ -864,7 +874,11 @@ def write_plan(
     on_step: Progress | None = None,
     force: bool = False,
 ) -> tuple[Path, ...]:
-    """Write ``plan.json``, ``dag.png`` and ``report.html`` into ``output`` as one unit.
+    """Write ``plan.json``, ``timings.json``, ``dag.png`` and ``report.html`` (and, with the
+    turn model ``concurrent``, the curve and timeline PNGs) into ``output`` as one unit.
+
+    ``plan.json`` holds no time measured while planning (those are ``timings.json``'s), so
+    two runs on the same input write the same ``plan.json``.
 
     The files of one run are named by ``manifest.json``; the previous run's files (only
     those its manifest names) are removed once this run is complete, and a folder holding
@@ -884,6 +898,7 @@ def write_plan(
     with OutputSet(output, force=force) as out:
         doc = result.to_dict()
         out.write_text("plan.json", json.dumps(doc, separators=(",", ":"), allow_nan=False) + "\n")
+        out.write_text("timings.json", json.dumps(result.timings(), indent=1) + "\n")
         game = played.policy
         draw_dag(
             played.figure,

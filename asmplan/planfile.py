@@ -6,6 +6,10 @@ next operations, the instruction to the person and the remaining guaranteed boun
 (``policy``); the principal line (``robust_plan``: both sides follow the plan); the worst
 line (``worst_line``: the robust robot against a delaying human); the metrics and the CP-SAT
 schedule. The JSON Schema is ``asmplan/schemas/plan-2.schema.json`` (shipped in the package).
+Times measured while planning (the CP-SAT wall times, its improvements over time, the
+concurrent game's seconds; :data:`TIMING_KEYS`) are not in the plan document but in
+``timings.json`` beside it (:func:`split_timings`), so ``plan.json`` is a pure function of
+its inputs.
 
 The policy table is columnar so that large policies stay fast to write and read: state
 ``i`` is entry ``i`` of every array of ``policy.states``; its moves are
@@ -1177,6 +1181,30 @@ def check_plan(doc: dict, where: str = "plan") -> None:
     for key in (*keys, "cost", "next"):
         if len(policy["moves"].get(key, ())) != m:
             raise FormatError(f"{where}: policy.moves.{key}: expected {m} entries")
+
+
+TIMINGS_FORMAT = "asmplan-timings/1"
+TIMING_KEYS = {"schedule": ("wall_s", "stage_s", "improvements"), "concurrent": ("seconds",)}
+"""The keys of a plan document's objects that measure time (``improvements``: ``[seconds,
+makespan]`` of each better CP-SAT schedule); they go to ``timings.json``, not ``plan.json``."""
+
+
+def split_timings(doc: dict) -> tuple[dict, dict]:
+    """``doc`` without its timings, and the timings (``timings.json``'s object).
+
+    ``plan.json`` is then a function of its inputs: two runs on the same input give the same
+    bytes. The timings keep the shape they had in the document (``{"schedule": {"wall_s":
+    ...}, "concurrent": {"seconds": ...}}``); ``doc`` is not changed.
+    """
+    plan = dict(doc)
+    timings: dict = {"format": TIMINGS_FORMAT}
+    for part, keys in TIMING_KEYS.items():
+        inner = plan.get(part)
+        if not isinstance(inner, dict) or not any(k in inner for k in keys):
+            continue
+        timings[part] = {k: inner[k] for k in keys if k in inner}
+        plan[part] = {k: v for k, v in inner.items() if k not in keys}
+    return plan, timings
 
 
 def plan_schema() -> dict:

@@ -36,13 +36,36 @@ def dead_pid() -> int:
 
 def test_a_complete_run_names_its_files_last(pump_plan, tmp_path):
     written = pipeline.write_plan(pump_plan, tmp_path)
-    files = ["plan.json", "dag.png", "report.html"]
+    files = ["plan.json", "timings.json", "dag.png", "report.html"]
     assert [p.name for p in written] == files
     manifest = json.loads((tmp_path / MANIFEST).read_text())
     assert manifest == {"format": "asmplan-manifest/1", "files": files}
     assert json.loads((tmp_path / "plan.json").read_text()) == json.loads(
         json.dumps(pump_plan.to_dict())
     )
+
+
+@pytest.mark.parametrize("turn_model", ["alternate", "concurrent"])
+def test_two_runs_write_the_same_plan_json(tmp_path, turn_model):
+    """Issue 26 item 7: the times measured while planning go to ``timings.json`` (named
+    by the manifest), so ``plan.json`` is a function of its inputs: byte-identical."""
+    from asmplan.planfile import TIMING_KEYS
+
+    runs = []
+    for name in ("first", "second"):
+        args = ["plan", str(PUMP), "-o", str(tmp_path / name), "--time-limit", "20"]
+        result = CliRunner().invoke(app, [*args, "--turn-model", turn_model])
+        assert result.exit_code == 0, result.output
+        runs.append((tmp_path / name / "plan.json").read_bytes())
+    assert runs[0] == runs[1]
+    doc = json.loads(runs[0])
+    timings = json.loads((tmp_path / "first" / "timings.json").read_text())
+    assert timings["format"] == "asmplan-timings/1"
+    assert {"wall_s", "stage_s", "improvements"} <= set(timings["schedule"])
+    assert ("seconds" in timings.get("concurrent", {})) == (turn_model == "concurrent")
+    for part, keys in TIMING_KEYS.items():
+        assert not set(keys) & set(doc.get(part, {})), part
+    assert "timings.json" in json.loads((tmp_path / "first" / MANIFEST).read_text())["files"]
 
 
 def test_a_failure_mid_write_leaves_no_mixed_folder(pump_plan, tmp_path, monkeypatch):
@@ -67,7 +90,7 @@ def test_a_failure_mid_write_leaves_no_mixed_folder(pump_plan, tmp_path, monkeyp
     monkeypatch.undo()
     pipeline.write_plan(pump_plan, tmp_path, force=True)
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
-        ["mine.txt", "plan.json", "dag.png", "report.html", MANIFEST]
+        ["mine.txt", "plan.json", "timings.json", "dag.png", "report.html", MANIFEST]
     )
 
 
@@ -172,7 +195,7 @@ def test_plan_refuses_a_folder_of_other_files_unless_forced(tmp_path):
     assert forced.exit_code == 0, forced.output
     assert (tmp_path / "robustness.png").read_bytes() == b"mine"
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
-        [MANIFEST, "plan.json", "dag.png", "report.html", "robustness.png"]
+        [MANIFEST, "plan.json", "timings.json", "dag.png", "report.html", "robustness.png"]
     )
 
 
@@ -201,5 +224,5 @@ def test_a_sigkill_right_after_step_5_leaves_a_folder_the_next_run_takes(tmp_pat
     again = CliRunner().invoke(app, ["plan", str(PUMP), "-o", str(tmp_path), "--time-limit", "1"])
     assert again.exit_code == 0, again.output
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
-        [MANIFEST, "plan.json", "dag.png", "report.html"]
+        [MANIFEST, "plan.json", "timings.json", "dag.png", "report.html"]
     )
