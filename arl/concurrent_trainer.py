@@ -23,8 +23,9 @@ Seeds: ``seed`` fixes torch, numpy and both models; every phase reseeds its mode
 its environment) from ``(seed, cycle, side)``. Torch runs on one thread on the CPU, so a
 seed gives the same log.
 
-The run folder: ``config.json``, ``log.json`` (a record per cycle), ``robot.zip`` (the
-best robot), ``human.zip`` (the last human), each written atomically after every cycle.
+The run folder: ``config.json``, ``log.json`` (a record per cycle; format
+:data:`RUN_FORMAT`), ``robot.zip`` (the best robot), ``human.zip`` (the last human), each
+written atomically after every cycle, the log last.
 :func:`load_robot` reads the robot back; :func:`learned_policy` makes it a robot policy
 for :func:`asp.concurrent.certify.certify`.
 """
@@ -47,6 +48,8 @@ from asp.concurrent.certify import certify
 from asp.concurrent.rules import Rules
 
 LOG_VERSION = 1
+RUN_FORMAT = "asmplan-arl-concurrent-run"
+"""The ``format`` of a run folder's ``config.json`` and ``log.json`` (:func:`is_run_folder`)."""
 
 
 @dataclass(frozen=True)
@@ -306,12 +309,22 @@ def _save(folder: Path, cfg, seed, budgets, records, best_cycle, robot_bytes, hu
     from asp.atomic import write_bytes, write_text
 
     folder.mkdir(parents=True, exist_ok=True)
-    config = {"version": LOG_VERSION, "seed": seed, "budgets": budgets, "config": cfg.to_dict()}
+    head = {"format": RUN_FORMAT, "version": LOG_VERSION}
+    config = {**head, "seed": seed, "budgets": budgets, "config": cfg.to_dict()}
     write_text(folder / "config.json", json.dumps(config, indent=1) + "\n")
-    log = {"version": LOG_VERSION, "best_cycle": best_cycle, "cycles": records}
-    write_text(folder / "log.json", json.dumps(log, indent=1) + "\n")
     write_bytes(folder / "robot.zip", robot_bytes)
     write_bytes(folder / "human.zip", _model_bytes(human))
+    log = {**head, "best_cycle": best_cycle, "cycles": records}  # last: it names robot.zip
+    write_text(folder / "log.json", json.dumps(log, indent=1) + "\n")
+
+
+def is_run_folder(folder: Path) -> bool:
+    """Whether ``folder`` holds a run of :func:`train_concurrent` (its ``config.json``)."""
+    path = Path(folder) / "config.json"
+    try:
+        return json.loads(path.read_text()).get("format") == RUN_FORMAT
+    except (OSError, ValueError, AttributeError):
+        return False
 
 
 def load_robot(folder: Path):
@@ -326,6 +339,6 @@ def load_robot(folder: Path):
 
     folder = Path(folder)
     path = folder / "robot.zip"
-    if not (folder / "config.json").is_file() or not path.is_file():
+    if not is_run_folder(folder) or not path.is_file():
         raise ValueError(f"{folder}: not a concurrent run folder (no config.json, robot.zip)")
     return MaskablePPO.load(path, device="cpu")

@@ -62,16 +62,28 @@ CERTIFIED_BUDGETS = [0, 1, 2, None]
 """The budgets a concurrent run's robot is certified at (None: ``k = inf``)."""
 
 
+def _concurrent_rules(source: Path, what: str):
+    """The concurrent game's rules of the assembly ``source`` (``what``: the option that
+    needs it, for the error)."""
+    from asmplan import pipeline
+    from asp.concurrent.rules import concurrent_rules
+
+    if source.is_file() and source.suffix.lower() in pipeline.GRAPH_SUFFIXES:
+        raise ValueError(f"{source}: {what} needs an assembly, not a game DAG file")
+    assembly = pipeline.load(source)
+    return concurrent_rules(assembly.spec, pipeline.state_graph(assembly))
+
+
+def _certified_text(certified: dict) -> str:
+    return ", ".join(f"k={'inf' if b is None else b}: {certified[b]:g}" for b in certified)
+
+
 def _train_concurrent(source, turn_model, config, seed, output, max_cycles, progress) -> None:
     """``train --config concurrent``: alternating PPO on the assembly's concurrent game played
     from its rules (:func:`arl.concurrent_trainer.train_concurrent`)."""
     from arl.concurrent_trainer import get_config as concurrent_config
     from arl.concurrent_trainer import train_concurrent
-    from asmplan import pipeline
-    from asp.concurrent.rules import concurrent_rules
 
-    if source.is_file() and source.suffix.lower() in pipeline.GRAPH_SUFFIXES:
-        raise ValueError(f"{source}: --config {config} needs an assembly, not a game DAG file")
     if turn_model is TurnModel.alternate:
         raise ValueError(
             f"--config {config} trains the concurrent game: use --turn-model concurrent"
@@ -79,17 +91,33 @@ def _train_concurrent(source, turn_model, config, seed, output, max_cycles, prog
     cfg = concurrent_config(config)
     if max_cycles is not None:
         cfg = cfg.replace(cycles=max_cycles)
-    assembly = pipeline.load(source)
-    rules = concurrent_rules(assembly.spec, pipeline.state_graph(assembly))
+    rules = _concurrent_rules(source, f"--config {config}")
     result = train_concurrent(
         rules, cfg, seed=seed, budgets=CERTIFIED_BUDGETS, output=output, progress=progress
     )
-    shown = ", ".join(
-        f"k={'inf' if b is None else b}: {result.certified[b]:g}" for b in CERTIFIED_BUDGETS
-    )
     typer.echo(
         f"trained {result.steps:,} steps in {result.seconds:.1f} s; the robot of cycle "
-        f"{result.best_cycle} is certified (exact best response) at {shown}; wrote {output}"
+        f"{result.best_cycle} is certified (exact best response) at "
+        f"{_certified_text(result.certified)}; wrote {output}"
+    )
+
+
+def _evaluate_concurrent(source: Path, folder: Path, fmt) -> None:
+    """``evaluate --model RUN`` of a concurrent run: its robot certified at every budget of
+    :data:`CERTIFIED_BUDGETS` by the exact best response (:func:`asp.concurrent.certify`)."""
+    from arl.concurrent_trainer import learned_policy, load_robot
+    from asp.concurrent.certify import certify
+
+    rules = _concurrent_rules(source, "a concurrent run (--model)")
+    robot = load_robot(folder)
+    cert = certify(rules, learned_policy(rules, robot), CERTIFIED_BUDGETS)
+    if fmt is OutputFormat.json:
+        doc = {"certified": cert.to_list(), "policy_game_nodes": cert.nodes}
+        typer.echo(json.dumps(doc, allow_nan=False))
+        return
+    typer.echo(
+        f"{source}, concurrent model {folder}: certified worst case (exact best response, "
+        f"{cert.nodes:,} policy-game nodes) {_certified_text(cert.worst)}"
     )
 
 
@@ -178,8 +206,12 @@ def evaluate_command(
     seed: int = seed_option("Seed of the simulation."),
 ) -> None:
     """Score a trained robot policy exactly: WCPL, certified WCPL, random-human metrics, RR."""
+    from arl.concurrent_trainer import is_run_folder
     from arl.trainer import evaluate
 
+    if is_run_folder(model):
+        _evaluate_concurrent(graph, model, fmt)
+        return
     dag = load_training_game(graph, turn_model)
     if not model.is_dir():
         raise ValueError(f"{model}: not a run folder")

@@ -99,6 +99,12 @@ def test_train_config_concurrent_plays_the_rules_and_certifies(tmp_path, capsys)
     assert "certified (exact best response) at k=0: " in out and "k=inf: " in out
     log = json.loads((run / "log.json").read_text())
     assert len(log["cycles"]) == 1 and (run / "robot.zip").is_file()
+    # evaluate certifies the saved robot again, without compiling the game.
+    with pytest.raises(SystemExit) as exit_info:
+        main(["evaluate", str(PUMP), "--model", str(run), "--format", "json"])
+    assert exit_info.value.code == 0
+    doc = json.loads(capsys.readouterr().out)
+    assert doc["certified"] == log["cycles"][0]["certified"]
 
 
 def test_train_config_concurrent_needs_the_concurrent_game_of_an_assembly(tmp_path, capsys):
