@@ -25,6 +25,8 @@ An ``assembly.yaml`` names everything the planner needs besides the part geometr
     max_states: 20000000               # state graph limit (asmplan plan --max-states)
     contact_tol: 0.1                   # mm, largest gap that counts as touching, every pair
     penetration_tol: 0.3               # mm, largest overlap that counts as touching
+    flex: [lever_housing]              # snap fits: flexes over the parts it locks with
+                                       # while inserted (asp/cad_keys.py)
                                        # (both default to cad/tolerances.py's per-part rule;
                                        # --contact-tol / --penetration-tol override them)
     subassemblies:                     # built on their own, then inserted as one unit
@@ -71,6 +73,7 @@ from pathlib import Path
 
 import networkx as nx
 
+from asp.cad_keys import parse_flex
 from asp.game.dag import MAX_COST
 from asp.game.rules import COST_MODELS
 from cad.bom import PartRecord, part_records, refuse_unknown_keys
@@ -87,7 +90,7 @@ SPEC_FILE = "assembly.yaml"
 TOP_KEYS = (
     "name", "units", "parts", "agents", "tools", "base_part", "gravity", "gripper_approach",
     "constraints", "turn_model", "cost", "operations", "credit", "max_states", "subassemblies",
-    "contact_tol", "penetration_tol", "frame",
+    "contact_tol", "penetration_tol", "frame", "flex",
 )  # fmt: skip
 """The top-level keys of ``assembly.yaml``; any other is refused."""
 OPERATION_KEYS = (
@@ -219,6 +222,8 @@ class AssemblySpec:
     """The build frame (``frame:``, :mod:`cad.frame`): the rotation ``R`` (row by row) with
     ``x_build = R @ x_file``, applied to every part where it is loaded; directions and
     gravity are axes of the build frame. None: the file's own frame."""
+    flex: tuple[str, ...] = ()
+    """Parts that flex while inserted (``flex:``, :mod:`asp.cad_keys`)."""
 
     @property
     def op_ids(self) -> tuple[str, ...]:
@@ -438,6 +443,7 @@ class _Parser:
             credit=str(data.get("credit", "")),
             max_states=max_states,
             frame=frame,
+            flex=parse_flex(data.get("flex"), part_ids, self.source),
             **tols,
         )
         raw_units = self.mapping(data.get("subassemblies"), "subassemblies")

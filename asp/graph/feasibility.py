@@ -836,14 +836,16 @@ def load_relations(spec: AssemblySpec, *, progress: bool = False, geometry=None)
     Reads the meshes of the spec's parts (:func:`asp.generate.spec_geometry`: in the
     spec's build frame) unless ``geometry`` (that ``cad.Assembly``, already read) is given,
     with the spec's
-    ``contact_tol`` and ``penetration_tol`` (None: the per-part rule).
+    ``contact_tol`` and ``penetration_tol`` (None: the per-part rule), and its ``flex``
+    parts (:func:`asp.cad_keys.with_flex`).
     """
     if not spec.has_geometry:
         return None
     import cad
+    from asp.cad_keys import with_flex
     from cad.loading import load_parts
 
-    return cad.compute_relations(
+    relations = cad.compute_relations(
         load_parts(spec.parts, spec.folder, spec.units, frame=spec.frame)
         if geometry is None
         else geometry,
@@ -851,3 +853,4 @@ def load_relations(spec: AssemblySpec, *, progress: bool = False, geometry=None)
         penetration_tol=spec.penetration_tol,
         progress=progress,
     )
+    return with_flex(relations, spec.flex)

@@ -25,6 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from asp.cad_keys import flex_hint
 from asp.errors import InfeasibleAssembly, StateLimit
 from asp.graph.feasibility import (
     OperationModel,
@@ -341,6 +342,7 @@ def infeasibility_report(graph: StateGraph) -> str:
     never = [i for i in range(n_ops) if not ever >> i & 1]
     placed_ever = unpack_words(np.bitwise_or.reduce(graph.parts, axis=0))
     head = f"{spec.source}: infeasible assembly, no complete sequence: "
+    head += flex_hint(_locking_pairs(model.oracle))  # the true cause, first
     if not never:
         return head + _dead_end(graph)
     layer_of = np.searchsorted(graph.layer_ptr, np.arange(graph.n_states), side="right") - 1
@@ -384,6 +386,22 @@ def never_done(graph: StateGraph) -> list[int]:
         i
         for i in range(model.n_ops)
         if not ever >> i & 1 and model.part_lists[i] and model.ready(graph.keys, i).any()
+    ]
+
+
+def _locking_pairs(oracle) -> list[tuple[str, str]]:
+    """Pairs of parts that block each other along all six directions (no order places
+    both), from the oracle's blocking masks."""
+    if not oracle.geometric:
+        return []
+    every = np.bitwise_and.reduce(oracle.blocked, axis=1)  # (n, PW): blocks p everywhere
+    masks = [unpack_words(row) for row in every]
+    n = len(masks)
+    return [
+        (oracle.parts[p], oracle.parts[q])
+        for p in range(n)
+        for q in range(p + 1, n)
+        if masks[p] >> q & 1 and masks[q] >> p & 1
     ]
 
 
