@@ -109,7 +109,7 @@ def test_no_import_cycles():
 
 
 ASP_FLOORS = (
-    ("errors", "numbers", "atomic", "heap"),
+    ("errors", "numbers", "atomic", "heap", "cad_keys"),
     ("game",),
     ("salbp",),
     ("spec",),
