@@ -176,13 +176,103 @@ def refutation(spec: AssemblySpec, relations) -> Refutation | None:
 
 
 def _derive(spec: AssemblySpec, relations) -> tuple[ReducedModel | None, str, Refutation | None]:
-    """:func:`reduced_model`, :func:`infeasibility` and :func:`refutation` in one pass."""
+    """:func:`reduced_model`, :func:`infeasibility` and :func:`refutation` in one pass.
+
+    From the spec's own precedences (and the base part first), to a fixed point: close them
+    transitively (a cycle is a proof), then reduce each operation's tests under them
+    (:func:`_reduced_row`, which may add precedences or find a proof).
+    """
     if not _applicable(spec, relations):
         return None, "", None
+    t = _tests(spec, relations)
+    n_ops = len(spec.operations)
+    must = _first_must(spec, t)
+    while True:
+        must = _closure(must)
+        cycle = [i for i in range(n_ops) if must[i] >> i & 1]
+        if cycle:
+            why = f"operation {spec.operations[cycle[0]].id} must precede itself"
+            looked = t.parts_of(sum(1 << i for i in cycle)) & ~t.initial
+            return None, why, _refuted(spec, t.oracle, why, cycle[0], looked)
+        ancestors = {
+            p: (t.parts_of(must[t.op_of[p]]) if p in t.op_of else t.initial) | 1 << p
+            for p in range(len(t.oracle.parts))
+        }
+        after = [0] * n_ops
+        for i in range(n_ops):
+            for a in _bits(must[i]):
+                after[a] |= 1 << i
+        rows = []
+        changed = False
+        for i in range(n_ops):
+            row = _reduced_row(spec, t, i, must, after, ancestors)
+            if row.failure is not None:
+                why, looked = row.failure
+                return None, why, _refuted(spec, t.oracle, why, i, looked)
+            rows.append(row)
+            changed |= row.changed
+        if not changed:
+            model = ReducedModel(
+                part_of=t.part_of,
+                op_of=t.op_of,
+                must=tuple(must),
+                contact=tuple(r.contact for r in rows),
+                support=tuple(r.support for r in rows),
+                family=tuple(r.family for r in rows),
+                raw_near=tuple(t.ops_of(t.contact[i] | t.support[i]) for i in range(n_ops)),
+                workspace=t.workspace,
+            )
+            return model, "", None
+
+
+@dataclass(frozen=True)
+class _Tests:
+    """What :func:`_derive` reads of the insertion oracle, per operation (bitsets over the
+    oracle's parts).
+
+    ``raw_*``: the oracle's rows (what the part may touch, rest on, is blocked by along each
+    allowed direction); ``contact``, ``support``, ``blocked``: the same as the operation's
+    test sees them (its workspace's members only, or the main assembly's parts with a unit
+    for its members). ``initial``: the base part when no operation places it; ``absent``:
+    the parts no operation places.
+    """
+
+    oracle: object
+    part_of: tuple[int, ...]
+    workspace: tuple[int, ...]
+    op_of: dict[int, int]
+    initial: int
+    absent: int
+    raw_contact: tuple[int, ...]
+    raw_support: tuple[int, ...]
+    raw_blocked: tuple[tuple[int, ...], ...]
+    contact: tuple[int, ...]
+    support: tuple[int, ...]
+    blocked: tuple[tuple[int, ...], ...]
+    held: tuple[bool, ...]
+
+    def parts_of(self, ops: int) -> int:
+        """The parts the operations of ``ops`` place, with ``initial``."""
+        out = self.initial
+        for i in _bits(ops):
+            if self.part_of[i] >= 0:
+                out |= 1 << self.part_of[i]
+        return out
+
+    def ops_of(self, parts: int) -> int:
+        """The operations placing the parts of ``parts``."""
+        out = 0
+        for p in _bits(parts):
+            if p in self.op_of:
+                out |= 1 << self.op_of[p]
+        return out
+
+
+def _tests(spec: AssemblySpec, relations) -> _Tests:
+    """The oracle's rows of ``spec``'s operations (:class:`_Tests`)."""
     from asp.graph.feasibility import insertion_oracle, unpack_words
 
     oracle = insertion_oracle(spec, relations)
-    n_ops = len(spec.operations)
     pidx = {p: k for k, p in enumerate(oracle.parts)}
     # a unit is one body of the main assembly (its oracle row ORs its members'): the main
     # assembly sees its members only once it is inserted, so in the tests of the main
@@ -199,134 +289,129 @@ def _derive(spec: AssemblySpec, relations) -> tuple[ReducedModel | None, str, Re
         room.get(p, 0) if not op.unit else 0 for p, op in zip(part_of, spec.operations, strict=True)
     )
     op_of = {p: i for i, p in enumerate(part_of) if p >= 0}
-    bits_of = {p: 1 << p for p in op_of}
     base = oracle.base
     initial = 0 if base in op_of or base < 0 else 1 << base
     absent = ((1 << len(oracle.parts)) - 1) & ~initial & ~sum(1 << p for p in op_of)
-    raw_contact = [unpack_words(oracle.contact[p]) if p >= 0 else 0 for p in part_of]
-    raw_support = [unpack_words(oracle.support[p]) if p >= 0 else 0 for p in part_of]
-    raw_blocked = [
-        [unpack_words(oracle.blocked[p, d]) for d in range(6) if oracle.directions[d]]
+    raw_contact = tuple(unpack_words(oracle.contact[p]) if p >= 0 else 0 for p in part_of)
+    raw_support = tuple(unpack_words(oracle.support[p]) if p >= 0 else 0 for p in part_of)
+    raw_blocked = tuple(
+        tuple(unpack_words(oracle.blocked[p, d]) for d in range(6) if oracle.directions[d])
         if p >= 0
-        else []
+        else ()
         for p in part_of
-    ]
+    )
 
     def seen(i: int, mask: int) -> int:
         """``mask`` as operation ``i``'s test sees it: its workspace's members, or the
         main assembly's parts with the units for their members."""
         return mask & workspace[i] if workspace[i] else _as_units(mask, units)
 
-    contact = [seen(i, m) for i, m in enumerate(raw_contact)]
-    support = [seen(i, m) for i, m in enumerate(raw_support)]
-    blocked = [[seen(i, m) for m in masks] for i, masks in enumerate(raw_blocked)]
+    return _Tests(
+        oracle=oracle,
+        part_of=part_of,
+        workspace=workspace,
+        op_of=op_of,
+        initial=initial,
+        absent=absent,
+        raw_contact=raw_contact,
+        raw_support=raw_support,
+        raw_blocked=raw_blocked,
+        contact=tuple(seen(i, m) for i, m in enumerate(raw_contact)),
+        support=tuple(seen(i, m) for i, m in enumerate(raw_support)),
+        blocked=tuple(tuple(seen(i, m) for m in masks) for i, masks in enumerate(raw_blocked)),
+        held=tuple(op.held or not oracle.stability for op in spec.operations),
+    )
+
+
+def _first_must(spec: AssemblySpec, t: _Tests) -> list[int]:
+    """Per operation, the operations the spec puts before it (bitset), with the base part's
+    placement before every placement in the main assembly."""
     index = {op.id: i for i, op in enumerate(spec.operations)}
     must = [sum(1 << index[a] for a in op.after) for op in spec.operations]
-    if base in op_of:
-        b = op_of[base]
-        for i in range(n_ops):
-            if i != b and part_of[i] >= 0 and not workspace[i]:
+    base = t.oracle.base
+    if base in t.op_of:
+        b = t.op_of[base]
+        for i in range(len(must)):
+            if i != b and t.part_of[i] >= 0 and not t.workspace[i]:
                 must[i] |= 1 << b
-    held = [op.held or not oracle.stability for op in spec.operations]
+    return must
 
-    def parts_of(ops: int) -> int:
-        out = initial
-        for i in _bits(ops):
-            if part_of[i] >= 0:
-                out |= bits_of[part_of[i]]
-        return out
 
-    def ops_of(parts: int) -> int:
-        out = 0
-        for p in _bits(parts):
-            if p in op_of:
-                out |= 1 << op_of[p]
-        return out
+@dataclass(frozen=True)
+class _Row:
+    """An operation's reduced tests (:func:`_reduced_row`): contact and support masks
+    (``TRUE``: always passes), the family of blocking sets, whether it added precedences,
+    and ``failure``, ``(why, looked)`` when it can never be done."""
 
-    while True:
-        must = _closure(must)
-        ancestors = {
-            p: (parts_of(must[op_of[p]]) if p in op_of else initial) | 1 << p
-            for p in range(len(oracle.parts))
-        }
+    contact: int
+    support: int
+    family: frozenset[int]
+    changed: bool = False
+    failure: tuple[str, int] | None = None
 
-        def covers(b: int, t: int, ancestors=ancestors) -> bool:
-            """Every part of ``t`` has an ancestor (or itself) in ``b``."""
-            return all(ancestors[r] & b for r in _bits(t))
 
-        cycle = [i for i in range(n_ops) if must[i] >> i & 1]
-        if cycle:
-            why = f"operation {spec.operations[cycle[0]].id} must precede itself"
-            looked = parts_of(sum(1 << i for i in cycle)) & ~initial
-            return None, why, _refuted(spec, oracle, why, cycle[0], looked)
-        after = [0] * n_ops
-        for i in range(n_ops):
-            for a in _bits(must[i]):
-                after[a] |= 1 << i
-        red_c, red_s, fams = [], [], []
-        changed = False
-        for i in range(n_ops):
-            p = part_of[i]
-            there, never = parts_of(must[i]), (parts_of(after[i]) & ~initial) | absent
-            if p < 0 or p == base:  # no part, or the base part (placed first, into nothing)
-                red_c.append(TRUE)
-                red_s.append(TRUE)
-                fams.append(frozenset({0}))
-                continue
-            if workspace[i]:
-                # in a unit's workspace: only its members count, and nothing is proved
-                # impossible or needed first (any member may go first into it)
-                there, never = there & workspace[i], never & workspace[i]
-            tests = []
-            for mask in (contact[i], TRUE if held[i] else support[i]):
-                tests.append(TRUE if mask == TRUE or mask & there else mask & ~never)
-            red_c.append(tests[0])
-            red_s.append(tests[1])
-            # a set holding every part it may touch (or rest on) is never free
-            # a set holding an ancestor (or itself) of every part it may touch or rest on is
-            # never free; a set holding an ancestor of every part of another set is free only
-            # when that one is (valid states hold the ancestors of what they hold)
-            sets = {b & ~never for b in blocked[i] if not b & there}
-            if workspace[i]:  # a set holding another is free only when that one is
-                family = frozenset(b for b in sets if not any(t != b and t & b == t for t in sets))
-            else:
-                need = [t for t in tests if t != TRUE]
-                sets = {b for b in sets if not any(covers(b, t) for t in need)}
-                family = frozenset(
-                    b for b in sets if not any(covers(b, t) and not covers(t, b) for t in sets)
-                )
-                why, test = _never(spec, i, tests, family)
-                if why:
-                    looked = (raw_contact[i], raw_support[i], _union(raw_blocked[i]))[test]
-                    return None, why, _refuted(spec, oracle, why, i, looked)
-                # the only part it can touch or rest on comes first
-                for mask in tests:
-                    if mask not in (TRUE, 0) and mask & (mask - 1) == 0:
-                        q = ops_of(mask)
-                        if q and not must[i] & q:
-                            must[i] |= q
-                            changed = True
-            fams.append(family)
-            # a part blocking it along every direction left comes after it
-            common = ~0
-            for s in family:
-                common &= s
-            for r in _bits(ops_of(common & ~initial) if common > 0 else 0):
-                if not must[r] >> i & 1:
-                    must[r] |= 1 << i
+def _reduced_row(
+    spec: AssemblySpec, t: _Tests, i: int, must: list[int], after: list[int], ancestors: dict
+) -> _Row:
+    """Operation ``i``'s tests reduced under the derived precedences ``must`` (its
+    successors ``after``; ``ancestors``: per part, the parts always there before it and
+    itself). Adds to ``must`` what they prove: the only part it can touch or rest on comes
+    first; a part blocking it along every direction left comes after it."""
+    p = t.part_of[i]
+    if p < 0 or p == t.oracle.base:  # no part, or the base part (placed first, into nothing)
+        return _Row(TRUE, TRUE, frozenset({0}))
+    there, never = t.parts_of(must[i]), (t.parts_of(after[i]) & ~t.initial) | t.absent
+    room = t.workspace[i]
+    if room:
+        # in a unit's workspace: only its members count, and nothing is proved
+        # impossible or needed first (any member may go first into it)
+        there, never = there & room, never & room
+    tests = [
+        TRUE if mask == TRUE or mask & there else mask & ~never
+        for mask in (t.contact[i], TRUE if t.held[i] else t.support[i])
+    ]
+    # a set holding every part it may touch (or rest on) is never free
+    sets = {b & ~never for b in t.blocked[i] if not b & there}
+    changed = False
+    if room:  # a set holding another is free only when that one is
+        family = frozenset(b for b in sets if not any(s != b and s & b == s for s in sets))
+    else:
+        family = _free_family(sets, tests, ancestors)
+        why, test = _never(spec, i, tests, family)
+        if why:
+            looked = (t.raw_contact[i], t.raw_support[i], _union(t.raw_blocked[i]))[test]
+            return _Row(tests[0], tests[1], family, failure=(why, looked))
+        # the only part it can touch or rest on comes first
+        for mask in tests:
+            if mask not in (TRUE, 0) and mask & (mask - 1) == 0:
+                q = t.ops_of(mask)
+                if q and not must[i] & q:
+                    must[i] |= q
                     changed = True
-        if not changed:
-            model = ReducedModel(
-                part_of=part_of,
-                op_of=op_of,
-                must=tuple(must),
-                contact=tuple(red_c),
-                support=tuple(red_s),
-                family=tuple(fams),
-                raw_near=tuple(ops_of(contact[i] | support[i]) for i in range(n_ops)),
-                workspace=workspace,
-            )
-            return model, "", None
+    # a part blocking it along every direction left comes after it
+    common = ~0
+    for s in family:
+        common &= s
+    for r in _bits(t.ops_of(common & ~t.initial) if common > 0 else 0):
+        if not must[r] >> i & 1:
+            must[r] |= 1 << i
+            changed = True
+    return _Row(tests[0], tests[1], family, changed)
+
+
+def _free_family(sets: set[int], tests: list[int], ancestors: dict) -> frozenset[int]:
+    """The blocking sets of an operation in the main assembly that can still be free: a set
+    holding an ancestor (or itself) of every part it may touch or rest on is never free; a
+    set holding an ancestor of every part of another set is free only when that one is
+    (valid states hold the ancestors of what they hold)."""
+
+    def covers(b: int, m: int) -> bool:
+        """Every part of ``m`` has an ancestor (or itself) in ``b``."""
+        return all(ancestors[r] & b for r in _bits(m))
+
+    need = [m for m in tests if m != TRUE]
+    sets = {b for b in sets if not any(covers(b, m) for m in need)}
+    return frozenset(b for b in sets if not any(covers(b, m) and not covers(m, b) for m in sets))
 
 
 def _never(spec: AssemblySpec, i: int, tests: list[int], family: frozenset[int]) -> tuple[str, int]:
