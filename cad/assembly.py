@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import warnings
 from dataclasses import dataclass
 
@@ -147,16 +148,30 @@ def prepare_part(
     )
 
 
+_SAID: set[str] = set()
+"""Part sources (``file#node``) already named in a not-watertight warning this process."""
+
+
 def warn_not_watertight(parts, where: str) -> None:
     """One warning naming every part of ``where`` whose mesh is not watertight (the first
-    ten); the same parts read again say nothing new (one message text, one place)."""
-    open_ids = [repr(p.id) for p in parts if not p.mesh.is_watertight]
-    if not open_ids:
+    ten); a part already named (the same file and node, read again: a spec generated from
+    a file, then its parts loaded) is not named again."""
+    fresh = []
+    for p in parts:
+        if p.mesh.is_watertight:
+            continue
+        file, _, nodes = p.source.partition("#")
+        file = os.path.realpath(file) if file and not file.startswith("<") else file
+        sources = {f"{file}#{n}" for n in nodes.split("+")} if nodes else {file}
+        if not sources <= _SAID:
+            fresh.append(repr(p.id))
+            _SAID.update(sources)
+    if not fresh:
         return
-    more = f" and {len(open_ids) - 10} more" if len(open_ids) > 10 else ""
-    which = f"part {open_ids[0]}" if len(open_ids) == 1 else f"{len(open_ids)} parts"
-    verb = "is" if len(open_ids) == 1 else f"({', '.join(open_ids[:10])}{more}) are"
-    its = "its" if len(open_ids) == 1 else "their"
+    more = f" and {len(fresh) - 10} more" if len(fresh) > 10 else ""
+    which = f"part {fresh[0]}" if len(fresh) == 1 else f"{len(fresh)} parts"
+    verb = "is" if len(fresh) == 1 else f"({', '.join(fresh[:10])}{more}) are"
+    its = "its" if len(fresh) == 1 else "their"
     warnings.warn(
         f"{which} ({where}) {verb} not watertight; {its} relations may be unreliable",
         stacklevel=1,

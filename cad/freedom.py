@@ -36,6 +36,7 @@ and each pair is computed once per axis.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 
 import numpy as np
@@ -362,7 +363,7 @@ def interpenetration_error(assembly: Assembly, tols, found: list[Overlap]) -> Ge
     """The one-line error for every pair in ``found`` (the first :data:`MAX_NAMED` named)."""
     parts = assembly.parts
     first = found[0]
-    hint = unit_hint(assembly, first.a, first.b)
+    hint = unit_hint(assembly, first.a, first.b) or _joining_line(parts[first.a], parts[first.b])
     tail = f"; {hint}" if hint else ""
     if len(found) == 1:
         return GeometryError(
@@ -379,6 +380,21 @@ def interpenetration_error(assembly: Assembly, tols, found: list[Overlap]) -> Ge
     return GeometryError(
         f"{len(found)} pairs of parts interpenetrate deeper than their tolerance: {named}{more}"
         + tail
+    )
+
+
+def _joining_line(a, b) -> str:
+    """The spec line that plans two parts of one scene file as one rigid part (their
+    meshes together, :mod:`cad.merging`), or "" when they are not nodes of one file."""
+    file_a, _, node_a = a.source.partition("#")
+    file_b, _, node_b = b.source.partition("#")
+    if not node_a or file_a != file_b:
+        return ""
+    name = os.path.basename(file_a)
+    return (
+        f"if {a.id!r} and {b.id!r} are one component, plan them as one rigid part: in the "
+        f"spec's parts, `- {{id: {a.id}, file: '{name}#{node_a}+{node_b}'}}` in place of both, "
+        f"and no operation placing {b.id} (`asmplan init` writes the spec)"
     )
 
 

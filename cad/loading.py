@@ -34,6 +34,7 @@ from cad.assembly import Assembly, prepare_part, warn_not_watertight
 from cad.bom import PartRecord, read_bom
 from cad.errors import GeometryError
 from cad.frame import Rotation, rotated
+from cad.merging import merge_overlapping
 from cad.readers import MESH_SUFFIXES
 from cad.scene import empty_scene_error, read_scene
 from cad.unit_hints import part_scale_hint
@@ -209,7 +210,8 @@ def _scene_assembly(path: Path, units: str | None) -> Assembly:
     )
     warn_not_watertight(parts, str(path))
     _check_unique([p.id for p in parts], path)
-    return Assembly(parts=parts, units=unit, source=str(path), groups=scene.groups)
+    assembly = Assembly(parts=parts, units=unit, source=str(path), groups=scene.groups)
+    return merge_overlapping(assembly, path.name)
 
 
 def apply_bom(assembly: Assembly, records: Sequence[PartRecord], base: Path) -> Assembly:

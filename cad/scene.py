@@ -202,11 +202,18 @@ class SceneParts:
         return self.nodes.index(node) if node in self.nodes else None
 
     def whole(self, node: str) -> trimesh.Trimesh | None:
-        """The mesh of a part split into bodies, whole (``node``: its id; None if none)."""
-        for pid, bodies in self.split:
-            if node == pid:
-                return trimesh.util.concatenate([self.meshes[self.ids.index(b)] for b in bodies])
-        return None
+        """One mesh of several parts, or None: ``node`` names a part split into bodies
+        (its id), a group of the file's hierarchy (its id), or parts joined by ``+``
+        (``spring_link_1+spring_link_2``: one rigid part, :mod:`cad.merging`)."""
+        members = dict(self.split).get(node) or dict(self.groups).get(node)
+        if members is None and "+" in node:
+            members = tuple(node.split("+"))
+        if members is None:
+            return None
+        found = [self.find(m) for m in members]
+        if None in found:
+            return None
+        return trimesh.util.concatenate([self.meshes[k] for k in found])
 
 
 def load_scene_file(path: Path) -> trimesh.Scene:

@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 import trimesh
 
-from cad import load_assembly, load_parts
+from cad import compute_relations, load_assembly, load_parts
 from cad.bodies import closed_bodies
 from cad.bom import PartRecord
+from cad.errors import GeometryError
 from cad.scene import read_scene
 
 
@@ -100,3 +101,56 @@ def test_a_spec_part_naming_the_whole_part_keeps_it_one_rigid_part(tmp_path):
         assembly = load_parts(records, tmp_path)
     assert [p.id for p in assembly.parts] == ["truck"]
     assert round(float(assembly.parts[0].mesh.volume)) == 3000
+
+
+def write_grouped_glb(path, pieces, loose):
+    """A glTF in metres: ``pieces`` (name -> mesh) under a node ``spring``, ``loose``
+    beside it, all under a product node."""
+    scene = trimesh.Scene()
+    scene.graph.update(frame_from="world", frame_to="engine")
+    scene.graph.update(frame_from="engine", frame_to="spring")
+    for parent, meshes in (("spring", pieces), ("engine", loose)):
+        for name, mesh in meshes.items():
+            scene.add_geometry(
+                mesh.copy().apply_scale(0.001),
+                node_name=name,
+                geom_name=name,
+                parent_node_name=parent,
+            )
+    scene.export(path)
+    return path
+
+
+def test_overlapping_parts_of_one_sub_assembly_are_one_rigid_part(tmp_path):
+    links = {f"link_{k}": box([4, 4, 3], [0, 0, 2.5 * k]) for k in range(3)}  # 0.5 overlaps
+    loose = {"block": box([4, 4, 4], [20, 0, 0]), "plate": box([30, 10, 2], [10, 0, -4])}
+    path = write_grouped_glb(tmp_path / "engine.glb", links, loose)
+    with pytest.warns(
+        UserWarning, match=r"engine.glb: parts of one sub-assembly .*spring \(3 parts\)"
+    ):
+        assembly = load_assembly(path)
+    assert assembly.ids == ("block", "plate", "spring")
+    spring = assembly.parts[2]
+    assert spring.source.endswith("engine.glb#link_0+link_1+link_2")
+    assert len(spring.mesh.faces) == 36
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        again = load_parts([PartRecord(id="spring", name="spring", file=spring.source)], tmp_path)
+        group = load_parts([PartRecord(id="s", name="s", file="engine.glb#spring")], tmp_path)
+    assert len(again.parts[0].mesh.faces) == len(group.parts[0].mesh.faces) == 36
+
+
+def test_overlapping_parts_of_no_common_group_stay_apart(tmp_path):
+    links = {"link_1": box([4, 4, 3], [0, 0, 0]), "link_2": box([4, 4, 3], [20, 0, 0])}
+    loose = {"block": box([4, 4, 4], [0, 0, 3])}  # overlaps link_1 by 0.5 mm
+    path = write_grouped_glb(tmp_path / "engine.glb", links, loose)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assembly = load_assembly(path)
+    assert assembly.ids == ("block", "link_1", "link_2")
+    with pytest.raises(GeometryError) as info:
+        compute_relations(assembly)
+    assert (
+        "plan them as one rigid part: in the spec's parts, `- {id: block, file: "
+        "'engine.glb#block+link_1'}` in place of both, and no operation placing link_1"
+    ) in str(info.value)
