@@ -11,3 +11,14 @@
 The package imports nothing itself, so pool and cluster workers load only what a task
 needs (:mod:`~asmplan.experiments.tasks`), not matplotlib or tqdm.
 """
+
+from asp.lazy import lazy_exports
+
+__all__, __getattr__ = lazy_exports(
+    __name__,
+    {
+        "backends": ("BACKENDS",),
+        "runner": ("TasksFailed", "run_experiment"),
+        "tasks": ("EXPERIMENT_KEYS", "Solver"),
+    },
+)

@@ -38,3 +38,32 @@ curve and what a policy guarantees), :mod:`asp.concurrent.describe` (the game re
 and :mod:`asp.concurrent.plan` (the concurrent plan of an assembly). The CP-SAT makespan
 stage it is compared with is :mod:`asp.schedule.assembly_makespan`.
 """
+
+from asp.lazy import lazy_exports
+
+__all__, __getattr__ = lazy_exports(
+    __name__,
+    {
+        "build": ("build_game",),
+        "describe": ("Bar", "commit_description", "move_starts", "state_description"),
+        "model": ("WAIT", "concurrent_model"),
+        "plan": (
+            "ConcurrentPlan",
+            "plan_concurrent",
+            "plan_entries",
+            "robustness_table",
+            "timeline_text",
+        ),
+        "robustness": ("DEFAULT_MAX_K", "certified_worst_case", "policy_array", "schedule_rule"),
+        "rules": (
+            "NONE",
+            "Position",
+            "Rules",
+            "commit_rows",
+            "committed_row",
+            "concurrent_rules",
+            "lower_bound_of",
+            "reply_rows",
+        ),
+    },
+)

@@ -4,3 +4,12 @@
 :mod:`~asp.fromcad.gravity` (which way is down), :mod:`~asp.fromcad.framing` (the build
 frame) and :mod:`~asp.fromcad.orientation` (which way up a unit is built).
 """
+
+from asp.lazy import lazy_exports
+
+__all__, __getattr__ = lazy_exports(
+    __name__,
+    {
+        "generate": ("decide_generated", "load_any", "spec_geometry", "spec_text"),
+    },
+)

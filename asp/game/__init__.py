@@ -7,3 +7,38 @@ array-backed DAG), :mod:`~asp.game.io` (its JSON and GraphML files),
 plan as steps), :mod:`~asp.game.play` (a person playing one side) and
 :mod:`~asp.game.alike` (alike operations at run time).
 """
+
+from asp.lazy import lazy_exports
+
+__all__, __getattr__ = lazy_exports(
+    __name__,
+    {
+        "alike": ("AlikeMap",),
+        "dag": (
+            "ANY",
+            "HUMAN",
+            "ROBOT",
+            "CodedLabels",
+            "GameDAG",
+            "from_arrays",
+            "from_edges",
+            "from_networkx",
+            "ids_topological",
+            "index_dtype",
+        ),
+        "io": ("load_dag", "save_dag"),
+        "metrics": ("PlanMetrics", "adversarial_tax", "is_robust_optimal", "plan_metrics"),
+        "plan": ("PlanStep", "relations_summary", "robust_plan"),
+        "play": ("ROBOT_KINDS", "GameSession", "fast_greedy_policy", "fmt", "side_name"),
+        "rules": (
+            "COST_MODELS",
+            "SIDE_NAMES",
+            "close_kernel",
+            "cost_at_most",
+            "costs_close",
+            "edge_cost",
+        ),
+        "solve": ("Solution", "certified_worst_case", "evaluate_policy", "node_order", "solve"),
+        "synth": ("synthetic_dag",),
+    },
+)

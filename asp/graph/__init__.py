@@ -8,3 +8,16 @@ infeasibility proofs and the interchangeable-part reduction), :mod:`~asp.graph.f
 at once, one rule), :mod:`~asp.graph.game_dag` (from the state graph to the game DAG) and
 :mod:`~asp.graph.checker` (an independent plan checker that shares no code with the rest).
 """
+
+from asp.lazy import lazy_exports
+
+__all__, __getattr__ = lazy_exports(
+    __name__,
+    {
+        "checker": ("check_line", "plan_operations"),
+        "feasibility": ("insertion_oracle", "load_relations", "operation_model"),
+        "game_dag": ("game_dag",),
+        "state_graph": ("StateGraph", "build_state_graph"),
+        "symmetry": ("Refutation", "reduced_state_graph", "refutation"),
+    },
+)

@@ -9,3 +9,16 @@ model with its lazy-cut loop), :mod:`~asp.schedule.psplib` (PSPLIB ``.sm`` insta
 :mod:`~asp.schedule.list_schedule` (a feasible schedule along a path) and
 :mod:`~asp.schedule.assembly_makespan` (the makespan stage of ``asmplan plan``).
 """
+
+from asp.lazy import lazy_exports
+
+__all__, __getattr__ = lazy_exports(
+    __name__,
+    {
+        "assembly_makespan": ("AUTO_PATIENCE", "AUTO_TIME_LIMIT", "assembly_makespan"),
+        "cpsat": ("BaselineResult",),
+        "makespan": ("min_makespan",),
+        "path": ("min_cost_path",),
+        "psplib": ("read_sm",),
+    },
+)

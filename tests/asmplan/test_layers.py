@@ -109,7 +109,7 @@ def test_no_import_cycles():
 
 
 ASP_FLOORS = (
-    ("errors", "numbers", "atomic", "heap", "cad_keys"),
+    ("errors", "numbers", "atomic", "heap", "cad_keys", "lazy"),
     ("game",),
     ("salbp",),
     ("spec",),
@@ -173,3 +173,50 @@ def test_no_module_imports_private_names():
                     if a.name.startswith("_")
                 ]
     assert not wrong, f"a private name stays in its module: {wrong}"
+
+
+PACKAGES = sorted(
+    {module_name(p) for pkg in LAYERS for p in sources(pkg) if p.name == "__init__.py"}
+)
+
+
+@pytest.mark.parametrize("package", PACKAGES)
+def test_every_package_names_its_public_api(package):
+    """Issue 22 B5: ``__all__`` in every package; each name is there (sub-packages import
+    their modules only when a name is used, :mod:`asp.lazy`)."""
+    import importlib.util
+
+    module = importlib.import_module(package)
+    assert isinstance(getattr(module, "__all__", None), list), f"{package}: no __all__"
+    missing = [
+        n
+        for n in module.__all__
+        if getattr(module, n, None) is None and importlib.util.find_spec(f"{package}.{n}") is None
+    ]
+    assert not missing, f"{package}.__all__ names what it does not have: {missing}"
+
+
+def test_asmplan_and_arl_use_the_public_names_of_asp():
+    """What asmplan and arl import from ``asp.<room>.<module>`` is in ``asp.<room>.__all__``
+    (or is a module of the room): add a new name to the room's ``__init__``."""
+    import importlib
+
+    wrong = []
+    for pkg in ("arl", "asmplan"):
+        for path in sources(pkg):
+            tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+            for node in ast.walk(tree):
+                if not isinstance(node, ast.ImportFrom) or node.level or not node.module:
+                    continue
+                parts = node.module.split(".")
+                if parts[0] != "asp" or len(parts) != 3:
+                    continue
+                room = importlib.import_module(".".join(parts[:2]))
+                public = set(room.__all__)
+                modules = {p.stem for p in (REPO / "asp" / parts[1]).glob("*.py")}
+                wrong += [
+                    f"{path.relative_to(REPO)}:{node.lineno} {node.module}.{a.name}"
+                    for a in node.names
+                    if a.name not in public and a.name not in modules
+                ]
+    assert not wrong, f"not in the room's __all__ (asp/<room>/__init__.py): {wrong}"
