@@ -27,9 +27,9 @@ to it) and answers for the worst of them; the robots do what it answered, which 
 moves whose commitment differs.
 
 Alike operations (both turn models): the policy knows one canonical order of each class of
-interchangeable operations (``plan.json``'s ``interchangeable``, :mod:`asp.symmetry`). An
+interchangeable operations (``plan.json``'s ``interchangeable``, :mod:`asp.graph.symmetry`). An
 observed operation of a class is mapped onto the operation the plan can take (the class's
-next canonical one) by a permutation of the class's blocks (:class:`asp.alike.AlikeMap`):
+next canonical one) by a permutation of the class's blocks (:class:`asp.game.alike.AlikeMap`):
 a block of several operations (a dowel with its roller) moves as one, and later events of
 the same physical operation (its finish after its start) map the same way. Observations,
 history and advice are in physical operation ids; an instruction or option that names one
@@ -498,7 +498,7 @@ class Advisor:
         return [self._ops[told[0]]]
 
     def _pattern(self, op: str):
-        """An alike operation's pattern (:data:`asp.alike.Pattern`): done or not; None
+        """An alike operation's pattern (:data:`asp.game.alike.Pattern`): done or not; None
         while it runs."""
         c = self._cursor
         if c.running >= 0 and self._ops[self._policy["moves"]["operation"][c.running]] == op:
@@ -881,7 +881,7 @@ class ConcurrentAdvisor(Advisor):
 
     def _pattern(self, op: str):
         """Done or not in each branch; None while it runs, is started or is committed in
-        any (:data:`asp.alike.Pattern`)."""
+        any (:data:`asp.game.alike.Pattern`)."""
         o = self._op_index[op]
         out = []
         for br in self._branches:

@@ -90,13 +90,13 @@ class Game:
 
     Attributes
     ----------
-    dag : asp.dag.GameDAG
+    dag : asp.game.dag.GameDAG
     descriptions : dict of str to str
         Operation id -> description, for readable plans.
     interchangeable : tuple
         The classes of interchangeable blocks of operations its state graph's reduction
         used (``graph.model.interchangeable``; empty for a bare graph file): the game knows
-        one canonical order of each (:mod:`asp.alike` maps a physical choice onto it).
+        one canonical order of each (:mod:`asp.game.alike` maps a physical choice onto it).
     """
 
     dag: GameDAG
@@ -110,10 +110,11 @@ class Schedule:
 
     Attributes
     ----------
-    result : asp.baseline.BaselineResult
+    result : asp.schedule.cpsat.BaselineResult
         Status, objective (makespan), bound and the task rows.
     lower_bound, chain_bound, load_bound : float
-        State-graph lower bounds of the makespan (see :class:`asp.baseline.AssemblySchedule`).
+        State-graph lower bounds of the makespan (see
+        :class:`asp.schedule.assembly.AssemblySchedule`).
     """
 
     result: BaselineResult
@@ -163,21 +164,21 @@ class AssemblyPlan:
     Attributes
     ----------
     assembly : Assembly
-    graph : asp.state_graph.StateGraph
+    graph : asp.graph.state_graph.StateGraph
     sequences : int
         Number of feasible complete assembly sequences.
     game : Game or None
         None when :func:`plan` let it go (``keep_game=False``; ``played`` has what the
         outputs need of it).
-    solution : asp.solve.Solution or None
+    solution : asp.game.solve.Solution or None
         Exact solution: TCT, W* and both sides' policies (None with ``game``).
-    steps : tuple of asp.plan.PlanStep
+    steps : tuple of asp.game.plan.PlanStep
         The robust plan, turn by turn (robust robot against a maximising human).
     relations_summary : list of dict
         Per part: contacts (with directions) and free directions.
     schedule : Schedule
         CP-SAT minimum makespan with the agents in parallel.
-    concurrent : asp.concurrent_plan.ConcurrentPlan or None
+    concurrent : asp.concurrent.plan.ConcurrentPlan or None
         With the turn model ``concurrent``: the curve ``W*(k)``, the CP-SAT schedule's
         certified worst case, the timelines.
     units : list of dict
@@ -286,7 +287,7 @@ def load_assembly(
     source : path
         A folder holding ``assembly.yaml``, the YAML itself, a Scholl ``.IN2`` graph, or a
         CAD file (STEP, glTF/GLB, 3MF, 3DXML) or folder of part meshes, whose spec is
-        generated (``spec.generated``; :mod:`asp.generate`).
+        generated (``spec.generated``; :mod:`asp.fromcad.generate`).
     units, gravity : str, optional
         ``--units`` (of mesh files that declare none) and ``--gravity``: replace the spec's.
 
@@ -338,7 +339,7 @@ def load(
     """:func:`load_assembly` and, when the spec has meshes, its :func:`relations`.
 
     A generated spec (no ``assembly.yaml``) is announced through ``on_step``, else as a
-    warning; the decisions that need its relations (:func:`asp.generate.decide_generated`:
+    warning; the decisions that need its relations (:func:`asp.fromcad.generate.decide_generated`:
     build frame, gravity, base part, ``held`` placements of parts nothing can keep from
     falling) are each said in a note. ``contact_tol`` and
     ``penetration_tol`` (mm) replace the spec's tolerances when given; ``units`` and
@@ -504,13 +505,13 @@ def state_graph(
         Called with a line for each round of automatic subassemblies.
     concurrent : bool
         Reduce so that the concurrent game keeps its values too: alike parts in a loose
-        order, not a fixed one (more states; :func:`asp.symmetry.symmetry_reduction`). The
+        order, not a fixed one (more states; :func:`asp.graph.symmetry.symmetry_reduction`). The
         CP-SAT schedule keeps its value either way (it undoes a fixed order,
-        :mod:`asp.fixed_order`).
+        :mod:`asp.graph.fixed_order`).
 
     Returns
     -------
-    asp.state_graph.StateGraph
+    asp.graph.state_graph.StateGraph
     """
     from asp.subassemblies import build_with_units
 
@@ -531,13 +532,13 @@ def game(graph: StateGraph, *, cost: str | None = None) -> GameDAG:
 
     Parameters
     ----------
-    graph : asp.state_graph.StateGraph
+    graph : asp.graph.state_graph.StateGraph
     cost : {"steps", "time"}, optional
         Cost of a move (default: the spec's ``cost:``).
 
     Returns
     -------
-    asp.dag.GameDAG
+    asp.game.dag.GameDAG
     """
     from asp.graph.game_dag import game_dag
 
@@ -615,20 +616,21 @@ def schedule(
     """CP-SAT minimum makespan with the agents working in parallel, physically feasible.
 
     Every schedule is replayed through the state graph and cut until one passes
-    (:func:`asp.concurrent.assembly_makespan`); the status is ``OPTIMAL`` only for a
+    (:func:`asp.schedule.assembly_makespan.assembly_makespan`); the status is ``OPTIMAL`` only for a
     proven optimum that passed, ``FEASIBLE`` for the best passing schedule when time ran
     out (a list schedule along a state-graph path is always there to fall back on).
 
     Parameters
     ----------
     assembly : Assembly
-    graph : asp.state_graph.StateGraph
+    graph : asp.graph.state_graph.StateGraph
         Gives the implied precedences and the lower bounds.
     time_limit : float or None
         Seconds for CP-SAT's search. ``None`` (the default): the automatic budget of
-        :func:`asp.concurrent.assembly_makespan`, the whole stage within
-        :data:`asp.concurrent.AUTO_TIME_LIMIT` seconds, stopping once neither a better
-        schedule nor a new cut has come for :data:`asp.concurrent.AUTO_PATIENCE` seconds.
+        :func:`asp.schedule.assembly_makespan.assembly_makespan`, the whole stage within
+        :data:`asp.schedule.assembly_makespan.AUTO_TIME_LIMIT` seconds, stopping once
+        neither a better schedule nor a new cut has come for
+        :data:`asp.schedule.assembly_makespan.AUTO_PATIENCE` seconds.
     workers : int
         CP-SAT workers (1: repeatable).
     seed : int
@@ -685,10 +687,10 @@ def plan(
         CP-SAT random seed.
     turn_model : {"alternate", "concurrent"}, optional
         Default: the spec's. ``concurrent`` adds the concurrent game
-        (:func:`asp.concurrent_plan.plan_concurrent`).
+        (:func:`asp.concurrent.plan.plan_concurrent`).
     max_k : int, optional
         Largest deviation budget of the concurrent curve (default
-        :data:`asp.concurrent.DEFAULT_MAX_K`).
+        :data:`asp.concurrent.robustness.DEFAULT_MAX_K`).
     duration_step : float or None
         Grid of a person's duration range in the concurrent game (None: its end points).
     on_step : callable, optional
@@ -808,7 +810,7 @@ def concurrent_preview(spec: AssemblySpec, graph: StateGraph, *, schedule=None) 
     Parameters
     ----------
     spec : asp.spec.AssemblySpec
-    graph : asp.state_graph.StateGraph
+    graph : asp.graph.state_graph.StateGraph
     schedule : (BaselineResult, float), optional
         The plan's CP-SAT schedule and its lower bound (spares solving it again).
 

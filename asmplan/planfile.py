@@ -94,7 +94,7 @@ class AlternateStates:
 
     Attributes
     ----------
-    graph : asp.state_graph.StateGraph
+    graph : asp.graph.state_graph.StateGraph
     state_of : (n,) int64
         The state graph state of each game node (of each of ``nodes``, when given).
     nodes : (k,) int64 or None
@@ -370,7 +370,7 @@ def policy_document(
 ) -> dict:
     """The ``policy`` object of the plan file (columnar, see the module docstring).
 
-    ``game``: the :class:`asp.concurrent.ConcurrentGame` whose DAG ``dag`` is (turn model
+    ``game``: the :class:`asp.concurrent.build.ConcurrentGame` whose DAG ``dag`` is (turn model
     ``concurrent``); its states and moves are named by :mod:`asp.concurrent`
     (``state_description``, ``commit_description``, ``move_starts``) and ``describe`` is
     not used.
@@ -761,13 +761,13 @@ def plan_document(
     """The whole plan file: policy, lines, metrics, operations and parts, plus ``extra``.
 
     ``extra`` holds the keys computed elsewhere (relations, state graph sizes, ``schedule``);
-    they are kept as given. ``game``: the :class:`asp.concurrent.ConcurrentGame` whose DAG
+    they are kept as given. ``game``: the :class:`asp.concurrent.build.ConcurrentGame` whose DAG
     ``dag`` is (turn model ``concurrent``; ``solution`` its exact solution, the policy that
     of its start, the largest budget). ``relations``: the part relations (``cad``
     ``Relations``, None without geometry): each line step's ``insertions`` then name the
     direction each body goes in along, and ``geometry`` the unit, scale and tolerances.
     ``interchangeable``: the classes of interchangeable blocks of operations the state
-    graph's reduction used (``graph.model.interchangeable``, :mod:`asp.symmetry`), written
+    graph's reduction used (``graph.model.interchangeable``, :mod:`asp.graph.symmetry`), written
     as the plan's ``interchangeable`` for the runtime advisor.
     """
     if game is None:
@@ -914,7 +914,7 @@ def add_insertions(steps: list[dict], spec, relations, operations: dict) -> str 
     ``insert_along`` is ``-d``: the body moves along it to go in; ``insert_vector_file`` is
     that direction as a unit vector in the file's coordinates. They are null for the first
     body of a workspace and without geometry. The line is replayed by
-    :func:`asp.checker.check_line`; returns None when it accepts the line, else its error
+    :func:`asp.graph.checker.check_line`; returns None when it accepts the line, else its error
     (the insertions then carry no directions).
     """
     from asp.graph.checker import check_line
@@ -1100,7 +1100,7 @@ def workspace_records(spec, operations: dict, principal: list[dict]) -> list[dic
     insertion), ``operations`` (in principal-line order), ``inserted_by`` and ``into``
     (a unit: the operation inserting it, into ``MAIN``; main: null), and ``gravity``: the
     direction a part falls along in that workspace, in the product's frame (main: the
-    spec's; a unit built upside down: the opposite, :mod:`asp.orientation`), the direction
+    spec's; a unit built upside down: the opposite, :mod:`asp.fromcad.orientation`), the direction
     its support is tested along.
     """
     placed = {p for info in operations.values() for p in info["parts"]}

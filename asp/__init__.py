@@ -1,8 +1,8 @@
 """asp: assembly sequence planning as a robot-vs-human game.
 
-The game DAG (:mod:`asp.dag`), the rules of play on it (:mod:`asp.rules`), its file formats
-(:mod:`asp.io`), the synthetic generator (:mod:`asp.synth`), the exact solver
-(:mod:`asp.solve`) and the metrics (:mod:`asp.metrics`).
+The game DAG (:mod:`asp.game.dag`), the rules of play on it (:mod:`asp.game.rules`), its
+file formats (:mod:`asp.game.io`), the synthetic generator (:mod:`asp.game.synth`), the exact
+solver (:mod:`asp.game.solve`) and the metrics (:mod:`asp.game.metrics`).
 This package never imports torch.
 """
 

@@ -9,7 +9,7 @@ DESIGN.md ("Parts and subassemblies from CAD"). A unit ``U`` with member parts `
   (its predecessors: every member operation). It is tested as one rigid body: ``U`` is free
   along ``d`` from ``S`` iff every member is free along ``d`` from every part of ``S``;
   touches iff some member touches; is supported iff some member is (the pairwise relations
-  ORed over the members, :func:`asp.feasibility.insertion_oracle`). Its duration for an
+  ORed over the members, :func:`asp.graph.feasibility.insertion_oracle`). Its duration for an
   agent is the longest member operation that agent may do (a documented default);
 - a state is still the set of operations done, so the game runs over the product of the
   workspaces: a person may build a unit while a robot works on the main body.
@@ -107,7 +107,7 @@ def build_with_units(
     rounds too), and the graph is built again (at most :data:`MAX_ROUNDS` rounds); if no
     new unit can be found, the file's remaining sub-assemblies are given up before the
     first error is raised. With ``reduce``, a round whose derived precedences already prove
-    that no complete sequence exists (:func:`asp.symmetry.refutation`, milliseconds)
+    that no complete sequence exists (:func:`asp.graph.symmetry.refutation`, milliseconds)
     builds no checked graph, and its graph for the stuck operations only up to
     :data:`PROVED_ROUND_STATES` states; beyond, the operation the proof names is the stuck
     one (a clutch's pressure plate blocked by its 13 pins: 15.7M states built twice before).
@@ -123,7 +123,7 @@ def build_with_units(
         Use the CAD file's sub-assemblies (:func:`with_cad_units`).
     reduce : bool
         Build each graph with the symmetry reduction
-        (:func:`asp.symmetry.reduced_state_graph`: interchangeable parts in the main
+        (:func:`asp.graph.symmetry.reduced_state_graph`: interchangeable parts in the main
         assembly and in each unit's workspace in a fixed order; the full graph when there
         is nothing to reduce), for the spec with every unit of that round; with
         ``concurrent``, the reduction that keeps the concurrent game's values too.
@@ -133,7 +133,7 @@ def build_with_units(
         The file's sub-assemblies given up already (default: :func:`refuted_units`, whose
         lines go to ``on_unit``).
     **kwargs
-        For :func:`asp.state_graph.build_state_graph`.
+        For :func:`asp.graph.state_graph.build_state_graph`.
 
     Returns
     -------
@@ -263,7 +263,7 @@ def refuted_units(
     on_unit: Callable[[str], None] | None = None,
 ) -> set[str]:
     """The CAD file's sub-assemblies to give up before any state graph is built: those the
-    derived precedences prove leave no complete sequence (:func:`asp.symmetry.refutation`,
+    derived precedences prove leave no complete sequence (:func:`asp.graph.symmetry.refutation`,
     milliseconds), with ``exclude``.
 
     While the file's units (:func:`with_cad_units`, without the ones given up) admit such a
@@ -306,7 +306,7 @@ def refuted_units(
 
 def prepared_units(spec: AssemblySpec, relations, on_unit=None) -> AssemblySpec:
     """``spec``'s units ready to build: each in its build orientation
-    (:func:`asp.orientation.orient_units`, said through ``on_unit``), held when nothing
+    (:func:`asp.fromcad.orientation.orient_units`, said through ``on_unit``), held when nothing
     outside it can keep it from falling (:func:`hold_unsupported_units`), and built one
     after another when their workspaces would multiply the states (:func:`built_in_turn`)."""
     from asp.fromcad.orientation import orient_units
@@ -318,7 +318,7 @@ def prepared_units(spec: AssemblySpec, relations, on_unit=None) -> AssemblySpec:
 def hold_unsupported_units(spec: AssemblySpec, relations) -> AssemblySpec:
     """A generated spec with ``held: true`` on the insertion of each unit that no part
     outside it can keep from falling (an upper die set sliding down its guide pins), as
-    :func:`asp.generate.hold_unsupported` does for single parts; other specs unchanged."""
+    :func:`asp.fromcad.generate.hold_unsupported` does for single parts; other specs unchanged."""
     if not spec.generated or not spec.constraints.stability or relations is None:
         return spec
     from dataclasses import replace
@@ -379,7 +379,7 @@ def hung_on_units(
     some member keeps it from falling along ``-g``: built upside down, the unit carries it
     (the guide bushings of a die set's upper half, pressed into the top plate from below,
     rest on it with the top plate on the bench). It joins the unit when the unit with it
-    is then built upside down (:func:`asp.orientation.unit_orientation`) without holding
+    is then built upside down (:func:`asp.fromcad.orientation.unit_orientation`) without holding
     it: a toolmaker presses the bushings in there instead of holding each on its guide pin
     until the top plate comes down. The state graph still checks the unit
     (:func:`build_with_units` falls back to the units without them)."""
@@ -587,7 +587,7 @@ def cad_units(
 ) -> tuple[HierarchyUnit, ...]:
     """Decide which of the CAD file's sub-assemblies become units.
 
-    The file's groups (:func:`asp.generate.spec_hierarchy`), outermost first; a part
+    The file's groups (:func:`asp.fromcad.generate.spec_hierarchy`), outermost first; a part
     belongs to one unit, so a group inside a used one is not used. A group is used when
 
     - it does not hold the base part (that stands first in the main assembly);
@@ -595,7 +595,7 @@ def cad_units(
     - it can be built on its own: its parts go into its workspace one by one, each free
       along a direction the gripper approaches from, touching and supported (unless held)
       by the parts already there, right side up or upside down (gravity reversed: a lid
-      with flanged pegs pressed in from below, :mod:`asp.orientation` then picks the way
+      with flanged pegs pressed in from below, :mod:`asp.fromcad.orientation` then picks the way
       up) (a search over the orders, at most :data:`BUILD_SEARCH_LIMIT` partial
       workspaces; undecided counts as buildable);
     - it can be inserted as one rigid body: free from the base part along such a

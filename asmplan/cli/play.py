@@ -1,14 +1,14 @@
 """Command ``asmplan play``: a person plays one side of the game, turn by turn.
 
-The game logic is :class:`asp.play.GameSession`; this module only reads and prints. The
+The game logic is :class:`asp.game.play.GameSession`; this module only reads and prints. The
 person types a move number or an operation id (``?`` help, ``q`` quit); end of input quits
 cleanly (exit 0). ``--moves 2,1,3`` plays those first (scripted demos and tests), then reads
 stdin.
 
-Alike parts: an assembly's game is reduced by symmetry (:mod:`asp.symmetry`), so its moves
+Alike parts: an assembly's game is reduced by symmetry (:mod:`asp.graph.symmetry`), so its moves
 name one canonical order of interchangeable operations. The moves are shown in the person's
 physical operation ids with the alike ones as good (``or alike: ...``), and a typed id of any
-of them plays the canonical move it maps onto (:class:`asp.alike.AlikeMap`).
+of them plays the canonical move it maps onto (:class:`asp.game.alike.AlikeMap`).
 """
 
 from __future__ import annotations
@@ -74,7 +74,7 @@ def _parse_moves(text: str | None, operations=()) -> list[str]:
 
 class _Alike:
     """The person's physical operation ids over a game reduced by symmetry: the moves shown
-    in them, a typed id mapped onto the canonical move (:class:`asp.alike.AlikeMap`)."""
+    in them, a typed id mapped onto the canonical move (:class:`asp.game.alike.AlikeMap`)."""
 
     def __init__(self, session, classes):
         from asp.game.alike import AlikeMap

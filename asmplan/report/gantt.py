@@ -113,7 +113,7 @@ def plot_gantt(
 
     Parameters
     ----------
-    bars : sequence of :class:`asp.concurrent.Bar`
+    bars : sequence of :class:`asp.concurrent.describe.Bar`
     unit : str
         The time unit of the axis and the makespan (``s``).
     """

@@ -7,7 +7,7 @@ from asp.numbers import cost_text
 
 
 def plan_text(steps: list) -> str:
-    """The step list as aligned text lines (:class:`~asp.plan.PlanStep` or the plan file's
+    """The step list as aligned text lines (:class:`~asp.game.plan.PlanStep` or the plan file's
     step dicts, ``robust_plan`` / ``worst_line``)."""
     lines = []
     for s in steps:
@@ -29,7 +29,7 @@ def plan_text(steps: list) -> str:
 
 
 def relations_summary_text(summary: list[dict]) -> str:
-    """The relations summary (:func:`asp.plan.relations_summary`) as aligned text lines."""
+    """The relations summary (:func:`asp.game.plan.relations_summary`) as aligned text lines."""
     width = max((len(r["part"]) for r in summary), default=4)
     lines = []
     for r in summary:

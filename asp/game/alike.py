@@ -1,6 +1,6 @@
 """Alike operations at run time: a physical observation mapped onto the policy's canonical one.
 
-The state graph is reduced by symmetry (:mod:`asp.symmetry`): of a class of interchangeable
+The state graph is reduced by symmetry (:mod:`asp.graph.symmetry`): of a class of interchangeable
 blocks of operations (the pins of a ring; a dowel with the roller it carries, around a
 drive) it keeps one canonical order, so the policy knows only the canonical states. Any
 transposition of two blocks of a class, position by position, is a symmetry of the game. A

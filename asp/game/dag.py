@@ -11,10 +11,10 @@ most :data:`INT32_NODES` (so that a game state ``2 * node + player`` still fits)
 ``costs`` are float32 when every cost is exactly a float32 (1 per step, whole or binary
 fraction seconds), else float64 (:func:`index_dtype`, :func:`compact_costs`). Arithmetic on
 them in the solvers is done in float64 (a float32 widens exactly), so every result is the
-same as with int64/float64 arrays; :func:`asp.rules.move_costs` gives the costs as float64.
+same as with int64/float64 arrays; :func:`asp.game.rules.move_costs` gives the costs as float64.
 
 The rules of play on it (who may take which edge, passes, the turn, the cost of a move) are
-:mod:`asp.rules`; the side codes ``ROBOT``, ``HUMAN`` and ``ANY`` come from there. On a
+:mod:`asp.game.rules`; the side codes ``ROBOT``, ``HUMAN`` and ``ANY`` come from there. On a
 synthetic DAG every edge is ``ANY``.
 """
 
@@ -119,7 +119,7 @@ class CodedCosts:
     index it (an int gives one cost, an index array or a slice the costs), ``len``,
     ``shape``, ``size``, ``dtype`` (the table's), comparisons, ``np.asarray`` (the whole
     array, made on each call), ``tolist``, ``astype``, ``min``, ``max``. The compiled
-    kernels read ``table[codes[e]]`` (:func:`asp.rules.kernel_tables`).
+    kernels read ``table[codes[e]]`` (:func:`asp.game.rules.kernel_tables`).
 
     Attributes
     ----------
@@ -276,7 +276,8 @@ class GameDAG:
         return range(int(self.indptr[v]), int(self.indptr[v + 1]))
 
     def moves(self, v: int, player: int) -> list[int]:
-        """Edge indices player ``player`` may take from node ``v`` (:func:`asp.rules.moves`)."""
+        """Edge indices player ``player`` may take from node ``v``
+        (:func:`asp.game.rules.moves`)."""
         return rules.moves(self, v, player)
 
     def index_of(self, node_id) -> int:

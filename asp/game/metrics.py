@@ -2,10 +2,10 @@
 
 For a robot policy (by default the robust one):
 
-- TCT and W* come from :func:`asp.solve.solve`;
+- TCT and W* come from :func:`asp.game.solve.solve`;
 - the certified WCPL is the policy's cost against an exact best-response human;
 - against a uniformly random human, the exact mean, minimum and maximum come from
-  :func:`asp.solve.evaluate_policy` (the random human plays every line with positive
+  :func:`asp.game.solve.evaluate_policy` (the random human plays every line with positive
   probability, so the maximum is the certified WCPL and the minimum the helpful human's
   cost): no distribution is needed for them;
 - the resilience ratio RR = P(cost <= b) for a bound b is exact by
@@ -19,7 +19,7 @@ For a robot policy (by default the robust one):
 
 The whole exact distribution (:func:`random_cost_distribution`) is kept for small games
 (tests, reports) under its own cap (:data:`MAX_DISTRIBUTION_ENTRIES`). The rules of play
-come from :mod:`asp.rules`.
+come from :mod:`asp.game.rules`.
 """
 
 from __future__ import annotations
@@ -61,7 +61,7 @@ def simulate_random_human(
 
     Parameters
     ----------
-    robot_policy : (n,) int64 edge indices (see :func:`asp.solve.as_policy_array`)
+    robot_policy : (n,) int64 edge indices (see :func:`asp.game.solve.as_policy_array`)
     n_games : int
     seed : int
         Seed of ``numpy.random.default_rng``; the same seed gives the same costs.

@@ -1,7 +1,7 @@
 """Plans as data: the relations summary and the robust plan as a list of steps.
 
 The robust plan is the game played by the robust robot policy against the maximising human
-(both minimax, :func:`asp.solve.solve`), step by step, with passes shown, and at each human
+(both minimax, :func:`asp.game.solve.solve`), step by step, with passes shown, and at each human
 turn the operations the human could choose from. Their text renderings are in
 :mod:`asmplan.report.plan`.
 """

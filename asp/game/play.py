@@ -7,7 +7,7 @@ passes at zero cost). The person plays either side:
 - the **human** side against a robot policy (the robust policy W* by default, the
   cooperative fastest path ``fast-greedy``, or any ``(n,)`` policy array, e.g. a trained
   one). The worst case shown is the robot policy's exact certified worst case
-  (:func:`asp.solve.evaluate_policy`); for the robust robot it is the game value.
+  (:func:`asp.game.solve.evaluate_policy`); for the robust robot it is the game value.
 - the **robot** side against a best-response human (the exact maximiser). The worst case
   shown is the game value: what a perfect robot can still guarantee from the state.
 
@@ -185,7 +185,7 @@ class GameSession:
         The side the person plays: ``HUMAN`` (default) or ``ROBOT``.
     robot : str or (n,) int array
         The computer robot when the person plays the human: ``"robust"``, ``"fast-greedy"``
-        or a policy array (edge index per node; see :func:`asp.solve.as_policy_array`).
+        or a policy array (edge index per node; see :func:`asp.game.solve.as_policy_array`).
     robot_name : str, optional
         Name shown for a policy array (default ``"given"``).
     descriptions : dict, optional
@@ -194,7 +194,7 @@ class GameSession:
         When the person plays the robot, the best-response human breaks ties between equally
         delaying moves at random with this seed (default: lowest move index).
     solution : Solution, optional
-        A precomputed :func:`asp.solve.solve` of ``dag``.
+        A precomputed :func:`asp.game.solve.solve` of ``dag``.
     """
 
     def __init__(

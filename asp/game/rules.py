@@ -1,8 +1,8 @@
 """The rules of play on a game DAG, written once (``../shared/DESIGN.md``, "The game").
 
 Every consumer of the game asks this module what a move is: the exact solver and the
-policy evaluator (:mod:`asp.solve`), the metrics (:mod:`asp.metrics`), the play session
-(:mod:`asp.play`), the readable plan (:mod:`asp.plan`), the CP-SAT path
+policy evaluator (:mod:`asp.game.solve`), the metrics (:mod:`asp.game.metrics`), the play session
+(:mod:`asp.game.play`), the readable plan (:mod:`asp.game.plan`), the CP-SAT path
 (:mod:`asp.baseline`), the learners' game, environments and trainer (:mod:`arl`), and the
 plan file's policy table (``asmplan.planfile``). The
 compiled kernels cannot call Python, so they take the rules as tables built here
@@ -25,8 +25,8 @@ Scalar helpers (:func:`moves`, :func:`step`, :func:`settle`) serve sessions and
 environments; table builders (:func:`move_masks`, :func:`move_counts`, :func:`move_costs`,
 :func:`has_move`, :func:`kernel_tables`) serve the vectorised and compiled consumers.
 
-Every ``dag`` argument is an :class:`asp.dag.GameDAG` (not imported: :mod:`asp.dag` builds on
-this module, and imports flow one way).
+Every ``dag`` argument is an :class:`asp.game.dag.GameDAG` (not imported:
+:mod:`asp.game.dag` builds on this module, and imports flow one way).
 
 Numba caches a compiled kernel per source file and does not notice a change in a function
 it calls from another file: the kernels therefore take the tables and the tolerance as
@@ -112,7 +112,7 @@ def move_costs(dag, edges=None) -> np.ndarray:
 
     The edge's cost under both ``steps`` and ``time``: a ``steps`` DAG says 1 per move
     unless its file gives other costs, and then the game is played on those. A DAG may
-    store its costs as float32 (:func:`asp.dag.compact_costs`, exact): they are widened
+    store its costs as float32 (:func:`asp.game.dag.compact_costs`, exact): they are widened
     here (a copy; pass ``edges`` to widen only those); the compiled kernels take them as
     stored (:func:`kernel_tables`).
     """
@@ -234,7 +234,7 @@ class KernelTables:
     cost : (m,) or (k,) float32 or float64
         Cost of each move (:func:`move_costs`) as the DAG stores it (float32 only when
         exact); the kernels add costs in float64. With ``code``, the table of distinct
-        costs (:class:`asp.dag.CodedCosts`).
+        costs (:class:`asp.game.dag.CodedCosts`).
     code : (m,) int8 or int16, or (0,) int8
         Index into ``cost`` of each edge's cost, or empty when ``cost`` is per edge; a
         kernel reads a cost with :func:`edge_cost`.
@@ -284,7 +284,7 @@ def edge_cost(cost, code, e):  # pragma: no cover - compiled
 
 def kernel_tables(dag) -> KernelTables:
     """The tables the compiled kernels play by."""
-    coded = hasattr(dag.costs, "codes")  # asp.dag.CodedCosts (asp.dag imports this module)
+    coded = hasattr(dag.costs, "codes")  # asp.game.dag.CodedCosts (dag imports this module)
     return KernelTables(
         indptr=dag.indptr,
         targets=dag.targets,

@@ -11,7 +11,7 @@ nodes in reverse topological order, each state gets:
 and the robust robot move (a move achieving the minimax value; ties broken by lower
 ``expected`` cost, then by lower move index) and the human's maximising move (ties by
 lower index). The rules of play (moves, passes, costs, the cost tolerance) come from
-:mod:`asp.rules` as tables (:func:`asp.rules.kernel_tables`).
+:mod:`asp.game.rules` as tables (:func:`asp.game.rules.kernel_tables`).
 
 The sweeps are compiled with numba (``cache=True``): a 1M-node, 3M-edge game solves in
 well under a second.

@@ -1,6 +1,6 @@
 """An independent plan checker: replay a line of operations against the part relations.
 
-It shares no code with the state graph (:mod:`asp.feasibility` compiles the relations to
+It shares no code with the state graph (:mod:`asp.graph.feasibility` compiles the relations to
 bitmasks; this reads the tables one pair at a time), so a plan both accept is right twice.
 For each operation of the line, in order, with ``S`` the parts already there (the base part
 from the start when no operation places it):

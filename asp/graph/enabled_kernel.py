@@ -1,8 +1,8 @@
 """The state graph's inner loops compiled with numba.
 
-The enabled-operations test (:meth:`asp.feasibility.OperationModel.enabled`), stuck states,
-duplicate successor keys (:func:`asp.state_graph.build_state_graph`) and the sequence count
-(:meth:`asp.state_graph.StateGraph.count_sequences`).
+The enabled-operations test (:meth:`asp.graph.feasibility.OperationModel.enabled`), stuck states,
+duplicate successor keys (:func:`asp.graph.state_graph.build_state_graph`) and the sequence count
+(:meth:`asp.graph.state_graph.StateGraph.count_sequences`).
 
 One pass over the states: for each state and operation, the key tests (not done, explicit
 predecessors done, tools ready) and then the geometric test of the part it places (touches

@@ -340,7 +340,7 @@ class OperationModel:
     unit_masks : (U, PW) uint64
         Per subassembly, its member parts.
     symmetric : tuple of classes of blocks of operation indices
-        Interchangeable blocks: of equal blocks only the first moves (:mod:`asp.symmetry`).
+        Interchangeable blocks: of equal blocks only the first moves (:mod:`asp.graph.symmetry`).
     loose : tuple of (int, tuple of int)
         Classes of interchangeable operations, each with its slack ``m``: an operation of a
         class may be done only while at most ``m`` of the ones listed before it are not
@@ -353,8 +353,8 @@ class OperationModel:
     fixed : tuple of classes of blocks of operation indices
         Interchangeable blocks the spec puts in a fixed order: at every position ``i``, the
         ``i``-th operations of the blocks are chained in block order by ``after``
-        (:func:`asp.symmetry.symmetry_reduction`). Only read by the schedule stage, which
-        undoes that order (:mod:`asp.fixed_order`).
+        (:func:`asp.graph.symmetry.symmetry_reduction`). Only read by the schedule stage, which
+        undoes that order (:mod:`asp.graph.fixed_order`).
     """
 
     spec: AssemblySpec
@@ -530,7 +530,7 @@ class OperationModel:
 
         ``parents`` (optional): the keys and parts of a state each of ``keys`` is reached
         from by one operation, none of them stuck; then only the operations whose part the
-        parts new to its set could block are tested (:func:`asp.enabled_kernel.stuck`,
+        parts new to its set could block are tested (:func:`asp.graph.enabled_kernel.stuck`,
         the same result).
         """
         keys = self._keys(keys)
@@ -552,7 +552,7 @@ class OperationModel:
 
     @functools.cached_property
     def _kernel_args(self) -> tuple | None:
-        """The arrays of :func:`asp.enabled_kernel.enabled_single`, or None when an
+        """The arrays of :func:`asp.graph.enabled_kernel.enabled_single`, or None when an
         operation places several parts (the numpy path)."""
         if any(len(p) > 1 for p in self.part_lists):
             return None
@@ -597,7 +597,7 @@ class OperationModel:
             self._loose_order(keys, ok)
 
     def _loose_order(self, keys: np.ndarray, ok: np.ndarray) -> None:
-        """Of each class of interchangeable operations ``(m, ops)`` (:mod:`asp.symmetry`),
+        """Of each class of interchangeable operations ``(m, ops)`` (:mod:`asp.graph.symmetry`),
         keep ``ops[j]`` only where at most ``m`` of ``ops[:j]`` are not done.
 
         Any of them may be done next, so doing the first one not done is the same move up to
@@ -619,7 +619,7 @@ class OperationModel:
 
         ``symmetric`` holds classes of blocks (tuples of operation indices, position by
         position alike): every transposition of two blocks of a class is a symmetry of the
-        game (:mod:`asp.symmetry`). Two blocks with the same operations done (position by
+        game (:mod:`asp.graph.symmetry`). Two blocks with the same operations done (position by
         position) are swapped by a symmetry that fixes the state, so a move in the later one
         has the same cost and an isomorphic future as the same move in the earlier one: only
         the earlier one's is kept. TCT and W* do not change.
@@ -733,7 +733,7 @@ def operation_model(
 
     The state key takes as many 64-bit words as the operations and tool fields need
     (``_min_words`` forces more, for tests of the multi-word path). ``symmetric``: classes of
-    interchangeable blocks of operation ids (:func:`asp.symmetry.interchangeable_blocks`),
+    interchangeable blocks of operation ids (:func:`asp.graph.symmetry.interchangeable_blocks`),
     of which only the first of equal blocks moves (:meth:`OperationModel.enabled`);
     ``loose``: classes of interchangeable operation ids with their slack, ``(m, ids)``
     (:attr:`OperationModel.loose`); ``interchangeable``: the classes of blocks the
@@ -833,7 +833,7 @@ def operation_model(
 def load_relations(spec: AssemblySpec, *, progress: bool = False, geometry=None):
     """Compute the cad relations of ``spec``'s parts (``None`` when it has no geometry).
 
-    Reads the meshes of the spec's parts (:func:`asp.generate.spec_geometry`: in the
+    Reads the meshes of the spec's parts (:func:`asp.fromcad.generate.spec_geometry`: in the
     spec's build frame) unless ``geometry`` (that ``cad.Assembly``, already read) is given,
     with the spec's
     ``contact_tol`` and ``penetration_tol`` (None: the per-part rule), and its ``flex``

@@ -1,9 +1,9 @@
 """The schedule stage on a graph whose alike operations are in a fixed order.
 
-The state graph of the alternating game is reduced by symmetry (:mod:`asp.symmetry`): of a
+The state graph of the alternating game is reduced by symmetry (:mod:`asp.graph.symmetry`): of a
 class of interchangeable blocks of operations (a pin; a dowel with its roller), the
 ``i``-th operations of the blocks are chained in block order at every position ``i``
-(:attr:`asp.feasibility.OperationModel.fixed`). The graph holds one state of every orbit:
+(:attr:`asp.graph.feasibility.OperationModel.fixed`). The graph holds one state of every orbit:
 the *sorted* state, whose blocks are done in block order by prefix length (longest first).
 TCT and W* stay exact, but a schedule replayed through it as it is could never run two
 alike operations at once (both orders must be transitions) and would keep the chain as a
@@ -19,7 +19,7 @@ precedence. This module undoes the order for the CP-SAT schedule (:mod:`asp.base
   position's next operation in the chain follows the sorted state. In the graph at most
   one operation of a position's chain has a transition out of a state (the next one), so
   the replay looks up the transition of ``o`` by its *label*, the first operation of its
-  chain (:attr:`FixedOrder.label`, :class:`asp.together.LiveSteps`).
+  chain (:attr:`FixedOrder.label`, :class:`asp.graph.together.LiveSteps`).
 - **Precedences** (:meth:`FixedOrder.implied`): the chain is no precedence; ``a`` precedes
   ``b`` in the full graph iff it precedes the first operation of ``b``'s chain in the
   reduced one and is no alike operation, or the whole chain of ``a`` (its last operation)
@@ -29,7 +29,7 @@ precedence. This module undoes the order for the CP-SAT schedule (:mod:`asp.base
   (``start[a] <= start[b]``, not ``end[a] <= start[b]``).
 - **Short cuts** (:meth:`FixedOrder.canonical`, :meth:`FixedOrder.actual`): a cut is found
   on the sorted done set and the graph's states, then stated again with counts per
-  position: it holds for every state of an orbit (:class:`asp.cuts.PlacementCuts`).
+  position: it holds for every state of an orbit (:class:`asp.schedule.cuts.PlacementCuts`).
 """
 
 from __future__ import annotations
@@ -47,7 +47,7 @@ class FixedOrder:
     ----------
     n_ops : int
     classes : tuple of classes of blocks of operation indices
-        :attr:`asp.feasibility.OperationModel.fixed`.
+        :attr:`asp.graph.feasibility.OperationModel.fixed`.
     chains : tuple of tuple of int
         Per class and position, the chain of the blocks' operations there, in block order.
     label : (n_ops,) int64
@@ -114,7 +114,7 @@ class FixedOrder:
 
     def implied(self, reduced: list[int]) -> list[int]:
         """The full graph's implied predecessors (bitsets, per operation) from the reduced
-        graph's (:func:`asp.baseline.implied_predecessors`; module docstring)."""
+        graph's (:func:`asp.schedule.assembly.implied_predecessors`; module docstring)."""
         alike = 0
         for chain in self.chains:
             alike |= sum(1 << o for o in chain)

@@ -6,7 +6,7 @@ transition ``(state, op)`` becomes one edge per agent allowed to do ``op``, labe
 the operation id and the agent; its side is the agent's side (``robot``, ``human`` or ``any``)
 and its cost 1 (``steps``) or the agent's duration plus the change time of every tool the
 operation actually changes (``time``). The turn model (alternating, robot first, zero-cost
-passes) is the solver's business (:mod:`asp.solve`).
+passes) is the solver's business (:mod:`asp.game.solve`).
 """
 
 from __future__ import annotations
@@ -161,8 +161,8 @@ def _build_edges(
     and whether every edge goes to a higher node index.
 
     Without tool changes a move's cost is its (operation, agent) slot's: the costs are
-    :class:`asp.dag.CodedCosts`, a code per edge into the distinct durations. Else they are
-    float32 when every one is exactly a float32 (:func:`asp.dag.compact_costs`), else
+    :class:`asp.game.dag.CodedCosts`, a code per edge into the distinct durations. Else they are
+    float32 when every one is exactly a float32 (:func:`asp.game.dag.compact_costs`), else
     float64: built as float32 first, again as float64 when one is not exact.
     """
     counts = _edge_counts(graph.src, graph.dst, graph.op, keep, alive, new_id, per_op, n)

@@ -1,12 +1,12 @@
 """The assembly state graph and the assembly sequence table (AST).
 
 A state is the set of operations done plus the tool values, packed into a key of
-``W = ceil(bits / 64)`` uint64 words (:class:`asp.feasibility.OperationModel`; ``W == 1``, up to
-64 operations and tool bits, is the fast path). Starting from the empty assembly, the graph is
-built breadth-first, one layer (states with ``k`` operations done) at a time: every state of
-the layer x every operation is tested at once with bit operations, the successor keys are
-computed the same way, and sorting the keys (``np.unique`` on one word, ``np.lexsort`` on the
-words otherwise) merges states reached in different orders.
+``W = ceil(bits / 64)`` uint64 words (:class:`asp.graph.feasibility.OperationModel`;
+``W == 1``, up to 64 operations and tool bits, is the fast path). Starting from the empty
+assembly, the graph is built breadth-first, one layer (states with ``k`` operations done) at
+a time: every state of the layer x every operation is tested at once with bit operations,
+the successor keys are computed the same way, and sorting the keys (``np.unique`` on one
+word, ``np.lexsort`` on the words otherwise) merges states reached in different orders.
 
 States are numbered layer by layer (sorted by key, as an integer, within a layer), so every
 transition goes from a layer to the next, from a lower to a higher index. The number of
@@ -63,7 +63,7 @@ class StateGraph:
     model : OperationModel
         The compiled spec (key layout, enabled operations).
     keys : (N, W) uint64
-        State keys (``W`` words each, see :class:`asp.feasibility.OperationModel`), layer by
+        State keys (``W`` words each, see :class:`asp.graph.feasibility.OperationModel`), layer by
         layer; state 0 is the start.
     layer_ptr : (L + 2,) int64
         States of layer ``l`` (``l`` operations done) are ``layer_ptr[l]:layer_ptr[l + 1]``.
@@ -95,8 +95,8 @@ class StateGraph:
     @property
     def parts(self) -> np.ndarray:
         """(N, PW) uint64: assembled-part set of each state (``PW`` words, see
-        :class:`asp.feasibility.InsertionOracle`), computed from the keys on each call
-        (:meth:`asp.feasibility.OperationModel.parts_of`): not stored, a state's parts are
+        :class:`asp.graph.feasibility.InsertionOracle`), computed from the keys on each call
+        (:meth:`asp.graph.feasibility.OperationModel.parts_of`): not stored, a state's parts are
         those of its done operations."""
         return self.model.parts_of(self.keys)
 
@@ -235,7 +235,7 @@ def build_state_graph(
         sequence exists.
     drop_stuck : bool
         Leave out the states in which some part still to come is blocked along every
-        direction (:meth:`asp.feasibility.OperationModel.stuck`): dead ends, which the game
+        direction (:meth:`asp.graph.feasibility.OperationModel.stuck`): dead ends, which the game
         drops anyway (TCT and W* do not change), but not the states an infeasibility report
         or the automatic subassemblies look at.
     """
@@ -581,7 +581,7 @@ def _join(layers: list[np.ndarray], dtype) -> np.ndarray:
 def _unique_rows(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Distinct rows of the (m, W) keys in increasing integer order, and each row's index.
 
-    The rows are first made distinct by hashing (:func:`asp.enabled_kernel.first_rows`,
+    The rows are first made distinct by hashing (:func:`asp.graph.enabled_kernel.first_rows`,
     linear), then only the distinct ones are sorted (a layer has several times more
     transitions than states).
     """

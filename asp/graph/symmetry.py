@@ -3,7 +3,7 @@
 Inserting the part ``p`` of operation ``o`` into the assembled set ``S`` is feasible iff its
 predecessors are done, ``p`` touches ``S``, rests on ``S`` (unless held) and some direction
 ``d`` is free: ``B(p, d) & S`` is empty, with ``B(p, d)`` the parts blocking ``p`` along ``d``
-(:mod:`asp.feasibility`). Only the *family* of blocker sets matters, not which direction
+(:mod:`asp.graph.feasibility`). Only the *family* of blocker sets matters, not which direction
 carries which set, and much of it never decides anything:
 
 1. **Derived precedences** (:func:`reduced_model`): operation ``a`` must come before ``o`` in
@@ -787,9 +787,9 @@ def reduce_interchangeable(spec: AssemblySpec, relations) -> AssemblySpec:
 def _reduced(spec: AssemblySpec, relations, concurrent: bool):
     """:func:`reduce_interchangeable` and, with ``concurrent``, the chains of the classes
     of blocks kept in a loose order instead, with their slack (``(m, ids)`` for
-    :func:`asp.feasibility.operation_model`'s ``loose``), the classes of blocks ordered,
+    :func:`asp.graph.feasibility.operation_model`'s ``loose``), the classes of blocks ordered,
     and those put in a fixed order at every position (``fixed``, for
-    :attr:`asp.feasibility.OperationModel.fixed`).
+    :attr:`asp.graph.feasibility.OperationModel.fixed`).
 
     The slack of position ``p`` of a class's blocks is ``s(p) = s(p - 1) + m(p)``, ``m(p)``
     the :func:`class_slack` of the operations at ``p`` (``s(-1) = 0``): the block to move,
@@ -848,21 +848,21 @@ def symmetry_reduction(
     (:func:`reduced_state_graph` records them on the graph's model).
     Last, the classes of blocks in a fixed order (the ``i``-th operations of the blocks
     chained in block order at every position ``i``; ``operation_model(..., fixed=...)``):
-    the schedule stage undoes that order (:mod:`asp.fixed_order`).
+    the schedule stage undoes that order (:mod:`asp.graph.fixed_order`).
 
     Classes of blocks that are chains are put in a fixed order position by position
     (:func:`reduce_interchangeable`): the alternating game keeps its values. With
     ``concurrent`` (a graph for the concurrent game too) they keep a *loose* order
-    instead (``(m, ids)``, :meth:`asp.feasibility.OperationModel._loose_order`, the slack
+    instead (``(m, ids)``, :meth:`asp.graph.feasibility.OperationModel._loose_order`, the slack
     of :func:`_reduced`), so that two of them may still run at once: a fixed order would
     forbid it and change the concurrent game's W* (the CP-SAT schedule undoes a fixed
-    order instead, :mod:`asp.fixed_order`).
+    order instead, :mod:`asp.graph.fixed_order`).
     It holds more states (the 26-part shear mold stand-in: 459,182 instead of 15,019).
     A class whose blocks are not chains (a shaft with its two bearings and a collar,
     three times around a drive) cannot be put in a fixed order by precedences; its first
     operations are chained when a block has one operation every other of it needs, and the
     state graph moves only the first of equal blocks
-    (:meth:`asp.feasibility.OperationModel.enabled`, pass the classes as
+    (:meth:`asp.graph.feasibility.OperationModel.enabled`, pass the classes as
     ``operation_model(..., symmetric=...)``): the alternating game's values only.
     """
     model, why, _ = _derive(spec, relations)
@@ -887,7 +887,7 @@ def reduced_state_graph(spec: AssemblySpec, relations, *, concurrent: bool = Fal
     ``concurrent``, also its concurrent game's W*(k) and makespans), without the states
     that are stuck (dead ends, see ``build_state_graph(drop_stuck=...)``).
 
-    Keyword arguments go to :func:`asp.state_graph.build_state_graph`; returns None when
+    Keyword arguments go to :func:`asp.graph.state_graph.build_state_graph`; returns None when
     there is nothing to reduce (build the full graph). The graph's
     ``model.interchangeable`` holds the classes of interchangeable blocks used (the plan
     file's ``interchangeable``: a runtime maps an alike physical operation onto the

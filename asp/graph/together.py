@@ -6,14 +6,14 @@ graph) and neither changes a tool the other needs. For a set ``A`` running on to
 ``s``: every ``s + T`` (``T`` a subset of ``A``) is a co-reachable state from which every
 other operation of ``A`` is a transition into a co-reachable state, and no two operations of
 ``A`` conflict on a tool. :func:`together` is that rule; the concurrent game's Python
-builder (:meth:`asp.concurrent.ConcurrentModel.compatible`), its compiled builder
+builder (:meth:`asp.concurrent.model.ConcurrentModel.compatible`), its compiled builder
 (:mod:`asp.concurrent_kernel`) and the CP-SAT schedule replay
-(:func:`asp.baseline.schedule_violation`, and the list schedule built on it) all call it.
+(:func:`asp.schedule.replay.schedule_violation`, and the list schedule built on it) all call it.
 
 The transitions are :class:`LiveSteps`: the state graph's transitions between co-reachable
 states in CSR form (per state, its out-transitions in the state graph's order), with the
 tool-change time each adds. On a graph whose alike operations are in a fixed order, the
-schedule replay looks transitions up by *label* (:mod:`asp.fixed_order`: an alike operation
+schedule replay looks transitions up by *label* (:mod:`asp.graph.fixed_order`: an alike operation
 takes the transition of the next one of its chain).
 """
 
@@ -46,7 +46,7 @@ class LiveSteps:
         Tool-change time each transition adds (zeros unless given).
     label : (n_ops,) int64 or None
         With labels, ``op`` holds the label of each transition's operation and an operation
-        ``o`` is looked up as ``label[o]`` (:mod:`asp.fixed_order`).
+        ``o`` is looked up as ``label[o]`` (:mod:`asp.graph.fixed_order`).
     """
 
     def __init__(self, graph, change=None, label=None):

@@ -51,7 +51,7 @@ def assembly_schedule(spec, graph=None, *, fixed_order: bool = True) -> Assembly
     Geometric alternatives that are not plain precedences (``a`` or ``c`` before ``b``) are
     relaxed. Under the tool model the bit-change times are part of the changing operations.
 
-    A graph whose alike operations are in a fixed order (:mod:`asp.fixed_order`) gives the
+    A graph whose alike operations are in a fixed order (:mod:`asp.graph.fixed_order`) gives the
     full graph's precedences instead (the chains are none) and the order in which the
     blocks of a class start (``start_order``, symmetry breaking); ``fixed_order=False``
     keeps the chains as precedences (the conservative schedule, for comparison).

@@ -43,15 +43,16 @@ def assembly_makespan(
     """The minimum-makespan schedule of an assembly that respects the state graph.
 
     Exact by lazy cuts: CP-SAT solves the schedule with the precedences the state graph
-    implies (:func:`asp.baseline.assembly_schedule`); each schedule it finds is replayed
-    through the state graph (:func:`asp.baseline.schedule_violation`, the concurrent game's
-    rule); one that fails adds its cut and CP-SAT solves again (:func:`asp.baseline.min_makespan`).
+    implies (:func:`asp.schedule.assembly.assembly_schedule`); each schedule it finds is replayed
+    through the state graph (:func:`asp.schedule.replay.schedule_violation`, the concurrent game's
+    rule); one that fails adds its cut and CP-SAT solves again
+    (:func:`asp.schedule.makespan.min_makespan`).
     Cuts only remove infeasible schedules, so a solve that proves no shorter schedule with
     every cut makes the best passing one ``OPTIMAL``.
 
     It starts from a list schedule along a path of the state graph
-    (:func:`asp.baseline.list_schedule`, greedy, and along ``sequence`` too when given, e.g.
-    the robust plan's principal line; the shorter one): physically feasible by
+    (:func:`asp.schedule.list_schedule.list_schedule`, greedy, and along ``sequence`` too
+    when given, e.g. the robust plan's principal line; the shorter one): physically feasible by
     construction, it is CP-SAT's hint and the fallback. So on a large state graph, where
     CP-SAT cannot prove an optimum in ``time_limit``, the result is still a replayed
     schedule, with status ``FEASIBLE`` and the proven lower bound. ``detail`` holds
@@ -67,10 +68,10 @@ def assembly_makespan(
         :data:`AUTO_PATIENCE`.
     patience : float, optional
         Stop once neither a better schedule nor a new cut has come for this many seconds
-        (:func:`asp.baseline.min_makespan`).
+        (:func:`asp.schedule.makespan.min_makespan`).
     fixed_order : bool
         On a graph whose alike operations are in a fixed order (the alternating game's
-        reduction), undo it (:mod:`asp.fixed_order`): the schedules of the full graph, alike
+        reduction), undo it (:mod:`asp.graph.fixed_order`): the schedules of the full graph, alike
         operations at once and in any order. ``False``: the order kept (a conservative
         makespan; for comparison).
     """
@@ -108,7 +109,7 @@ def assembly_makespan(
         replay=replay,
         incumbent=incumbent,
         patience=patience,
-        more_cuts=more_cuts if model.cuts.combined else None,  # positive durations (asp.cuts)
+        more_cuts=more_cuts if model.cuts.combined else None,  # positive durations (cuts.py)
     )
     result.detail["stage_s"] = round(time.perf_counter() - t0, 3)
     return sched, result

@@ -74,7 +74,7 @@ def exact_scale(values, n_terms: int) -> tuple[int, bool]:
     """The power of ten making every value an integer, as CP-SAT needs, and whether it is exact.
 
     The smallest ``10**k`` that makes every value integral (to the relative cost tolerance,
-    :data:`asp.rules.COST_TOL`; a nonzero value never becomes 0) while
+    :data:`asp.game.rules.COST_TOL`; a nonzero value never becomes 0) while
     ``n_terms`` of the largest value, scaled, stay within :data:`EXACT_HEADROOM`; if none
     does, the largest such scale and ``False``: the values are then rounded to ``1 / scale``.
     """

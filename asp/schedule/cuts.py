@@ -1,7 +1,7 @@
 """Short cuts for the CP-SAT replay loop, read off the state graph.
 
 When a schedule places operation ``b`` right after the done set ``I`` and the state graph
-has no such step, the general cut of :func:`asp.baseline.schedule_violation` ("some
+has no such step, the general cut of :func:`asp.schedule.replay.schedule_violation` ("some
 operation outside ``I`` precedes one of ``I + {b}``") has about ``|I| x (n - |I|)``
 literals. :class:`PlacementCuts` finds a shorter one that holds for every feasible schedule,
 from ``B``, the done sets of the co-reachable states with a step ``b`` into a co-reachable
@@ -33,9 +33,9 @@ a part waits for or the parts that would block it.
 them and the result is checked against all; sets that break it join the sample and the
 shrinking starts again (a few rounds at most), so a cut costs a few passes over ``B``.
 
-On a graph whose alike operations are in a fixed order (:mod:`asp.fixed_order`), ``B``
+On a graph whose alike operations are in a fixed order (:mod:`asp.graph.fixed_order`), ``B``
 holds the sorted states only: the cut is found for the sorted done set and stated again
-with counts per position (:meth:`asp.fixed_order.FixedOrder.actual`), so that it holds for
+with counts per position (:meth:`asp.graph.fixed_order.FixedOrder.actual`), so that it holds for
 every state of an orbit.
 """
 
@@ -72,7 +72,7 @@ class PlacementCuts:
     combined : bool
         Whether cuts with both ``Y`` and ``X`` are allowed (their proof needs every
         operation to take time); else only ``X`` or ``Y`` empty.
-    fixed : asp.fixed_order.FixedOrder, optional
+    fixed : asp.graph.fixed_order.FixedOrder, optional
         The graph's fixed order of alike operations, undone (``steps`` then has its labels).
     """
 

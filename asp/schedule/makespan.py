@@ -47,7 +47,7 @@ class ScheduleProblem:
     """Tasks, precedences ``(before, after)`` (task indices), resources and tool states.
 
     ``start_order`` (task index pairs ``(a, b)``: ``start[a] <= start[b]``) breaks the
-    symmetry of interchangeable tasks (:meth:`asp.fixed_order.FixedOrder.start_order`).
+    symmetry of interchangeable tasks (:meth:`asp.graph.fixed_order.FixedOrder.start_order`).
     """
 
     name: str

@@ -86,7 +86,7 @@ def min_cost_path(
 ) -> BaselineResult:
     """Minimum-cost path from start to end of a game DAG with CP-SAT.
 
-    Equals ``asp.solve.solve(dag).tct`` (the cooperative value under the turn model).
+    Equals ``asp.game.solve.solve(dag).tct`` (the cooperative value under the turn model).
     """
     from ortools.sat.python import cp_model
 

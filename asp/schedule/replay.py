@@ -62,7 +62,7 @@ def tool_conflicts(spec: AssemblySpec) -> np.ndarray:
 class ReplayModel:
     """What a schedule replay needs of the concurrent rules: the spec, the workers, the
     state graph's transitions, the tool conflicts, (optionally) the short cuts and the
-    graph's fixed order of alike operations, undone (:mod:`asp.fixed_order`)."""
+    graph's fixed order of alike operations, undone (:mod:`asp.graph.fixed_order`)."""
 
     spec: AssemblySpec
     workers: tuple[Worker, ...]
@@ -78,7 +78,7 @@ def replay_model(
     """The :class:`ReplayModel` of a spec and its state graph (with the short cuts).
 
     On a graph whose alike operations are in a fixed order, the replay undoes it
-    (:mod:`asp.fixed_order`): an alike operation takes the transition of the next one of
+    (:mod:`asp.graph.fixed_order`): an alike operation takes the transition of the next one of
     its chain, so alike operations may run at once and in any order (``fixed_order=False``:
     the graph's transitions as they are).
     """
@@ -94,7 +94,7 @@ def schedule_violation(
 ) -> tuple[str, list[tuple[int, int]]] | None:
     """Replay a schedule through the state graph; ``None`` if it is physically feasible.
 
-    The rule is the concurrent game's (:func:`asp.together.together`):
+    The rule is the concurrent game's (:func:`asp.graph.together.together`):
     at every start time ``t``, with ``D`` the operations ended by ``t`` and ``A`` those
     running, every ``D + T`` (``T`` a subset of ``A``) is a state of the state graph from
     which every other operation of ``A`` is a transition, and no two running operations
@@ -103,7 +103,7 @@ def schedule_violation(
     graph, whichever of two overlapping operations finishes first.
 
     On a graph whose alike operations are in a fixed order (``model.fixed``), the order is
-    undone (:mod:`asp.fixed_order`): each block of alike operations must be done in its
+    undone (:mod:`asp.graph.fixed_order`): each block of alike operations must be done in its
     order (a derived precedence, its own cut), then the transitions are looked up by label.
 
     Returns
@@ -157,7 +157,8 @@ def schedule_violation(
 def _cannot_follow(model: ReplayModel, done: set[int], b: int) -> tuple[str, list[tuple[int, int]]]:
     """The violation "``b`` cannot follow the done set" and its cut (see
     :func:`schedule_violation`): some operation outside ``done`` precedes one of
-    ``done + {b}``, or a shorter cut from ``model.cuts`` (:class:`asp.cuts.PlacementCuts`)."""
+    ``done + {b}``, or a shorter cut from ``model.cuts``
+    (:class:`asp.schedule.cuts.PlacementCuts`)."""
     ids = model.spec.op_ids
     where = "{" + " ".join(ids[i] for i in sorted(done)) + "}" if done else "the start"
     cut = model.cuts.cut(done, b) if model.cuts is not None else None
@@ -169,7 +170,7 @@ def _cannot_follow(model: ReplayModel, done: set[int], b: int) -> tuple[str, lis
 
 def together_violation(model: ReplayModel, state: int, done: set[int], running: list[int]):
     """Whether the operations ``running`` may run together from ``state`` (``done`` done):
-    :func:`asp.together.together`.
+    :func:`asp.graph.together.together`.
 
     Returns
     -------
