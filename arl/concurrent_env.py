@@ -59,7 +59,7 @@ MAX_RESTARTS = 100
 
 Opponent = Callable[[np.ndarray, np.ndarray], int] | Any | None
 """A frozen opponent: ``None`` (uniformly random among the allowed actions), a callable
-``(observation, mask) -> action``, or an SB3 model (``predict`` with ``action_masks``)."""
+``(observation, mask) -> action``, or an SB3 actor-critic model (``MaskablePPO``)."""
 
 
 class Turn:
@@ -77,6 +77,7 @@ class Turn:
         self.deciders = [w for w in range(codes.shape[1]) if codes.shape[0] and codes[0, w] != NONE]
         self.j = 0
         self.chosen: list[int] = []
+        self._allowed: np.ndarray | None = None  # of decider j
         self._skip_forced()
 
     @property
@@ -94,7 +95,9 @@ class Turn:
 
     def allowed(self) -> np.ndarray:
         """The action codes open to the deciding worker, sorted."""
-        return np.unique(self.codes[self.alive, self.worker])
+        if self._allowed is None:
+            self._allowed = np.unique(self.codes[self.alive, self.worker])
+        return self._allowed
 
     def choose(self, action: int) -> None:
         """Take ``action`` for the deciding worker (mapped into the allowed ones)."""
@@ -105,13 +108,14 @@ class Turn:
         self.alive &= self.codes[:, self.worker] == a
         self.chosen.append(a)
         self.j += 1
+        self._allowed = None
         self._skip_forced()
 
     def _skip_forced(self) -> None:
         while not self.done and len(self.allowed()) == 1:
-            a = int(self.allowed()[0])
-            self.chosen.append(a)
+            self.chosen.append(int(self.allowed()[0]))
             self.j += 1
+            self._allowed = None
 
 
 class Encoder:
@@ -186,13 +190,33 @@ class Encoder:
 
 
 def act(opponent: Opponent, obs: np.ndarray, mask: np.ndarray, rng, deterministic: bool) -> int:
-    """The frozen opponent's action (see :data:`Opponent`)."""
+    """The frozen opponent's action (see :data:`Opponent`). An SB3 model's policy network is
+    called directly (:func:`policy_logits`): its greedy action is ``predict``'s, and a
+    sampled one is drawn from the masked softmax with ``rng`` (no torch distribution made
+    per move, most of the time of a game otherwise)."""
     if opponent is None:
         return int(rng.choice(np.flatnonzero(mask)))
-    if hasattr(opponent, "predict"):
-        action, _ = opponent.predict(obs, action_masks=mask, deterministic=deterministic)
-        return int(action)
+    if hasattr(opponent, "policy"):
+        logits = np.where(mask, policy_logits(opponent, obs), -np.inf)
+        if deterministic:
+            return int(np.argmax(logits))
+        p = np.exp(logits - logits.max())
+        return int(rng.choice(len(p), p=p / p.sum()))
     return int(opponent(obs, mask))
+
+
+def policy_logits(model, obs: np.ndarray) -> np.ndarray:
+    """The action logits of an SB3 actor-critic model (``MaskablePPO``) at ``obs``, unmasked:
+    the path of its ``predict`` (features, actor latent, action net)."""
+    import torch
+    from stable_baselines3.common.policies import BaseModel
+
+    policy = model.policy
+    with torch.no_grad():
+        t = torch.as_tensor(obs, dtype=torch.float32)[None]
+        features = BaseModel.extract_features(policy, t, policy.pi_features_extractor)
+        latent = policy.mlp_extractor.forward_actor(features)
+        return policy.action_net(latent)[0].numpy().astype(np.float64)
 
 
 def mask_of(turn: Turn, n_actions: int) -> np.ndarray:

@@ -137,3 +137,25 @@ def test_bad_side_is_an_error():
         from arl.concurrent_env import ConcurrentEnv
 
         ConcurrentEnv(small_rules(), "cat")
+
+
+def test_a_models_greedy_action_is_its_predict():
+    from sb3_contrib import MaskablePPO
+
+    from arl.concurrent_env import act
+
+    rules = small_rules()
+    env = ConcurrentHumanEnv(rules, budgets=[0, 1, None])
+    model = MaskablePPO("MlpPolicy", env, seed=0, device="cpu", n_steps=32, batch_size=32)
+    model.learn(32)  # a network that is not at its initial weights
+    rng = np.random.default_rng(0)
+    for seed in range(5):
+        obs, _ = env.reset(seed=seed)
+        done = False
+        while not done:
+            mask = env.action_masks()
+            want, _ = model.predict(obs, action_masks=mask, deterministic=True)
+            assert act(model, obs, mask, rng, True) == int(want)
+            sampled = act(model, obs, mask, rng, False)
+            assert mask[sampled]
+            obs, _, done, _, _ = env.step(sampled)
