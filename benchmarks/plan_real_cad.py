@@ -4,8 +4,9 @@ For each assembly (a CAD file, a folder of part meshes or an ``assembly.yaml``),
 process of its own: ``asmplan plan PATH -o OUT`` with default settings (the command line, a
 time limit per assembly), then :func:`asp.checker.check_line` on the plan's principal line
 against relations loaded afresh from the same file. Prints one row per assembly: parts, parts
-``held``, subassemblies, length unit, states, seconds, peak memory of the plan command, TCT,
-W*, the CP-SAT status and the checker's verdict, or the error (the command's last stderr line).
+``held``, subassemblies, length unit, the generated spec's gravity, states, seconds, peak
+memory of the plan command, TCT, W*, the CP-SAT status and the checker's verdict, or the
+error (the command's last stderr line).
 
 Assemblies, by default: the Fabrica assemblies in ``../shared/data/cad/fabrica/``, the built
 rod tower, bolted bracket, finger box, gear pair and bearing stack (tests/cad), and every
@@ -43,6 +44,7 @@ COLUMNS = (
     "held",
     "units",
     "unit",
+    "gravity",
     "states",
     "total_s",
     "peak_mb",
@@ -140,6 +142,8 @@ def plan_one(path: str, out: str, timeout: float) -> dict:
     text = run.stdout + run.stderr
     held = re.search(r"held: true for ([^(]*)\(", text)
     row["held"] = len(held.group(1).split(",")) if held else 0
+    gravity = re.search(r"generated spec: gravity (\S+):", text)
+    row["gravity"] = gravity.group(1) if gravity else ""
     row["unit"] = source_unit(path)
     if run.returncode != 0:
         lines = [s for s in run.stderr.splitlines() if s.strip()]
@@ -164,7 +168,7 @@ def plan_one(path: str, out: str, timeout: float) -> dict:
 
 def print_row(row: dict) -> None:
     if "error" in row:
-        cells = [str(row.get(c, "")) for c in ("parts", "held", "units", "unit")]
+        cells = [str(row.get(c, "")) for c in ("parts", "held", "units", "unit", "gravity")]
         cells += ["", str(row.get("total_s", "")), str(row.get("peak_mb", ""))]
         print(f"| {row['assembly']} | " + " | ".join(cells) + f" | error: {row['error']} |")
     else:

@@ -26,6 +26,16 @@ the gap is within the tolerance). Two parts whose closest surfaces face each oth
 (edge against edge, both normals further than 75.5 degrees from every axis) get no
 direction. Touching along only a line or a point counts (e.g. two boxes that share an
 edge are in contact along both faces' axes).
+
+Open meshes (:func:`distance_contacts`)
+---------------------------------------
+Parts cut from one visual mesh lack the faces where they meet: no face of one opposes a
+face of the other, though their surfaces touch. For a pair with an open part (a mesh that
+is not watertight) and no contact by faces, contact is decided by distance: the two
+surfaces come within the pair's contact tolerance (FCL's distance of the meshes). The
+direction is the axis along which the parts' surface centroids lie farthest apart (j on
+that side of i); :func:`cad.relations.compute_relations` takes it as contact and, the
+open part having no face to rest on, as support along it.
 """
 
 from __future__ import annotations
@@ -156,3 +166,51 @@ def _shrink(uv: np.ndarray) -> np.ndarray:
     """Triangles ``(N, 3, 2)`` scaled slightly about their centroids."""
     centre = uv.mean(axis=1, keepdims=True)
     return centre + (uv - centre) * (1.0 - _AREA_SHRINK)
+
+
+def distance_contacts(assembly: Assembly, tols, tc: np.ndarray) -> list[tuple[int, int, int]]:
+    """``(a, b, d)``: parts ``a < b``, one of them open, with no contact by faces (``tc``)
+    whose surfaces lie within the pair's contact tolerance; ``b`` on the ``d`` side of ``a``
+    (module docstring, "Open meshes")."""
+    import fcl
+
+    parts = assembly.parts
+    is_open = [not p.mesh.is_watertight for p in parts]
+    if not any(is_open):
+        return []
+    objects: dict[int, object] = {}
+
+    def obj(k: int):
+        if k not in objects:
+            model = fcl.BVHModel()
+            mesh = parts[k].mesh
+            model.beginModel(len(mesh.vertices), len(mesh.faces))
+            model.addSubModel(
+                np.asarray(mesh.vertices, float), np.asarray(mesh.faces, dtype=np.int32)
+            )
+            model.endModel()
+            objects[k] = fcl.CollisionObject(model, fcl.Transform())
+        return objects[k]
+
+    found = []
+    for a in range(len(parts)):
+        for b in range(a + 1, len(parts)):
+            if not (is_open[a] or is_open[b]) or tc[a, b].any():
+                continue
+            ctol = tols.contact_pair(a, b)
+            if not bounds_overlap(parts[a].bounds, parts[b].bounds, pad=ctol):
+                continue
+            gap = fcl.distance(obj(a), obj(b), fcl.DistanceRequest(), fcl.DistanceResult())
+            if gap <= ctol:
+                delta = _surface_centroid(parts[b].mesh) - _surface_centroid(parts[a].mesh)
+                axis = int(np.argmax(np.abs(delta)))
+                found.append((a, b, 2 * axis + (0 if delta[axis] >= 0 else 1)))
+    return found
+
+
+def _surface_centroid(mesh) -> np.ndarray:
+    """The area-weighted centre of a mesh's faces (open or closed)."""
+    areas = np.asarray(mesh.area_faces)
+    return (np.asarray(mesh.triangles_center) * areas[:, None]).sum(axis=0) / max(
+        areas.sum(), 1e-300
+    )

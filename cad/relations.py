@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from cad.assembly import Assembly
-from cad.contact import contact_relation
+from cad.contact import contact_relation, distance_contacts
 from cad.directions import DIRECTIONS
 from cad.errors import GeometryError
 from cad.fits import find_fits
@@ -152,6 +152,9 @@ def compute_relations(
     sp = support_relation(assembly, tols, eroded, tc, tt, progress=progress)
     for fit in fits:
         fit.write_into(tc, tt, sp)
+    for a, b, d in distance_contacts(assembly, tols, tc):  # open meshes: by distance
+        tc[a, b, d] = tc[b, a, d ^ 1] = True
+        sp[a, b, d] = sp[b, a, d ^ 1] = True
     ids = assembly.ids
     return Relations(
         parts=assembly.ids,

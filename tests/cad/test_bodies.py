@@ -154,3 +154,32 @@ def test_overlapping_parts_of_no_common_group_stay_apart(tmp_path):
         "plan them as one rigid part: in the spec's parts, `- {id: block, file: "
         "'engine.glb#block+link_1'}` in place of both, and no operation placing link_1"
     ) in str(info.value)
+
+
+def open_halves():
+    """A 10 mm cube cut at z = 5 into two open halves, neither with the cut face (parts cut
+    from one visual mesh)."""
+    cube = trimesh.creation.box(extents=[10, 10, 10]).subdivide()
+    centres = cube.triangles_center
+    lower = cube.submesh([np.flatnonzero(centres[:, 2] < 0)], append=True)
+    upper = cube.submesh([np.flatnonzero(centres[:, 2] > 0)], append=True)
+    return lower, upper
+
+
+def test_open_parts_touching_without_opposing_faces_are_in_contact():
+    from cad.assembly import Assembly
+
+    lower, upper = open_halves()
+    assert not lower.is_watertight and lower.bounds[1][2] == 0.0 == upper.bounds[0][2]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rel = compute_relations(Assembly.from_meshes({"lower": lower, "upper": upper}))
+    up, down = 4, 5  # +z, -z
+    assert rel.tc[0, 1].tolist() == [k == up for k in range(6)]
+    assert rel.tc[1, 0].tolist() == [k == down for k in range(6)]
+    assert rel.sp[1, 0, down] and rel.sp[0, 1, up]
+    far = upper.copy().apply_translation([0, 0, 1.0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        apart = compute_relations(Assembly.from_meshes({"lower": lower, "upper": far}))
+    assert not apart.tc.any()
