@@ -1,6 +1,9 @@
-"""``asmplan report PLAN_DIR``: report.html redrawn from plan.json alone (issue 22 B3)."""
+"""``asmplan report PLAN_DIR``: report.html redrawn from plan.json alone (issue 22 B3); two
+runs of ``asmplan plan`` write the same plan.json (issue 26 item 7)."""
 
 from __future__ import annotations
+
+import json
 
 import pytest
 from typer.testing import CliRunner
@@ -26,13 +29,16 @@ SOLVERS = (
 """Every entry that plans or solves: ``asmplan report`` calls none of them."""
 
 
-@pytest.fixture(scope="module", params=["alternate", "concurrent"])
-def plan_dir(request, tmp_path_factory):
-    out = tmp_path_factory.mktemp(request.param) / "plan"
-    args = ["plan", str(PUMP), "-o", str(out), "--time-limit", "20"]
-    result = CliRunner().invoke(app, [*args, "--turn-model", request.param])
+def plan_into(out, turn_model: str):
+    args = ["plan", str(PUMP), "-o", str(out), "--time-limit", "20", "--turn-model", turn_model]
+    result = CliRunner().invoke(app, args)
     assert result.exit_code == 0, result.output
     return out
+
+
+@pytest.fixture(scope="module", params=["alternate", "concurrent"])
+def plan_dir(request, tmp_path_factory):
+    return plan_into(tmp_path_factory.mktemp(request.param) / "plan", request.param)
 
 
 def refuse_to_solve(monkeypatch):
@@ -46,20 +52,37 @@ def refuse_to_solve(monkeypatch):
 
 
 def test_the_redrawn_report_is_byte_identical(plan_dir, tmp_path, monkeypatch):
+    """The alternate plan's report is drawn to ``-o``, the concurrent one's in place."""
     written = (plan_dir / "report.html").read_bytes()
     refuse_to_solve(monkeypatch)
-    again = tmp_path / "again.html"
-    result = CliRunner().invoke(app, ["report", str(plan_dir), "-o", str(again)])
+    alternate = json.loads((plan_dir / "plan.json").read_text())["turn_model"] == "alternate"
+    again = tmp_path / "again.html" if alternate else plan_dir / "report.html"
+    output = ["-o", str(again)] if alternate else []
+    result = CliRunner().invoke(app, ["report", str(plan_dir), *output])
     assert result.exit_code == 0, result.output
+    assert result.output.strip().splitlines()[-1] == f"wrote {again}"
     assert again.read_bytes() == written
-    in_place = CliRunner().invoke(app, ["report", str(plan_dir)])
-    assert in_place.exit_code == 0, in_place.output
-    assert (plan_dir / "report.html").read_bytes() == written
+
+
+def test_a_second_run_writes_the_same_plan_json(plan_dir, tmp_path):
+    """Issue 26 item 7: the times measured while planning go to ``timings.json`` (named
+    by the manifest), so ``plan.json`` is a function of its inputs: byte-identical."""
+    from asmplan.planfile import TIMING_KEYS
+    from asp.atomic import MANIFEST
+
+    doc = json.loads((plan_dir / "plan.json").read_text())
+    second = plan_into(tmp_path / "second", doc["turn_model"])
+    assert (second / "plan.json").read_bytes() == (plan_dir / "plan.json").read_bytes()
+    timings = json.loads((plan_dir / "timings.json").read_text())
+    assert timings["format"] == "asmplan-timings/1"
+    assert {"wall_s", "stage_s", "improvements"} <= set(timings["schedule"])
+    assert ("seconds" in timings.get("concurrent", {})) == (doc["turn_model"] == "concurrent")
+    for part, keys in TIMING_KEYS.items():
+        assert not set(keys) & set(doc.get(part, {})), part
+    assert "timings.json" in json.loads((plan_dir / MANIFEST).read_text())["files"]
 
 
 def test_the_alternate_plan_keeps_its_concurrent_preview(plan_dir):
-    import json
-
     doc = json.loads((plan_dir / "plan.json").read_text())
     page = (plan_dir / "report.html").read_text()
     if doc["turn_model"] == "alternate":

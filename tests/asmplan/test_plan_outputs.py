@@ -45,29 +45,6 @@ def test_a_complete_run_names_its_files_last(pump_plan, tmp_path):
     )
 
 
-@pytest.mark.parametrize("turn_model", ["alternate", "concurrent"])
-def test_two_runs_write_the_same_plan_json(tmp_path, turn_model):
-    """Issue 26 item 7: the times measured while planning go to ``timings.json`` (named
-    by the manifest), so ``plan.json`` is a function of its inputs: byte-identical."""
-    from asmplan.planfile import TIMING_KEYS
-
-    runs = []
-    for name in ("first", "second"):
-        args = ["plan", str(PUMP), "-o", str(tmp_path / name), "--time-limit", "20"]
-        result = CliRunner().invoke(app, [*args, "--turn-model", turn_model])
-        assert result.exit_code == 0, result.output
-        runs.append((tmp_path / name / "plan.json").read_bytes())
-    assert runs[0] == runs[1]
-    doc = json.loads(runs[0])
-    timings = json.loads((tmp_path / "first" / "timings.json").read_text())
-    assert timings["format"] == "asmplan-timings/1"
-    assert {"wall_s", "stage_s", "improvements"} <= set(timings["schedule"])
-    assert ("seconds" in timings.get("concurrent", {})) == (turn_model == "concurrent")
-    for part, keys in TIMING_KEYS.items():
-        assert not set(keys) & set(doc.get(part, {})), part
-    assert "timings.json" in json.loads((tmp_path / "first" / MANIFEST).read_text())["files"]
-
-
 def test_a_failure_mid_write_leaves_no_mixed_folder(pump_plan, tmp_path, monkeypatch):
     """A new plan.json never sits beside an old dag.png: the write fails after plan.json."""
     pipeline.write_plan(pump_plan, tmp_path)
