@@ -607,6 +607,7 @@ def spec_text(
         lines.append(
             "# identical parts: " + ", ".join(f"{n} x {s}" for s, n in sorted(counts.items()))
         )
+    lines += _alike_lines(assembly)
     folder = spec_folder or (path if path.is_dir() else path.parent)
     lines += _hierarchy_lines(data, assembly, relations, folder, decide_units)
     lines += [
@@ -643,6 +644,24 @@ def spec_text(
             + (", held: true}" if op.held else "}")
         )
     return "\n".join(lines) + "\n"
+
+
+def _alike_lines(assembly) -> list[str]:
+    """One comment per class of parts the file names generically (``alike_a_1``, ...:
+    :mod:`cad.scene`): how many, their bounding box and the file's names."""
+    import re
+
+    classes: dict[str, list] = {}
+    for part in assembly.parts:
+        found = re.fullmatch(r"(alike_[a-z]+)(_\d+)?", part.id)
+        if found:
+            classes.setdefault(found.group(1), []).append(part)
+    lines = []
+    for cls, members in classes.items():
+        box = " x ".join(f"{x:.3g}" for x in members[0].mesh.extents)
+        names = ", ".join(dict.fromkeys(p.name for p in members))
+        lines.append(f"# {cls}: {len(members)} part(s), each {box} mm (the file names {names})")
+    return lines
 
 
 def _hierarchy_lines(data: dict, assembly, relations, spec_folder, decide) -> list[str]:

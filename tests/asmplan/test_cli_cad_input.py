@@ -202,3 +202,19 @@ def test_a_one_part_file_says_so_and_a_fused_one_is_split(tmp_path):
 def write_named_glb_of(scene: trimesh.Scene, path: Path) -> Path:
     scene.export(path)
     return path
+
+
+def test_init_comments_each_class_of_generically_named_parts(tmp_path):
+    scene = trimesh.Scene()
+    b = shapes.box_between
+    meshes = [b((0, 0, 0), (40, 40, 5)), b((0, 0, 5), (40, 40, 10)), b((5, 5, 10), (8, 8, 20))]
+    for k, mesh in enumerate(meshes):
+        node = "Body" if k == 0 else f"Body{k:03d}"
+        scene.add_geometry(mesh.apply_scale(0.001), node_name=node, geom_name=node)
+    scene.export(tmp_path / "coupling.glb")
+    out = tmp_path / "assembly.yaml"
+    result = CliRunner().invoke(app, ["init", str(tmp_path / "coupling.glb"), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    text = out.read_text()
+    assert "# alike_a: 2 part(s), each 40 x 40 x 5 mm (the file names Body, Body001)" in text
+    assert "# alike_b: 1 part(s), each 3 x 3 x 10 mm (the file names Body002)" in text
