@@ -911,7 +911,7 @@ def write_plan(
         if result.concurrent is not None:
             from asmplan.report.gantt import write_figures
 
-            write_figures(result.concurrent, out.path)
+            write_figures(doc, out.path)
         if on_step is not None:
             on_step("  writing report.html ...")
         out.write_text("report.html", plan_report(doc, out.path("dag.png").read_bytes()))

@@ -12,7 +12,6 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 
 from asp.atomic import write_bytes
-from asp.concurrent.plan import ConcurrentPlan
 
 AGENT_COLOURS = {"H": "#9e9e9e", "R1": "#2e9d4a", "R2": "#f28c28"}
 """The paper's Figure 9 colours: operator grey, R1 green, R2 orange."""
@@ -188,29 +187,51 @@ def draw_gantt(ax, bars: Sequence, *, makespan: float | None = None, unit: str =
     return {"labels": written, "legend": [h.get_label() for h in handles]}
 
 
-def write_figures(plan: ConcurrentPlan, folder: str | os.PathLike[str] | Callable) -> list[Path]:
-    """Write ``robustness.png``, ``gantt_cooperative.png`` and ``gantt_worst.png``.
+def write_figures(doc: dict, folder: str | os.PathLike[str] | Callable) -> list[Path]:
+    """Write ``robustness.png``, ``gantt_cooperative.png`` and ``gantt_worst.png`` of a
+    concurrent plan document (its ``robustness``, ``concurrent`` and ``schedule``), so they
+    are a function of ``plan.json`` like ``report.html``.
 
     ``folder`` is a folder, or a function from a file name to its path (an
     :class:`asp.atomic.OutputSet`'s ``path``).
     """
     path_of = folder if callable(folder) else Path(folder).joinpath
-    name = plan.spec.name
-    k = plan.curve.k
+    name = doc.get("assembly", "plan")
+    game = doc["concurrent"]
+    k = game["plan_budget"]
     written = [
         plot_robustness(
-            plan.curve.to_list(),
+            doc["robustness"],
             path_of("robustness.png"),
-            schedule=plan.schedule.objective,
-            schedule_rows=plan.schedule_worst,
+            schedule=(doc.get("schedule") or {}).get("objective"),
+            schedule_rows=game["schedule_worst_case"],
             title=f"{name}\nguaranteed makespan against a person who may deviate k times",
         )
     ]
     lines = (
-        ("gantt_cooperative.png", plan.cooperative, "the person follows it"),
-        ("gantt_worst.png", plan.worst, "against the worst person"),
+        ("gantt_cooperative.png", game["cooperative"], "the person follows it"),
+        ("gantt_worst.png", game["worst"], "against the worst person"),
     )
-    for file, (bars, makespan), who in lines:
+    for file, line, who in lines:
+        makespan = line["makespan"]
         title = f"{name}: robust plan (k = {k}), {who}: makespan {makespan:g} s"
+        bars = document_bars(line["bars"])
         written.append(plot_gantt(bars, path_of(file), makespan=makespan, title=title))
     return written
+
+
+def document_bars(rows: list[dict], operation: str = "operation") -> list:
+    """Timeline bars (:class:`asp.concurrent.describe.Bar`) of a plan document's rows
+    (``operation``: the key naming the task)."""
+    from asp.concurrent.describe import Bar
+
+    return [
+        Bar(
+            str(r["agent"]),
+            str(r[operation]),
+            float(r["start"]),
+            float(r["end"]),
+            bool(r.get("deviation", False)),
+        )
+        for r in rows
+    ]

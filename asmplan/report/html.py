@@ -47,7 +47,7 @@ def report_figures(doc: dict) -> dict[str, bytes]:
     """
     import tempfile
 
-    from asmplan.report.gantt import plot_gantt, plot_robustness
+    from asmplan.report.gantt import document_bars, plot_gantt, plot_robustness
 
     out: dict[str, bytes] = {}
     part = concurrent_part(doc)
@@ -65,7 +65,7 @@ def report_figures(doc: dict) -> dict[str, bytes]:
                 who = "follows the plan" if name == "cooperative" else "is the worst"
                 makespan = game[name]["makespan"]
                 out[f"gantt_{name}"] = plot_gantt(
-                    _bars(game[name]["bars"]),
+                    document_bars(game[name]["bars"]),
                     folder / f"{name}.png",
                     makespan=makespan,
                     title=f"concurrent: the person {who}, makespan {makespan:g} s",
@@ -76,28 +76,12 @@ def report_figures(doc: dict) -> dict[str, bytes]:
         if rows:
             sched = doc["schedule"]
             out["gantt_schedule"] = plot_gantt(
-                _bars(rows, operation="task"),
+                document_bars(rows, operation="task"),
                 folder / "s.png",
                 title=f"CP-SAT schedule: makespan {sched.get('objective')} s "
                 f"({sched.get('status')})",
             ).read_bytes()
     return out
-
-
-def _bars(rows: list[dict], operation: str = "operation") -> list:
-    """Timeline bars of a plan document's rows (``operation``: the key naming the task)."""
-    from asp.concurrent.describe import Bar
-
-    return [
-        Bar(
-            str(r["agent"]),
-            str(r[operation]),
-            float(r["start"]),
-            float(r["end"]),
-            bool(r.get("deviation", False)),
-        )
-        for r in rows
-    ]
 
 
 def plan_report(doc: dict, dag_png: bytes | None = None) -> str:

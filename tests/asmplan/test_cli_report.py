@@ -105,3 +105,22 @@ def test_a_bad_plan_folder_is_one_line_and_exit_2(tmp_path, make, message):
     result = CliRunner().invoke(app, ["report", str(make(tmp_path))])
     assert result.exit_code == 2
     assert message in result.output and len(result.output.strip().splitlines()) == 1
+
+
+def test_the_concurrent_figures_are_drawn_from_plan_json(plan_dir, tmp_path, monkeypatch):
+    """robustness.png and the Gantt PNGs of a concurrent plan are a function of plan.json."""
+    from asmplan.planfile import read_plan
+    from asmplan.report.gantt import write_figures
+
+    doc = read_plan(plan_dir)
+    if doc["turn_model"] != "concurrent":
+        pytest.skip("an alternate plan writes no concurrent figures")
+    refuse_to_solve(monkeypatch)
+    written = write_figures(doc, tmp_path)
+    assert [p.name for p in written] == [
+        "robustness.png",
+        "gantt_cooperative.png",
+        "gantt_worst.png",
+    ]
+    for path in written:
+        assert path.read_bytes() == (plan_dir / path.name).read_bytes(), path.name
