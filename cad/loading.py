@@ -36,7 +36,7 @@ from cad.errors import GeometryError
 from cad.frame import Rotation, rotated
 from cad.merging import merge_overlapping
 from cad.readers import MESH_SUFFIXES
-from cad.scene import empty_scene_error, read_scene
+from cad.scene import empty_scene_error, read_scene, warn_split
 from cad.unit_hints import part_scale_hint
 from cad.units import unit_scale
 
@@ -202,6 +202,7 @@ def _scene_assembly(path: Path, units: str | None) -> Assembly:
     scene = read_scene(path)
     if not scene.meshes:
         raise empty_scene_error(path)
+    warn_split(path, scene)
     unit = scene.units or units or "mm"
     scale = unit_scale(unit)
     parts = tuple(

@@ -350,7 +350,6 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
     split = ()
     if len(meshes) == 1 and (bodies := closed_bodies(meshes[0])) is not None:
         split = ((ids[0], tuple(f"{ids[0]}_body_{n}" for n in range(1, len(bodies) + 1))),)
-        _warn_split(file, ids[0], len(bodies))
         meshes, names = list(bodies), [f"{names[0]} body {n}" for n in range(1, len(bodies) + 1)]
         part_nodes, ids = part_nodes * len(bodies), list(split[0][1])
     id_of = {node: pid for (node, _), pid in zip(part_nodes, ids, strict=True)}
@@ -373,10 +372,16 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
     )
 
 
-def _warn_split(file: Path, part: str, count: int) -> None:
-    """Say that the one part of ``file`` is planned as its ``count`` closed bodies."""
+def warn_split(file: Path, scene: SceneParts) -> None:
+    """Say that the one part of ``file`` is planned as its closed bodies (when it is):
+    called where the bodies become parts (a bare scene file), never where a spec names
+    the file's part (then it is one rigid part and nothing is split)."""
     import warnings
 
+    if not scene.split:
+        return
+    part, bodies = scene.split[0]
+    count = len(bodies)
     warnings.warn(
         f"{file.name}: its one part {part} is {count} separate closed bodies: planned as "
         f"{count} parts {part}_body_1..{count} (cad/bodies.py); a spec part with "

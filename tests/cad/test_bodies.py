@@ -95,12 +95,14 @@ def test_a_one_part_file_of_several_bodies_plans_one_part_per_body(tmp_path):
 def test_a_spec_part_naming_the_whole_part_keeps_it_one_rigid_part(tmp_path):
     mesh = fused(box([0.01, 0.01, 0.01], [0, 0, 0]), box([0.01, 0.01, 0.02], [0.05, 0, 0]))
     write_one_node_glb(tmp_path / "truck.glb", mesh)
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        records = [PartRecord(id="truck", name="truck", file="truck.glb#truck")]
-        assembly = load_parts(records, tmp_path)
-    assert [p.id for p in assembly.parts] == ["truck"]
-    assert round(float(assembly.parts[0].mesh.volume)) == 3000
+    for file in ("truck.glb#truck", "truck.glb"):  # the part, or the whole file
+        with warnings.catch_warnings(record=True) as said:
+            warnings.simplefilter("always")
+            records = [PartRecord(id="truck", name="truck", file=file)]
+            assembly = load_parts(records, tmp_path)
+        assert not [w for w in said if "closed bodies" in str(w.message)], file
+        assert [p.id for p in assembly.parts] == ["truck"]
+        assert round(float(assembly.parts[0].mesh.volume)) == 3000
 
 
 def write_grouped_glb(path, pieces, loose):
