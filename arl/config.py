@@ -72,7 +72,7 @@ class TrainConfig:
     opponent_epsilon : float
         Share of uniformly random opponent moves (vectorised envs only).
     reward : "paper" or "zero_sum"
-        See :mod:`arl.game`.
+        See :mod:`arl.moves`.
     reward_scale : "none" or "tct"
         ``tct``: on a graph of ``time`` costs, PPO learns from the rewards divided by the
         graph's cooperative cost TCT (the logged episode rewards stay in the graph's units).

@@ -7,10 +7,10 @@
 
 Observation (``obs``): ``"node"`` gives the node index, ``Discrete(n)`` (the paper's);
 ``"features"`` gives ``features[node]`` as a ``Box`` (caller-supplied ``(n, d)`` features,
-default :func:`arl.game.layer_features`). Action: the index of the move among the learner's
+default :func:`arl.moves.layer_features`). Action: the index of the move among the learner's
 moves at the node, ``Discrete(max_moves)``; :meth:`~TurnEnv.action_masks` serves sb3-contrib's
 ``MaskablePPO``. An invalid action (without masking) is mapped to ``action % n_moves``,
-deterministically (``invalid="raise"`` raises instead). Rewards: see :mod:`arl.game`.
+deterministically (``invalid="raise"`` raises instead). Rewards: see :mod:`arl.moves`.
 
 The learner is only asked when it has a move: passes and opponent moves happen inside
 ``step`` / ``reset``. If the game ends before the learner ever moves (e.g. the robot goes

@@ -1,8 +1,8 @@
 """Pure game logic of the robot-vs-human game, shared by every RL adapter.
 
 This module knows nothing of Gymnasium, PettingZoo or SB3 (like the board logic of
-PettingZoo's tic-tac-toe): it turns a :class:`asp.dag.GameDAG` into move tables, plays moves
-and passes by the rules of :mod:`asp.rules` (the same the exact solver plays by), and
+PettingZoo's tic-tac-toe): it turns a :class:`asp.game.dag.GameDAG` into move tables, plays moves
+and passes by the rules of :mod:`asp.game.rules` (the same the exact solver plays by), and
 defines the rewards (``../shared/DESIGN.md``, "The game" and "Alternating
 PPO").
 
@@ -22,7 +22,7 @@ Rewards
 ``reward="paper"`` (DESIGN.md, Table 1 of the paper): the robot gets ``-cost`` for each of
 its own moves and ``+n`` (the number of nodes) when the end is reached, whoever moved last;
 the human gets ``+cost`` for each of its own moves. A move's cost is
-:func:`asp.rules.move_costs`: the edge's cost, 1 per operation on a ``steps`` graph unless its
+:func:`asp.game.rules.move_costs`: the edge's cost, 1 per operation on a ``steps`` graph unless its
 file gives other costs (a GraphML with ``cost`` edges is trained on those costs, the ones it
 is certified on).
 
@@ -80,9 +80,9 @@ class GameTables:
     n_moves : (2, n) int64
         Number of moves of each player at each node.
     move_cost : (m,) float64
-        Cost of each edge (:func:`asp.rules.move_costs`).
+        Cost of each edge (:func:`asp.game.rules.move_costs`).
     can_move : (2, n) bool
-        Whether each player has a move at each node (:func:`asp.rules.has_move`).
+        Whether each player has a move at each node (:func:`asp.game.rules.has_move`).
     """
 
     dag: GameDAG

@@ -2,7 +2,7 @@
 
 A policy over a game DAG with ``n`` nodes is small enough to hold as a table. The trainer
 tabulates the frozen opponent once per phase (instead of a network call per step) and the
-greedy policies after each cycle (for the exact metrics of :mod:`asp.solve`).
+greedy policies after each cycle (for the exact metrics of :mod:`asp.game.solve`).
 """
 
 from __future__ import annotations

@@ -2,7 +2,7 @@
 
 Each cycle trains the robot against the frozen human, then the human against the frozen
 robot, both with SB3 PPO; after each cycle the greedy policies are tabulated over all nodes
-and scored exactly with :mod:`asp.solve`: the WCPL of greedy robot vs greedy human (the
+and scored exactly with :mod:`asp.game.solve`: the WCPL of greedy robot vs greedy human (the
 paper's) and the certified WCPL of the robot against an exact best-response human.
 
 The stop rule never looks at the exact solution: it reads the rewards (``paper``) or the
@@ -72,7 +72,7 @@ class TrainResult:
     converged : bool
         Whether the stop rule fired (else ``max_cycles`` or the callback ended it).
     wcpl : float
-        Cost of greedy robot vs greedy human (:func:`asp.solve.play`).
+        Cost of greedy robot vs greedy human (:func:`asp.game.solve.play`).
     certified_wcpl : float
         Cost of the greedy robot against an exact best-response human.
     minimax : float
@@ -141,7 +141,7 @@ class _EpisodeRecorder(BaseCallback):
 def graph_summary(dag: GameDAG) -> dict:
     """Size, ends, cost model and a fingerprint of the arrays (checked on resume)."""
     digest = hashlib.sha256()
-    # Hashed as int64 / float64 whatever the DAG stores (asp.dag keeps them narrow when
+    # Hashed as int64 / float64 whatever the DAG stores (asp.game.dag keeps them narrow when
     # exact), so a fingerprint depends on the game only.
     arrays = ((dag.indptr, np.int64), (dag.targets, np.int64), (dag.costs, np.float64))
     for arr, dtype in (*arrays, (dag.sides, np.int8)):
@@ -218,7 +218,7 @@ def _make_model(config: TrainConfig, env: VecEnv, seed: int):
 
 def robot_reach(tables: GameTables, robot_policy: np.ndarray) -> np.ndarray:
     """(n,) bool: nodes where the robot is on turn, with a move, in some state reachable
-    when it follows ``robot_policy`` against any human (:func:`asp.rules.reachable_states`)."""
+    when it follows ``robot_policy`` against any human (:func:`asp.game.rules.reachable_states`)."""
     seen = rules.reachable_states(tables.dag, robot_policy)
     return seen[:, ROBOT] & tables.can_move[ROBOT]
 
@@ -599,7 +599,7 @@ def evaluate(
     n_games: int = 1000,
     seed: int = 0,
 ) -> dict:
-    """All metrics of a learned robot policy (``asp.metrics.plan_metrics``) as a dict.
+    """All metrics of a learned robot policy (``asp.game.metrics.plan_metrics``) as a dict.
 
     Parameters
     ----------
@@ -615,7 +615,7 @@ def evaluate(
     -------
     dict
         ``tct, minimax, wcpl, certified_wcpl, avg_random, max_random, rr, rr_certified,
-        robust_optimal, ...`` (every :class:`asp.metrics.PlanMetrics` field) plus
+        robust_optimal, ...`` (every :class:`asp.game.metrics.PlanMetrics` field) plus
         ``robot_policy`` (edge indices).
     """
     from asp.game.metrics import plan_metrics

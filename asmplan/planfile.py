@@ -64,7 +64,7 @@ def alternate_states(graph, dag: GameDAG) -> AlternateStates:
     """The structured state of each node of ``game_dag(graph)`` (turn model ``alternate``).
 
     Node ``i < n - 1`` is the ``i``-th state that can still be completed and is not
-    complete (the numbering of :func:`asp.game.game_dag`); the last node is the complete
+    complete (the numbering of :func:`asp.graph.game_dag.game_dag`); the last node is the complete
     assembly. No operation runs between turns, so ``running`` is always empty.
     """
     alive = graph.coreachable()

@@ -51,7 +51,7 @@ Semantics:
 
 - An operation may start when all its ``after`` operations are done, every ``requires``
   tool has the value named, and every part it places is a feasible insertion
-  (:mod:`asp.feasibility`). Afterwards the ``sets`` tools have their new values.
+  (:mod:`asp.graph.feasibility`). Afterwards the ``sets`` tools have their new values.
 - Under ``cost: time`` a move costs the agent's duration plus the tool's ``change_time``
   for every tool whose value the operation actually changes.
 - If no operation places the base part, it is on the fixture from the start.
@@ -60,7 +60,7 @@ Semantics:
 file, the key and the offending operation or part. An unknown key is refused with the
 nearest known one suggested (``gravty`` -> ``gravity``); YAML aliases that expand past
 a limit are refused (:mod:`cad.yamlfile`). For a CAD file or a folder of part meshes,
-:func:`asp.generate.load_any` generates the spec. To add a top-level key, add it to
+:func:`asp.fromcad.generate.load_any` generates the spec. To add a top-level key, add it to
 :data:`TOP_KEYS` and read it in ``_Parser.parse``.
 """
 
@@ -213,7 +213,7 @@ class AssemblySpec:
     (a die set's upper half built upside down, then turned over and inserted). Its members
     are tested for support along that direction (product frame) in its workspace; units
     not listed are built as they sit in the product (``gravity``). See
-    :mod:`asp.orientation`."""
+    :mod:`asp.fromcad.orientation`."""
     contact_tol: float | None = None
     """Contact tolerance (mm) for every pair; None: the per-part rule of cad.tolerances."""
     penetration_tol: float | None = None
@@ -298,7 +298,7 @@ def load_spec(path: str | os.PathLike[str]) -> AssemblySpec:
     """Load and validate an assembly spec: a folder with ``assembly.yaml``, the YAML, a ``.IN2``.
 
     A CAD file or a folder of part meshes has no spec to load: see
-    :func:`asp.generate.generated_spec` (:func:`asp.generate.load_any` picks).
+    :func:`asp.fromcad.generate.generated_spec` (:func:`asp.fromcad.generate.load_any` picks).
 
     Raises
     ------

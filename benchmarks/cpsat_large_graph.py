@@ -1,15 +1,15 @@
 """CP-SAT makespan stage on small and large cases: time, makespan, status, bound, cuts.
 
-The stage is :func:`asp.concurrent.assembly_makespan` (``asmplan plan``'s step 4: the
-precedences the state graph implies, the replay tables, the list schedules, then CP-SAT with
-lazy cuts from the replay). Each case runs with the default of ``asmplan plan`` (``auto``:
-the whole stage within :data:`asp.concurrent.AUTO_TIME_LIMIT` seconds, stopping once neither a
-better schedule nor a new cut has come for :data:`asp.concurrent.AUTO_PATIENCE` seconds) and
-with each ``--limits`` value (a CP-SAT time limit in seconds, as ``--time-limit`` gives).
-Printed per run: the stage's wall time and the part of it spent before CP-SAT (the
-precedences, the replay tables, the list schedules), status, makespan, proven lower bound,
-cuts and solves, and who found the schedule; every schedule printed has passed the replay (checked
-again here).
+The stage is :func:`asp.schedule.assembly_makespan.assembly_makespan` (``asmplan plan``'s
+step 4: the precedences the state graph implies, the replay tables, the list schedules, then
+CP-SAT with lazy cuts from the replay). Each case runs with the default of ``asmplan plan``
+(``auto``: the whole stage within :data:`asp.schedule.assembly_makespan.AUTO_TIME_LIMIT`
+seconds, stopping once neither a better schedule nor a new cut has come for
+:data:`asp.schedule.assembly_makespan.AUTO_PATIENCE` seconds) and with each ``--limits``
+value (a CP-SAT time limit in seconds, as ``--time-limit`` gives). Printed per run: the
+stage's wall time and the part of it spent before CP-SAT (the precedences, the replay
+tables, the list schedules), status, makespan, proven lower bound, cuts and solves, and who
+found the schedule; every schedule printed has passed the replay (checked again here).
 
 Cases (those whose files are missing are skipped):
 
@@ -21,11 +21,11 @@ Cases (those whose files are missing are skipped):
 - ``file:PATH``: any assembly file or folder, loaded as ``asmplan plan`` does (e.g.
   ``file:/tmp/realcad_pub/cycloidal.3DXML``, the 72-part cycloidal drive);
 - ``j30:NAME``: PSPLIB instances (shared data), plain CP-SAT without a state graph
-  (:func:`asp.baseline.min_makespan`; ``auto`` is then the same time limit with the
+  (:func:`asp.schedule.makespan.min_makespan`; ``auto`` is then the same time limit with the
   patience).
 
 With ``--fixed-order both`` every assembly run is made twice: with the graph's fixed order
-of alike parts undone (``undo``, the default of ``asmplan plan``: :mod:`asp.fixed_order`,
+of alike parts undone (``undo``, the default of ``asmplan plan``: :mod:`asp.graph.fixed_order`,
 the full graph's schedules) and kept (``keep``: the chain a precedence, no two alike parts
 at once; the conservative makespan of before).
 

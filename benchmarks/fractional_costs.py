@@ -3,7 +3,7 @@
 Issue 14: the exact random-human distribution kept one probability per distinct total cost,
 so a 110-node graph with fractional costs took 114 s and 5.3 GB. The metrics now need no
 distribution (mean, minimum and maximum come from the exact evaluation; RR from a bounded
-dynamic program over the budget left, see `asp.metrics.probability_within`).
+dynamic program over the budget left, see `asp.game.metrics.probability_within`).
 
 Prints, for the metrics of the robust policy (RR against the certified WCPL, as `asmplan
 solve` does) and for RR against a lower reference WCPL (between the average and the

@@ -1,19 +1,19 @@
 """Everything downstream of a multi-million-state assembly state graph: time and memory.
 
 Stages (those of ``asmplan plan`` after the state graph): counting sequences, the game DAG
-(:func:`asp.game.game_dag`), the exact solve, the robust plan, what the outputs take from the
-game (:func:`asmplan.pipeline.played_game`: the policy table, named; the figure), after
-which the game and its solution are let go, the CP-SAT schedule (limit 5 s; only with
-``--cpsat``, else an empty schedule), the plan document (``AssemblyPlan.to_dict``) and
-writing plan.json, dag.png and report.html. Each row gives wall seconds, CPU seconds (the
-machine is shared) and the process's peak RSS after the stage. Target (issue 12, the
+(:func:`asp.graph.game_dag.game_dag`), the exact solve, the robust plan, what the outputs
+take from the game (:func:`asmplan.pipeline.played_game`: the policy table, named; the
+figure), after which the game and its solution are let go, the CP-SAT schedule (limit 5 s;
+only with ``--cpsat``, else an empty schedule), the plan document (``AssemblyPlan.to_dict``)
+and writing plan.json, dag.png and report.html. Each row gives wall seconds, CPU seconds
+(the machine is shared) and the process's peak RSS after the stage. Target (issue 12, the
 4.19M-state graph of a 72-part cycloidal drive): game DAG + solve + plan document + writing
 under 10 s, the peak of the whole downstream (graph in memory) under 1.6 GB.
 
 Default graph, built here: ``K`` independent chains of ``L`` operations each (every
 operation done by the person or the robot), ``(L + 1) ** K`` states: 6 chains of 12 give
 4.8M states, 26.7M transitions and a 53M-edge game, like the cycloidal drive's. With a path,
-a pickled :class:`asp.state_graph.StateGraph` instead.
+a pickled :class:`asp.graph.state_graph.StateGraph` instead.
 
 Run: ``.venv/bin/python benchmarks/game_downstream.py [--chains K] [--length L] [--cpsat]
 [GRAPH.pkl]``

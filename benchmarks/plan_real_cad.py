@@ -2,7 +2,7 @@
 
 For each assembly (a CAD file, a folder of part meshes or an ``assembly.yaml``), in a child
 process of its own: ``asmplan plan PATH -o OUT`` with default settings (the command line, a
-time limit per assembly), then :func:`asp.checker.check_line` on the plan's principal line
+time limit per assembly), then :func:`asp.graph.checker.check_line` on the plan's principal line
 against relations loaded afresh from the same file. Prints one row per assembly: parts, parts
 ``held``, subassemblies, length unit, the generated spec's gravity, states, seconds, peak
 memory of the plan command, TCT, W*, the CP-SAT status and the checker's verdict, or the

@@ -3,10 +3,10 @@
 The die sets are built here (:func:`tests.cad.real_shapes.die_set`, mm, z up, drawn open):
 a lower half on the bench (bottom plate, guide pins, die block, screws) and an upper half
 whose screws and bushings go in from below, so it is built upside down as a unit (top
-plate first on the bench, :mod:`asp.orientation`), turned over and lowered onto the guide
+plate first on the bench, :mod:`asp.fromcad.orientation`), turned over and lowered onto the guide
 pins (held: drawn open, nothing of the lower half is under it). Cases: two and four
 corners (4 pins, 4 bushings, 4 screws in each half: the identical parts would multiply the
-states; the symmetry reduction, :mod:`asp.symmetry`, orders them in the main body and in
+states; the symmetry reduction, :mod:`asp.graph.symmetry`, orders them in the main body and in
 the upper half's workspace alike), as a folder of STL parts (the upper half found
 automatically) and as a Y-up glTF with the product tree a CAD export has. With a path (a
 CAD file or folder, e.g. a real die set or the 26-part stand-in

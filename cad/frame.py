@@ -8,7 +8,7 @@ vertical: the build frame is the file's frame rotated by a rotation ``R``,
     x_build = R @ x_file          (millimetres, about the file's origin)
 
 ``R`` is the spec's ``frame:`` (:func:`parse_frame`), or chosen for a generated spec
-(:mod:`asp.framing`). Parts are turned once, where they are loaded
+(:mod:`asp.fromcad.framing`). Parts are turned once, where they are loaded
 (:func:`cad.loading.load_parts`): relations, tolerances, support, gravity and every mesh
 output are then in the build frame. ``None`` is the file's own frame (no rotation).
 

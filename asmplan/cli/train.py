@@ -104,7 +104,8 @@ def _train_concurrent(source, turn_model, config, seed, output, max_cycles, prog
 
 def _evaluate_concurrent(source: Path, folder: Path, fmt) -> None:
     """``evaluate --model RUN`` of a concurrent run: its robot certified at every budget of
-    :data:`CERTIFIED_BUDGETS` by the exact best response (:func:`asp.concurrent.certify`)."""
+    :data:`CERTIFIED_BUDGETS` by the exact best response
+    (:func:`asp.concurrent.certify.certify`)."""
     from arl.concurrent_trainer import learned_policy, load_robot
     from asp.concurrent.certify import certify
 

@@ -12,7 +12,7 @@ Every task derives its own seeds from the base seed with numpy's ``SeedSequence`
                  spawn_key=(EXPERIMENT_KEYS[experiment], layers, max_nodes, max_actions,
                             trial)).generate_state(3)  # -> graph, train, games seeds
 
-(uint32 words). The graph seed feeds :func:`asp.synth.synthetic_dag`, the train seed
+(uint32 words). The graph seed feeds :func:`asp.game.synth.synthetic_dag`, the train seed
 :func:`arl.train`, the games seed the 1,000-game random-human simulation.
 """
 
@@ -190,7 +190,7 @@ ROW_METRICS = (
     "rr_sampled",
     "adversarial_tax",
 )
-"""The :class:`asp.metrics.PlanMetrics` fields a row carries, in ``results.csv`` order."""
+"""The :class:`asp.game.metrics.PlanMetrics` fields a row carries, in ``results.csv`` order."""
 
 
 def _row_fields() -> list[tuple[str, object]]:
@@ -233,7 +233,7 @@ ResultRow = make_dataclass(
         "__doc__": """The metrics of one planner on one graph: a row of ``results.csv``.
 
     The task's identity, then the :data:`ROW_METRICS` fields of
-    :class:`asp.metrics.PlanMetrics` (declared there once), then the training figures.
+    :class:`asp.game.metrics.PlanMetrics` (declared there once), then the training figures.
     ``wcpl`` is the paper's WCPL: learned robot against learned human for ``arl``, the
     minimax value W* for ``exact``. ``rr`` is the exact share of random-human games with
     cost <= ``wcpl`` (the paper's RR), ``rr_certified`` the share within the certified WCPL

@@ -33,7 +33,7 @@ an unknown one is refused with its place):
       speed: 5                      # game seconds per wall-clock second
 
 :func:`load_study` reads it; :class:`Study` is the result. Plans are not planned here:
-:func:`asmplan.study.serve.study_plans` does it, once per plan, and makes each condition's
+:func:`asmplan.study.plans.study_plans` does it, once per plan, and makes each condition's
 plan document.
 """
 

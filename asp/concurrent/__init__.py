@@ -19,7 +19,7 @@ Semantics (``../shared/DESIGN.md``, "The concurrent game"):
 - Two operations run at the same time only if each is feasible whichever finishes first:
   with ``D`` done and the set ``A`` running, every ``D + T`` (``T`` a subset of ``A``) is a
   state of the state graph from which each operation of ``A - T`` is an edge
-  (:func:`asp.together.together`, the one place this rule is written: both builders and
+  (:func:`asp.graph.together.together`, the one place this rule is written: both builders and
   the schedule replay call it), and no
   operation changes a tool another one needs or changes. Every
   state entered must still be completable (the state graph's co-reachable states).

@@ -4,7 +4,7 @@ Compilation (the game the existing solver plays): every game state becomes a *ro
 (the robot side on turn) and every robot commitment a *human node*; a robot edge (cost 0)
 is a commitment, a human edge is the human side's reply followed by the wait for the next
 event, and costs the time until that event. Robot and human nodes alternate strictly, each
-node has moves only for its side, so the alternating turn rules of :mod:`asp.solve` (robot
+node has moves only for its side, so the alternating turn rules of :mod:`asp.game.solve` (robot
 first, the turn flips every move) play exactly this game, and the makespan is the sum of
 the edge costs. One DAG holds every budget ``0..K`` (a state's budget is part of it), with
 one start node per budget: ``W*(k)`` is the value at start ``k``. The unbounded adversary
@@ -167,7 +167,7 @@ def build_game(
         Bytes the build may use (:func:`game_bytes` of what it has built, checked at every
         node and edge); default :func:`default_memory` (2 GiB at most).
     compiled : bool, optional
-        Use the numba builder (:mod:`asp.concurrent_kernel`); default whenever its packed
+        Use the numba builder (:mod:`asp.concurrent.kernel`); default whenever its packed
         state key fits. ``False``: the Python builder (the same game, slower).
 
     Raises

@@ -7,7 +7,7 @@ game for the human side, much smaller than the concurrent game: from the start p
 the robot's single commitment at each position and *every* reply of the human side to it.
 That *policy game* is walked here from the rules, with the same node and edge layout as the
 policy games of :mod:`asp.concurrent.search` (so it is an ordinary
-:class:`asp.concurrent.build.ConcurrentGame`), and solved exactly by :func:`asp.game.solve`:
+:class:`asp.concurrent.build.ConcurrentGame`), and solved exactly by :func:`asp.game.solve.solve`:
 the value at a start is the exact best response of the human side to the policy, the
 policy's *certified worst case* for that budget.
 

@@ -4,13 +4,13 @@ The same rules as :mod:`asp.concurrent` (one game, two builders: this one for sp
 Python one for states that do not fit the packed key), written over arrays:
 
 - ``indptr``/``dst``/``op``/``change``: the live transitions in CSR form
-  (:class:`asp.together.LiveSteps`): the enabled operations of state ``s`` are
+  (:class:`asp.graph.together.LiveSteps`): the enabled operations of state ``s`` are
   ``op[indptr[s]:indptr[s + 1]]`` in the state graph's order, each with its target state and
   tool-change time;
 - ``dur[w, o, :ndur[w, o]]``: the durations worker ``w`` may take for ``o`` (none: not allowed);
 - ``conflict[a, b]``: a tool conflict; ``complete[s]``; ``side[w]`` (0 robot, 1 human).
 
-Which operations may run together is :func:`asp.together.together` (memoised here).
+Which operations may run together is :func:`asp.graph.together.together` (memoised here).
 
 A node is an int32 row ``[kind, state, budget, op[0..W), rem[0..W), instr[0..W)]``
 (``kind`` 0 robot, 1 human, 2 end; ``op`` -1 for a free worker; ``instr`` -2 where there is
@@ -67,7 +67,8 @@ def _key(row, nw):  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def _compatible(s, ops, m, indptr, dst, op, conflict, memo):  # pragma: no cover - compiled
-    """``ops[:m]`` (sorted) may run together from state ``s`` (:func:`asp.together.together`)."""
+    """``ops[:m]`` (sorted) may run together from state ``s``
+    (:func:`asp.graph.together.together`)."""
     packed = 0
     for i in range(m):
         packed = packed * 256 + ops[i] + 1
@@ -139,7 +140,16 @@ def build_kernel(
     :data:`OVER_NODES`) before a node past ``max_nodes``, and (:data:`OVER_MEMORY`) once
     its nodes and edges, at ``node_bytes`` and ``edge_bytes`` each, pass ``max_bytes``.
     Returns ``(overflow, [nodes expanded, nodes, edges], node rows, start nodes, edge
-    arrays...)``, the arrays empty when it stopped."""
+    arrays...)``, the arrays empty when it stopped.
+
+    One long function on purpose (it stays above the complexity limit): it is the nopython
+    loop over every node, and splitting it costs speed. Each piece would be a call between
+    jitted functions taking a dozen arrays (the transitions, durations, the growing node and
+    edge buffers, the hash map and the memo), and the loop state (the node expanded, its
+    busy and free workers, the odometer over their choices, the buffer sizes) would leave
+    the locals numba keeps in registers for arrays or tuples passed back and forth. What
+    touches none of that state is split out: :func:`_key`, :func:`_compatible`,
+    :func:`_with`, :func:`_has_candidate`, :func:`_append_edge`, :func:`_intern`."""
     nw = side.shape[0]
     width = 3 + 3 * nw
     cap = 1024

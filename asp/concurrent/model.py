@@ -38,11 +38,11 @@ class ConcurrentModel:
     workers : tuple of Worker
         Robots first, then humans.
     scale : int
-        Times are integers in units of ``1 / scale`` (see :func:`asp.baseline.integer_scale`).
+        Times are integers in units of ``1 / scale`` (see :func:`asp.schedule.cpsat.integer_scale`).
     choices : list of list of tuple of int, [worker][op]
         The durations (scaled) worker ``w`` may take for operation ``op`` (empty: not
         allowed). A robot has one; a human with a range has the grid points.
-    steps : asp.together.LiveSteps
+    steps : asp.graph.together.LiveSteps
         Transitions of the state graph between co-reachable states, with the tool-change
         time (scaled) the operation adds there.
     succ : dict (state, op) -> (state, change)
@@ -80,7 +80,7 @@ class ConcurrentModel:
 
     def compatible(self, state: int, ops: tuple[int, ...]) -> bool:
         """Whether the operations ``ops`` may run together from ``state``
-        (:func:`asp.together.together`, the one place this rule is written)."""
+        (:func:`asp.graph.together.together`, the one place this rule is written)."""
         key = (state, ops)
         hit = self._memo.get(key)
         if hit is None:
@@ -125,7 +125,7 @@ class ConcurrentModel:
         return ReplayModel(self.spec, self.workers, self.steps, self.conflict)
 
     def kernel_arrays(self) -> tuple:
-        """The arrays :func:`asp.concurrent_kernel.build_kernel` takes (its docstring)."""
+        """The arrays :func:`asp.concurrent.kernel.build_kernel` takes (its docstring)."""
         n = self.n_ops
         nw = len(self.workers)
         width = max((len(c) for row in self.choices for c in row), default=1)

@@ -3,8 +3,9 @@
 :func:`plan_concurrent` does the work ``asmplan plan --turn-model concurrent`` reports:
 
 - the CP-SAT makespan schedule, replayed through the state graph
-  (:func:`asp.baseline.assembly_makespan`);
-- ``W*(k)`` for ``k = 0, 1, ...`` until it reaches ``W*(inf)`` (:func:`asp.concurrent.robustness`);
+  (:func:`asp.schedule.assembly_makespan.assembly_makespan`);
+- ``W*(k)`` for ``k = 0, 1, ...`` until it reaches ``W*(inf)``
+  (:func:`asp.concurrent.robustness.robustness`);
 - the CP-SAT schedule run as a plan that ignores the person (:func:`asp.concurrent.schedule_rule`)
   and its certified worst case under the same budgets: what deviations cost a plan that
   does not plan for them;
@@ -78,8 +79,8 @@ def plan_concurrent(
     Parameters
     ----------
     schedule : (BaselineResult, float), optional
-        The CP-SAT schedule (from :func:`asp.concurrent.assembly_makespan`) and its lower
-        bound, when already computed.
+        The CP-SAT schedule (from :func:`asp.schedule.assembly_makespan.assembly_makespan`)
+        and its lower bound, when already computed.
 
     Raises
     ------

@@ -4,7 +4,7 @@ The game is walked from its start by the rules of :mod:`asp.concurrent.rules`; o
 positions the search needs are ever made. Two compiled kernels (numba, ``cache=True``) do
 the work: a minimax search for values and a builder of the *policy game* (the states one
 robot policy can reach against every human, with all their replies), whose exact solution
-(:func:`asp.solve.solve`) is that policy's certified worst case state by state.
+(:func:`asp.game.solve.solve`) is that policy's certified worst case state by state.
 
 The search
 ----------
@@ -345,7 +345,15 @@ def _search(T, H, root, alpha, beta, st):  # pragma: no cover - compiled
     Depth-first with an explicit stack of positions (numba cannot cache a recursive
     function): a frame is a position, its commitments in the order tried and, for the one
     being tried, its human node's replies. A frame's depth is at most the operations + 2
-    (each event completes one)."""
+    (each event completes one).
+
+    One long function on purpose (it stays above the complexity limit): the phases of a
+    frame are one nopython loop, and splitting it costs speed. Each phase as its own
+    function would be a call between jitted functions taking the rules' arrays ``T``, the
+    transposition table ``H`` and the stack's dozen per-frame arrays, and the loop state
+    (the frame, its window and cursors, the value so far) would leave the locals numba
+    keeps in registers. What touches none of that state is split out: :func:`_entry`,
+    :func:`_find`, :func:`_estimate`, :func:`_dominant`, :func:`_tick`."""
     nw = T.side.shape[0]
     width = root.shape[0]
     D = T.label.shape[0] + 3
@@ -639,7 +647,7 @@ def _running(row, nw, o):  # pragma: no cover - compiled
 
 @numba.njit(cache=True)
 def _node_row(row, kind, told, nw):  # pragma: no cover - compiled
-    """A position as :class:`asp.concurrent.NodeRows` reads a node:
+    """A position as :class:`asp.concurrent.build.NodeRows` reads a node:
     ``[kind, state, budget, ops, remains, instructions]``."""
     out = np.full(3 + 3 * nw, NONE, np.int64)
     out[0] = kind

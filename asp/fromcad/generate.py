@@ -11,11 +11,11 @@ rule, fixed so that a generated spec plans the same as the file it writes:
 - frame: the file's own, unless some pair of parts can never be assembled in it (each
   blocks the other along every axis direction, :func:`cad.frame.interlocked`: the Fabrica
   duct's pins lie 30 degrees off ``z``); then a few frames turning a part axis the parts
-  share onto a coordinate axis are tried (:mod:`asp.framing`), the first that leaves every
+  share onto a coordinate axis are tried (:mod:`asp.fromcad.framing`), the first that leaves every
   part a way in taken; ``frame:`` in the spec, said on stderr;
 - gravity: the format's own down (``-y`` for glTF/GLB, whose specification makes ``+y``
   up; ``-z`` for the others) unless another axis direction is clearly better for the
-  parts' relations (:mod:`asp.gravity`: a Y-up STEP export gets ``-y``);
+  parts' relations (:mod:`asp.fromcad.gravity`: a Y-up STEP export gets ``-y``);
   :func:`orient_generated` applies it once the relations are computed, and says why;
 - the base part, placed first: the lowest of the large parts along gravity (those whose
   footprint, the bounding box's area across gravity, is at least half the largest);
@@ -34,10 +34,10 @@ rule, fixed so that a generated spec plans the same as the file it writes:
   :func:`hold_unsupported` applies it once they are computed (``asmplan.pipeline.load``),
   and :func:`spec_text` computes them to write it;
 - subassemblies: the file's sub-assemblies that can be built on their own and inserted
-  as one unit (:func:`asp.units.cad_units`: not holding the base part, buildable in their
+  as one unit (:func:`asp.subassemblies.cad_units`: not holding the base part, buildable in their
   own workspace, free from the base part along some direction) are units; the others are
   written commented with the reason. The state graph of a generated spec gives up a unit
-  that leaves no complete sequence (:func:`asp.units.build_with_units`).
+  that leaves no complete sequence (:func:`asp.subassemblies.build_with_units`).
 """
 
 from __future__ import annotations
@@ -122,7 +122,7 @@ def workable_base(spec: AssemblySpec, relations) -> tuple[AssemblySpec, str]:
     """A generated spec on a base part from which the assembly is not ruled out.
 
     The geometric rule (:func:`base_index`) looks at bounding boxes only; when the derived
-    precedences (:func:`asp.symmetry.infeasibility`) prove that no complete sequence starts
+    precedences (:func:`asp.graph.symmetry.infeasibility`) prove that no complete sequence starts
     from that base (with gravity as given, e.g. a drive drawn upside down whose lowest large
     part rests on parts that need the parts above it), the other parts are tried, those
     touching the most parts first (then in operation order), and the first not ruled out
@@ -235,7 +235,7 @@ def spec_data(
 
     Part files are written relative to ``spec_folder`` (default: the CAD file's folder,
     or the folder of meshes itself); ``gravity`` defaults to the format's own down
-    (:func:`asp.gravity.default_down`); ``frame`` (a rotation, :mod:`cad.frame`; None: the
+    (:func:`asp.fromcad.gravity.default_down`); ``frame`` (a rotation, :mod:`cad.frame`; None: the
     file's own) is the build frame the parts are turned into, and written as ``frame:``;
     ``units`` is the unit of mesh files that declare none (default mm; ``--units``).
 
@@ -369,7 +369,7 @@ def generated_spec(
 
 
 def gravity_choice(relations, geometry, default: str):
-    """:func:`asp.gravity.choose_gravity` for parts ``geometry`` (a ``cad.Assembly``)."""
+    """:func:`asp.fromcad.gravity.choose_gravity` for parts ``geometry`` (a ``cad.Assembly``)."""
     from asp.fromcad.gravity import choose_gravity
 
     box = {p.id: p.bounds for p in geometry.parts}
@@ -378,7 +378,7 @@ def gravity_choice(relations, geometry, default: str):
 
 
 def orient_generated(spec: AssemblySpec, relations, geometry, turn=None, given: bool = False):
-    """A generated spec with the gravity :mod:`asp.gravity` chooses, and the choice.
+    """A generated spec with the gravity :mod:`asp.fromcad.gravity` chooses, and the choice.
 
     When the choice differs from the spec's (the format's own down), the spec is
     generated again along it (base part and operation order follow gravity) by
@@ -423,7 +423,7 @@ class Decisions:
     spec : AssemblySpec
         The spec in the chosen build frame, along the chosen gravity, on a workable base,
         ``held`` applied.
-    gravity : asp.gravity.GravityChoice or None
+    gravity : asp.fromcad.gravity.GravityChoice or None
         The gravity choice and its reason (None: a user's spec, or no support table).
     rebased : str
         Why another base part was taken ("" when the lowest large part was kept).
@@ -432,7 +432,7 @@ class Decisions:
         was chosen).
     geometry : cad.Assembly or None
         The parts in the spec's build frame.
-    frame : asp.framing.FrameChoice or None
+    frame : asp.fromcad.framing.FrameChoice or None
         Why another build frame was taken, or why none helped (None: the file's frame
         leaves every pair of parts a way in, or a user's spec).
     """
@@ -474,7 +474,7 @@ def decide_generated(
     given_gravity: bool = False,
 ) -> Decisions:
     """The decisions of a generated spec that need its relations, in this order: the build
-    frame (:func:`asp.framing.choose_frame`: only when some pair of parts can never be
+    frame (:func:`asp.fromcad.framing.choose_frame`: only when some pair of parts can never be
     assembled in the file's frame), gravity (:func:`orient_generated`), then the base part
     and ``held`` (:func:`workable_base`).
 
@@ -540,7 +540,7 @@ def spec_text(
     the ``held`` marks; else both keys are written commented out. ``on_note`` (optional) is
     called with a line for each decision of :func:`decide_generated` (build frame,
     gravity, base part, ``held``). ``decide_units(spec,
-    relations)`` (:func:`asp.units.cad_units`, given by the caller: it sits above this
+    relations)`` (:func:`asp.subassemblies.cad_units`, given by the caller: it sits above this
     module) decides which of the file's sub-assemblies are written as ``subassemblies:``;
     without it they are all written commented. ``units`` (of mesh files that declare
     none) and ``gravity`` (kept, not chosen): ``--units`` and ``--gravity``.
@@ -709,7 +709,7 @@ def _hierarchy_lines(data: dict, assembly, relations, spec_folder, decide) -> li
 
 def _unit_ways(spec, relations, used) -> tuple[dict[str, str], set[str]]:
     """For the used units: those built upside down (unit id -> the gravity of its
-    workspace) and those held while inserted (:func:`asp.orientation.loose_units`), as the
+    workspace) and those held while inserted (:func:`asp.fromcad.orientation.loose_units`), as the
     planner decides them."""
     from asp.fromcad.orientation import loose_units, unit_orientation
 

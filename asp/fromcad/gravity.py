@@ -168,7 +168,7 @@ def choose_gravity(relations, bounds: np.ndarray, default: str = "-z") -> Gravit
 def one_sequence(relations, gravity: str, base: int, held: set[int]) -> bool | None:
     """Whether the parts can all be inserted one by one, base first (None: search ran out).
 
-    The insertion test of ``asp.feasibility`` with every direction open to the gripper:
+    The insertion test of ``asp.graph.feasibility`` with every direction open to the gripper:
     a part goes in when it touches (or rests on) the parts there, some direction is free
     of all of them, and something stops it falling along ``gravity`` unless it is held.
     """

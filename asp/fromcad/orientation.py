@@ -16,7 +16,7 @@ no other member keeps from falling (an empty row of the support relation restric
 unit: in its workspace only members are there); one of them may be the workspace's first
 part (it stands on the fixture), the others need an agent holding them. Upside down is
 chosen when it needs strictly fewer holds and its members can be placed one by one
-(:func:`asp.gravity.one_sequence` over the members), or when only it can be built. The
+(:func:`asp.fromcad.gravity.one_sequence` over the members), or when only it can be built. The
 member placements' ``held`` follow the orientation chosen (a screw driven upwards in the
 product is held there, but rests on its head in a half built upside down), and the member
 that carries the most others (the top plate) stands first on the bench: the other
@@ -82,7 +82,7 @@ class UnitOrientation:
 def loose_units(spec: AssemblySpec, relations) -> set[str]:
     """The units that no part outside them can keep from falling along the product's
     gravity (an upper die set sliding down its guide pins, drawn open): each is held while
-    it goes in (:func:`asp.units.hold_unsupported_units`; ``asmplan init`` writes
+    it goes in (:func:`asp.subassemblies.hold_unsupported_units`; ``asmplan init`` writes
     ``held: true``). Empty without a support table."""
     sp = getattr(relations, "sp", None)
     if relations is None or sp is None:
@@ -171,7 +171,7 @@ def _build(relations, members, gravity: str) -> tuple[list[str], str] | None:
 
     Loose members (nothing among the members keeps them from falling) are held but the
     first; the first is the loose member (any member when none is loose) that keeps the
-    most members from falling, of those from which :func:`asp.gravity.one_sequence` finds
+    most members from falling, of those from which :func:`asp.fromcad.gravity.one_sequence` finds
     (or cannot rule out) an order placing every member.
     """
     from asp.fromcad.gravity import one_sequence

@@ -3,7 +3,7 @@
 Every consumer of the game asks this module what a move is: the exact solver and the
 policy evaluator (:mod:`asp.game.solve`), the metrics (:mod:`asp.game.metrics`), the play session
 (:mod:`asp.game.play`), the readable plan (:mod:`asp.game.plan`), the CP-SAT path
-(:mod:`asp.baseline`), the learners' game, environments and trainer (:mod:`arl`), and the
+(:mod:`asp.schedule`), the learners' game, environments and trainer (:mod:`arl`), and the
 plan file's policy table (``asmplan.planfile``). The
 compiled kernels cannot call Python, so they take the rules as tables built here
 (:func:`kernel_tables`): one change here changes every consumer.

@@ -7,7 +7,7 @@ class of interchangeable blocks of operations (a pin; a dowel with its roller), 
 the *sorted* state, whose blocks are done in block order by prefix length (longest first).
 TCT and W* stay exact, but a schedule replayed through it as it is could never run two
 alike operations at once (both orders must be transitions) and would keep the chain as a
-precedence. This module undoes the order for the CP-SAT schedule (:mod:`asp.baseline`):
+precedence. This module undoes the order for the CP-SAT schedule (:mod:`asp.schedule`):
 
 - **Relabelling.** Every done set ``D`` of the full graph whose blocks are done in block
   order (each block a prefix of its operations: its derived precedences, which every

@@ -7,7 +7,7 @@ graph) and neither changes a tool the other needs. For a set ``A`` running on to
 other operation of ``A`` is a transition into a co-reachable state, and no two operations of
 ``A`` conflict on a tool. :func:`together` is that rule; the concurrent game's Python
 builder (:meth:`asp.concurrent.model.ConcurrentModel.compatible`), its compiled builder
-(:mod:`asp.concurrent_kernel`) and the CP-SAT schedule replay
+(:mod:`asp.concurrent.kernel`) and the CP-SAT schedule replay
 (:func:`asp.schedule.replay.schedule_violation`, and the list schedule built on it) all call it.
 
 The transitions are :class:`LiveSteps`: the state graph's transitions between co-reachable

@@ -29,7 +29,7 @@ def plan_and_check(
     Asserts the command succeeds, the principal line does every operation of the spec
     loaded afresh from ``source`` (with the units the plan used: the CAD file's and the
     automatic ones are decided while planning; each inserted by an operation named as the
-    unit), and :func:`asp.checker.check_line` accepts it (the units built in their own
+    unit), and :func:`asp.graph.checker.check_line` accepts it (the units built in their own
     workspaces along the gravity ``plan.json``'s ``workspaces`` give, ``held`` as the plan's
     operations say: what the plan claims an agent holds), and the mesh replay
     (:mod:`tests.asmplan.mesh_replay`: ``plan.json`` and the meshes alone) accepts both of

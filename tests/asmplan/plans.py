@@ -76,7 +76,7 @@ def cell_plan(cost: str | None = None) -> dict:
 
 def concurrent_cell(data: dict | None = None, *, max_k: int = 2, step: float | None = 1.0):
     """(spec, curve) of a job in the concurrent game (default: the small cell), budgets
-    ``0..max_k`` (:func:`asp.concurrent.robustness`)."""
+    ``0..max_k`` (:func:`asp.concurrent.robustness.robustness`)."""
     from asp.concurrent.model import concurrent_model
     from asp.concurrent.robustness import robustness
 
@@ -99,7 +99,7 @@ def concurrent_plan(data: dict | None = None, *, max_k: int = 2, step: float | N
 
 def alike_plan(spec, relations, turn_model: str = "alternate", *, cost: str = "time") -> dict:
     """The plan document of a spec with alike parts, from the state graph reduced by
-    symmetry (:func:`asp.symmetry.reduced_state_graph`: the policy knows one canonical
+    symmetry (:func:`asp.graph.symmetry.reduced_state_graph`: the policy knows one canonical
     order of each class; ``interchangeable`` lists the classes). ``concurrent``: budgets
     0 to 2."""
     from asp.graph.symmetry import reduced_state_graph

@@ -36,7 +36,7 @@ def test_no_sequence_from_the_lowest_large_part(tmp_path):
     folder = plate_on_post(tmp_path / "post")
     with pytest.warns(UserWarning):
         assembly = pipeline.load(folder)
-    # The gravity choice (asp.gravity) sees the drawing is upside down and turns gravity
+    # The gravity choice (asp.fromcad.gravity) sees the drawing is upside down and turns gravity
     # to +z, where the plate is a workable base; with gravity kept at -z, workable_base
     # must move the base to the post.
     assert (assembly.spec.gravity, assembly.spec.base_part) in {("+z", "plate"), ("-z", "post")}

@@ -2,7 +2,7 @@
 
 A Pro/E (Creo) or SolidWorks STEP export is often Y-up: with gravity ``-z`` the bracket of
 a bolted joint needs a bolt beside it to "rest" on and the bolts need the bracket, so no
-order exists. The generated spec chooses ``-y`` there (:mod:`asp.gravity`), says so on
+order exists. The generated spec chooses ``-y`` there (:mod:`asp.fromcad.gravity`), says so on
 stderr and in ``asmplan init``'s comment, and plans; Z-up files keep ``-z``, glTF keeps
 its ``-y`` unless its content is Z-up; a user's spec is never changed. Geometry built here.
 """

@@ -20,7 +20,7 @@ TORCH_STACK = ("torch", "stable_baselines3", "sb3_contrib", "tensorboard")
 
 
 def module_name(path: Path) -> str:
-    """``asp/salbp.py`` -> ``asp.readers.in2``."""
+    """``asp/salbp.py`` -> ``asp.salbp``."""
     parts = path.relative_to(REPO).with_suffix("").parts
     return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
 

@@ -137,7 +137,7 @@ def test_a_die_set_without_product_tree_finds_its_upper_half(tmp_path):
     parts can never go in one by one (the screws driven up into the top plate would have
     to pass through the die block); the groups of the stuck parts that span both first
     guesses merge into one unit, which is built upside down. The guide bushings, pressed
-    into the top plate from below, join it (:func:`asp.units.hung_on_units`): upside down
+    into the top plate from below, join it (:func:`asp.subassemblies.hung_on_units`): upside down
     they rest on the top plate, where otherwise each would be held on its guide pin until
     the upper half comes down."""
     from cad import Assembly

@@ -1,4 +1,4 @@
-"""Giving memory back between stages (asp.memory)."""
+"""Giving memory back between stages (asp.heap)."""
 
 from __future__ import annotations
 

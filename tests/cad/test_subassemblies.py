@@ -485,7 +485,7 @@ def capped_block():
 
 def test_a_files_sub_assembly_built_upside_down_passes_both_checkers(tmp_path):
     """The file's sub-assembly [lid, peg_1, peg_2] is built upside down in its workspace
-    (:mod:`asp.orientation`), turned over and put on the block; the relations checker and
+    (:mod:`asp.fromcad.orientation`), turned over and put on the block; the relations checker and
     the mesh replay both follow the workspace's gravity from ``plan.json``."""
     from tests.asmplan.checked import plan_and_check
 

@@ -35,7 +35,8 @@ def wide(dag: GameDAG) -> GameDAG:
 
 
 def reference_edges(graph, cost: str) -> dict[str, np.ndarray]:
-    """The game's CSR arrays as ``asp.game.game_dag`` built them with numpy (int64/float64)."""
+    """The game's CSR arrays as ``asp.graph.game_dag.game_dag`` built them with numpy
+    (int64/float64)."""
     spec, model = graph.spec, graph.model
     alive, done = graph.coreachable(), graph.complete
     keep = alive & ~done

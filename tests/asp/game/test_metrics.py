@@ -65,7 +65,7 @@ def test_metrics_keys_and_bad_game_count():
 
 
 def _brute_force_rr(dag, policy, bound):
-    """P(cost <= bound) by enumerating every line (sides read directly, not via asp.rules)."""
+    """P(cost <= bound) by enumerating every line (sides read directly, not via asp.game.rules)."""
 
     def go(v, p, spent, prob):
         if v == dag.end:

@@ -1,4 +1,4 @@
-"""Game sessions (asp.play): the person against the robust robot or a best-response human."""
+"""Game sessions (asp.game.play): the person against the robust robot or a best-response human."""
 
 from __future__ import annotations
 

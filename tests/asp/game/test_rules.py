@@ -1,4 +1,4 @@
-"""The rules of play (asp.rules): moves by side, passes, the turn, the cost of a move."""
+"""The rules of play (asp.game.rules): moves by side, passes, the turn, the cost of a move."""
 
 import numpy as np
 import pytest

@@ -1,10 +1,10 @@
 """The CP-SAT makespan on a graph reduced by a fixed order of alike parts is the full graph's.
 
 The alternating game's graph chains interchangeable operations in a fixed order
-(:mod:`asp.symmetry`); the schedule stage undoes it (:mod:`asp.fixed_order`: relabelling in
-the replay, start-order symmetry breaking instead of the chain, cuts stated with counts), so
-alike parts may run at once again. Without it the makespan grows (the chain is a precedence
-and two alike parts never overlap).
+(:mod:`asp.graph.symmetry`); the schedule stage undoes it (:mod:`asp.graph.fixed_order`:
+relabelling in the replay, start-order symmetry breaking instead of the chain, cuts stated
+with counts), so alike parts may run at once again. Without it the makespan grows (the chain
+is a precedence and two alike parts never overlap).
 """
 
 from __future__ import annotations
