@@ -9,7 +9,7 @@ class                  raised for
 ``ScheduleError``      a scheduling problem (``.sm``, CP-SAT baseline) that cannot be built
 ``FormatError``        a file in one of the readers' formats that does not parse
 ``InfeasibleAssembly`` (a ``SpecError``) an assembly with no complete sequence
-``StateLimit``         (a ``SpecError``) a state graph over ``max_states``
+``StateLimit``         (a ``SpecError``) a state graph over ``max_states`` or its memory
 ``GameLimit``          (a ``GameError``) a game over its node limit
 =====================  ====================================================================
 
@@ -48,7 +48,8 @@ class InfeasibleAssembly(SpecError):
 
 
 class StateLimit(SpecError):
-    """A state graph that would exceed ``max_states`` (the message says how to raise it)."""
+    """A state graph that would exceed ``max_states`` or the memory it may use (the message
+    says which, and what to change)."""
 
 
 class GameLimit(GameError):

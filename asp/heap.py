@@ -13,6 +13,9 @@ do nothing but collect garbage):
   megabytes stay in the heap once freed.
 - :func:`release_memory`, called between stages: collects reference cycles and returns the
   heap's free pages (``malloc_trim``).
+
+And the one rule of how much memory a build may use (:func:`memory_budget`: a share of the
+memory available when it starts), which every builder with a memory bound calls.
 """
 
 from __future__ import annotations
@@ -21,10 +24,15 @@ import ctypes
 import ctypes.util
 import functools
 import gc
+import os
 
 LARGE_BLOCK = 1 << 20
 """Blocks of at least this many bytes (1 MiB) are mapped on their own
 (:func:`map_large_blocks`)."""
+
+MEMORY_SHARE = 0.75
+"""A build may use at most this share of the memory available when it starts
+(:func:`memory_budget`)."""
 
 _M_MMAP_THRESHOLD = -3
 """glibc's ``mallopt`` parameter of the mapping threshold (``malloc.h``)."""
@@ -55,3 +63,56 @@ def release_memory() -> None:
     libc = _glibc()
     if libc is not None:
         libc.malloc_trim(0)
+
+
+def available_memory() -> int:
+    """Bytes of memory available now: ``MemAvailable`` of ``/proc/meminfo`` (else the free
+    physical pages, else 8 GiB), and no more than the process's control group leaves
+    (:func:`cgroup_room`)."""
+    free = None
+    try:
+        with open("/proc/meminfo", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    free = int(line.split()[1]) * 1024
+                    break
+    except (OSError, ValueError, IndexError):
+        pass
+    if free is None:
+        try:
+            free = int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_AVPHYS_PAGES"))
+        except (AttributeError, ValueError, OSError):
+            free = 8 << 30
+    room = cgroup_room()
+    return free if room is None else min(free, room)
+
+
+CGROUP_FILES = (
+    ("/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory.current"),
+    ("/sys/fs/cgroup/memory/memory.limit_in_bytes", "/sys/fs/cgroup/memory/memory.usage_in_bytes"),
+)
+"""The memory limit and usage of the process's control group (v2, then v1)."""
+
+
+def cgroup_room(files=CGROUP_FILES) -> int | None:
+    """Bytes the control group's memory limit leaves (limit minus usage), or None when
+    there is no limit (``max``, or v1's huge number) or no such files."""
+    for limit_file, usage_file in files:
+        try:
+            with open(limit_file, encoding="ascii") as f:
+                limit = f.read().strip()
+            with open(usage_file, encoding="ascii") as f:
+                usage = int(f.read().strip())
+        except (OSError, ValueError):
+            continue
+        if limit == "max" or not limit.isdigit() or int(limit) >= 1 << 60:
+            return None
+        return max(0, int(limit) - usage)
+    return None
+
+
+def memory_budget(cap: int | None = None) -> int:
+    """The bytes a build may use: :data:`MEMORY_SHARE` of :func:`available_memory`, and at
+    most ``cap`` bytes when given."""
+    share = int(MEMORY_SHARE * available_memory())
+    return share if cap is None else min(int(cap), share)

@@ -14,7 +14,6 @@ is its own DAG (no instructions).
 from __future__ import annotations
 
 import functools
-import os
 import sys
 import time
 from collections.abc import Sequence
@@ -25,6 +24,7 @@ import numpy as np
 from asp.concurrent.model import UNBOUNDED, WAIT, ConcurrentModel
 from asp.errors import GameError, GameLimit
 from asp.game.dag import HUMAN, ROBOT, GameDAG, from_arrays
+from asp.heap import available_memory, memory_budget
 
 DEFAULT_MAX_NODES = 3_000_000
 """Above this many game nodes the build stops with a ``ValueError``."""
@@ -35,30 +35,14 @@ at 0.32 GB over the interpreter, 103 bytes per edge, nodes included)."""
 PY_NODE_BYTES, PY_EDGE_BYTES = 1000, 400
 """The same for the Python builder (tuples in a dict, one dataclass per edge)."""
 DEFAULT_MEMORY = 2 << 30
-MEMORY_SHARE = 0.75
-"""The default memory limit of a build: :data:`DEFAULT_MEMORY` bytes (2 GiB), or this share
-of the memory available when it starts if that is less (:func:`default_memory`)."""
+"""The default memory limit of a build: :data:`DEFAULT_MEMORY` bytes (2 GiB), or less when
+the memory available says so (:func:`default_memory`)."""
 
 
 def default_memory() -> int:
-    """The default memory limit of a build, in bytes (:data:`MEMORY_SHARE`)."""
-    return min(DEFAULT_MEMORY, int(MEMORY_SHARE * available_memory()))
-
-
-def available_memory() -> int:
-    """Bytes of memory available now (``MemAvailable`` of ``/proc/meminfo``; else the free
-    physical pages; else 8 GiB)."""
-    try:
-        with open("/proc/meminfo", encoding="ascii") as f:
-            for line in f:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except (OSError, ValueError, IndexError):
-        pass
-    try:
-        return int(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_AVPHYS_PAGES"))
-    except (AttributeError, ValueError, OSError):
-        return 8 << 30
+    """The default memory limit of a build, in bytes (:func:`asp.heap.memory_budget` of
+    :data:`DEFAULT_MEMORY`)."""
+    return memory_budget(DEFAULT_MEMORY)
 
 
 def game_bytes(n_nodes: int, n_edges: int, *, compiled: bool = True) -> int:

@@ -18,6 +18,7 @@ many primes are needed), so even astronomically large counts are exact Python in
 
 from __future__ import annotations
 
+import functools
 import math
 import sys
 import time
@@ -25,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from asp import heap
 from asp.cad_keys import flex_hint
 from asp.errors import InfeasibleAssembly, StateLimit
 from asp.graph.feasibility import (
@@ -40,6 +42,34 @@ DEFAULT_MAX_STATES = 20_000_000
 """Above this many states the build stops with a ``ValueError``."""
 _CHUNK_CELLS = 1 << 25
 """States x operations tested at once (bounds the enabled-table memory of a layer)."""
+STATE_WORD_BYTES = 24
+"""Peak bytes of a state per key word: its key, the key's copy when the layers are joined,
+and its part set while its layer is the last (:func:`graph_bytes`)."""
+LAYER_TRANSITION_BYTES = 40
+"""Peak bytes of a transition of the layer being built, over what it keeps once built: the
+chunks' moves and successor keys and their merge (measured: free operations, 18 to 24)."""
+CHUNKS_IN_LIMIT = 8
+"""A chunk's moves (at most its states x operations) take at most this fraction of the
+memory limit, so that checking after each chunk overshoots the limit by little."""
+
+
+def graph_bytes(
+    n_states: int, n_transitions: int, in_flight: int = 0, *, n_words: int = 1, wide: bool = False
+) -> int:
+    """The estimated peak bytes of a state graph of ``n_states`` states (``n_words`` key
+    words each) and ``n_transitions`` transitions, ``in_flight`` of them in the layer being
+    built (:data:`LAYER_TRANSITION_BYTES` more each); ``wide``: int64 state indices.
+
+    A kept transition costs its source, target and operation and the copy of one of them
+    when the layers are joined (13 bytes, 25 when ``wide``); a state
+    :data:`STATE_WORD_BYTES` per key word.
+    """
+    index = 8 if wide else 4
+    return (
+        int(n_states) * STATE_WORD_BYTES * int(n_words)
+        + int(n_transitions) * (3 * index + 1)
+        + int(in_flight) * LAYER_TRANSITION_BYTES
+    )
 
 
 def sorted_bounds(src: np.ndarray, states) -> np.ndarray:
@@ -215,6 +245,7 @@ def build_state_graph(
     progress: bool = False,
     check: bool = True,
     drop_stuck: bool = False,
+    max_memory: int | None = None,
 ) -> StateGraph:
     """Build the state graph of ``spec`` breadth-first, vectorised over each layer.
 
@@ -238,12 +269,25 @@ def build_state_graph(
         direction (:meth:`asp.graph.feasibility.OperationModel.stuck`): dead ends, which the game
         drops anyway (TCT and W* do not change), but not the states an infeasibility report
         or the automatic subassemblies look at.
+    max_memory : int, optional
+        Bytes the build may use (default :func:`asp.heap.memory_budget`: 3/4 of the memory
+        available). The estimate (:func:`graph_bytes`) of the graph built so far and of
+        the layer being built is checked after every chunk of moves, and of the whole
+        graph as projected (:func:`_projected`) after every layer; past the limit the
+        build stops with a one-line :class:`asp.errors.StateLimit` naming the estimate,
+        the limit, the memory available and ``--max-states``.
     """
     model = operation_model(spec, relations) if model is None else model
     if max_states is None:
         max_states = spec.max_states or DEFAULT_MAX_STATES
     n_ops, n_words = model.n_ops, model.n_words
     index_type = np.int32 if max_states < 2**31 else np.int64
+    memory = _Memory(
+        heap.memory_budget() if max_memory is None else int(max_memory),
+        functools.partial(graph_bytes, n_words=n_words, wide=index_type is np.int64),
+        max_states,
+    )
+    kept = 0  # transitions of the layers built
     keys = model.pack([model.start_key])
     parts = pack_words([model.initial_parts], model.oracle.n_words)
     key_layers = [keys]
@@ -256,7 +300,9 @@ def build_state_graph(
             f"state graph: {n_ops} operations, {model.n_bits} key bits in {n_words} word(s)",
             file=sys.stderr,
         )
-    chunk = max(1, _CHUNK_CELLS // max(1, n_ops))
+    # a chunk's moves are counted once found: at most an eighth of the memory limit each
+    cells = min(_CHUNK_CELLS, memory.limit // (CHUNKS_IN_LIMIT * LAYER_TRANSITION_BYTES))
+    chunk = max(1, cells // max(1, n_ops))
     for layer in range(n_ops):
         # chunk by chunk: the enabled moves, their successors (distinct within the chunk,
         # stuck ones dropped) and a lower bound on the layer being built, which stops a
@@ -273,6 +319,9 @@ def build_state_graph(
                 raise _too_many(
                     model, keys, max_states, _after(f"at least {at_least:,}", layer, n_ops)
                 )
+            sizes = (total + found.n_distinct, kept + found.n_transitions, found.n_transitions)
+            if memory.over(*sizes):
+                raise memory.error(model, keys, sizes, f"while building layer {layer + 1}")
         if found.n_transitions == 0:  # nothing enabled, or every successor is stuck
             break
         si, oi, inv, uniq, new_parts = found.join()
@@ -281,6 +330,7 @@ def build_state_graph(
                 model, uniq, max_states, _after(f"{total + uniq.shape[0]:,}", layer, n_ops)
             )
         n_new = int(si.size)
+        kept += n_new
         src_l.append(si + index_type(offset))
         dst_l.append(inv.astype(index_type) + index_type(offset + keys.shape[0]))
         op_l.append(oi)
@@ -305,6 +355,11 @@ def build_state_graph(
                 f" times the one before: about {projected:,} projected"
             )
             raise _too_many(model, keys, max_states, reached)
+        rest = projected - total  # and as many transitions a state as the layer just built
+        sizes = (projected, kept + rest * n_new // max(1, keys.shape[0]), 0)
+        if memory.over(*sizes):
+            reached = f"projected from the {total:,} states after layer {layer + 1} of {n_ops}"
+            raise memory.error(model, keys, sizes, reached)
     if progress and line:  # the last layer's line, unless just shown
         print(line, file=sys.stderr)
     layer_ptr = np.zeros(len(key_layers) + 1, dtype=np.int64)
@@ -639,8 +694,23 @@ def _too_many(model: OperationModel, keys: np.ndarray, limit: int, reached: str)
     are named, the most balanced choices (done in about half the states) first. ``reached``
     says how many states were reached (or projected) after which layer.
     """
+    per_state = 8 * model.n_words + 8 * model.oracle.n_words + 8
+    return StateLimit(
+        f"{model.spec.source}: the state graph exceeds the limit of {limit:,} states: "
+        f"{reached}; {_free_choices(model, keys)}; raise max_states (the command line's "
+        f"--max-states N or the spec key max_states: N) if memory allows (about {per_state} "
+        f"bytes a state plus 10 a transition), or fix their order with precedences (after:) "
+        f"or build some of them as subassemblies"
+    )
+
+
+def _free_choices(model: OperationModel, keys: np.ndarray) -> str:
+    """``the free order of N parts or operations multiplies them (a, b, ...)``: the
+    operations done in some but not all of ``keys`` (a layer; 200,000 of them evenly
+    spaced at most), the most balanced (done in about half the states) first, by the parts
+    they place."""
     spec = model.spec
-    done = model.done_matrix(keys[:200_000]).mean(axis=0)
+    done = model.done_matrix(keys[:: max(1, keys.shape[0] // 200_000)]).mean(axis=0)
     free = np.flatnonzero((done > 0) & (done < 1))
     order = free[np.argsort(np.abs(done[free] - 0.5), kind="stable")]
     names = []
@@ -649,15 +719,41 @@ def _too_many(model: OperationModel, keys: np.ndarray, limit: int, reached: str)
         names.extend(op.parts or (f"operation {op.id}",))
     names = list(dict.fromkeys(names))
     shown = ", ".join(names[:8]) + (f" and {len(names) - 8} more" if len(names) > 8 else "")
-    per_state = 8 * model.n_words + 8 * model.oracle.n_words + 8
-    return StateLimit(
-        f"{spec.source}: the state graph exceeds the limit of {limit:,} states: {reached}; "
-        f"the free order of {len(names)} parts or "
-        f"operations multiplies them ({shown or 'none'}); raise max_states (the command line's "
-        f"--max-states N or the spec key max_states: N) if memory allows (about {per_state} "
-        f"bytes a state plus 10 a transition), or fix their order with precedences (after:) "
-        f"or build some of them as subassemblies"
-    )
+    return f"the free order of {len(names)} parts or operations multiplies them ({shown or 'none'})"
+
+
+@dataclass(frozen=True)
+class _Memory:
+    """The memory bound of a build (:func:`build_state_graph`): ``limit`` bytes, the
+    estimate ``bytes_of(states, transitions, in_flight)`` and the state limit it is named
+    with."""
+
+    limit: int
+    bytes_of: object
+    max_states: int
+
+    def over(self, states: int, transitions: int, in_flight: int) -> bool:
+        return self.bytes_of(states, transitions, in_flight) > self.limit
+
+    def error(self, model: OperationModel, keys: np.ndarray, sizes: tuple, when: str):
+        """The one-line :class:`StateLimit` of a build over its memory: the estimate from
+        ``sizes`` (states, transitions, in flight) ``when`` (which layer), the limit, the
+        memory available, how many states fit at this many transitions a state, the state
+        limit that allowed more, and the free choices that multiply the states."""
+        states, transitions, _ = sizes
+        gb = 2**30
+        need = self.bytes_of(*sizes)
+        each = self.bytes_of(1, transitions / max(1, states))
+        fit = int(self.limit / max(1.0, each))
+        return StateLimit(
+            f"{model.spec.source}: the state graph needs more memory than it may use: "
+            f"{need / gb:.2f} GB or more for {states:,} states and {transitions:,} transitions "
+            f"({when}), over its limit of {self.limit / gb:.2f} GB "
+            f"({heap.available_memory() / gb:.2f} GB available); about {fit:,} states fit, so "
+            f"--max-states {self.max_states:,} (or the spec key max_states) cannot be "
+            f"reached: {_free_choices(model, keys)}; fix their order with precedences "
+            f"(after:) or build some of them as subassemblies"
+        )
 
 
 # --------------------------------------------------------------------------- exact counting
