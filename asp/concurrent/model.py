@@ -150,6 +150,29 @@ class ConcurrentModel:
         )
 
 
+def game_spec(spec: AssemblySpec, graph: StateGraph) -> AssemblySpec:
+    """The spec whose operations the graph's states are made of: ``spec`` when they are its
+    own, the graph's spec when it adds operations to ``spec``'s (subassemblies' insertions).
+
+    Raises
+    ------
+    ValueError
+        The graph's operations are not ``spec``'s nor a superset of them.
+    """
+    own = graph.spec
+    if own is spec or own.op_ids == spec.op_ids:
+        return spec
+    if set(spec.op_ids) < set(own.op_ids):
+        return own
+    missing = sorted(set(spec.op_ids) - set(own.op_ids))
+    raise SpecError(
+        f"{spec.source or spec.name}: the state graph is of other operations than the spec "
+        f"({len(own.op_ids)} against {len(spec.op_ids)}"
+        + (f"; it has no {', '.join(missing[:3])}" if missing else "")
+        + ")"
+    )
+
+
 def concurrent_model(
     spec: AssemblySpec, graph: StateGraph, *, step: float | None = 1.0
 ) -> ConcurrentModel:
@@ -161,12 +184,18 @@ def concurrent_model(
         Grid of the human's durations within a range (module docstring); ``None``: the two
         end points.
 
+    The game is played on the graph's operations: when the graph's spec holds ``spec``'s
+    operations and more (the insertions of subassemblies found while it was built,
+    :func:`asmplan.pipeline.state_graph`), the graph's spec is the game's.
+
     Raises
     ------
     ValueError
         One line naming the spec and the fault: a robot with a duration range, an agent
-        with no operation it may do, an operation nobody may do, a bad duration or step.
+        with no operation it may do, an operation nobody may do, a bad duration or step,
+        a graph of other operations.
     """
+    spec = game_spec(spec, graph)
     where = spec.source or spec.name
     if step is not None and not (math.isfinite(step) and step > 0):
         raise SpecError(f"{where}: duration step: expected a positive number, got {step}")

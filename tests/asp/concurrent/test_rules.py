@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -16,6 +18,7 @@ from asp.game.solve import solve
 from asp.graph.fixed_order import FixedOrder
 from asp.graph.state_graph import build_state_graph
 from asp.graph.symmetry import interchangeable_blocks, reduced_state_graph
+from asp.spec import spec_from_dict, with_subassemblies
 from tests.asp.concurrent.test_concurrent import job as concurrent_job
 from tests.asp.graph.test_symmetry_workspaces import GROUPINGS, random_alike_spec
 
@@ -224,3 +227,39 @@ def test_random_alike_tables_fixed_order_undone_gives_the_full_game(
     if interchangeable_blocks(spec, rel, chains_only=False) != interchangeable_blocks(spec, rel):
         return  # blocks that are not chains (first of equals): the alternating game's only
     assert alike_values(fixed) == alike_values(full)
+
+
+def unit_job():
+    """A spec of three parts (the pin held) and its state graph with the plate and the pin
+    as a subassembly added while building (as :func:`asmplan.pipeline.state_graph` adds
+    units automatically): the graph's spec has one operation more than the spec."""
+    data = {
+        "parts": [{"id": p, "file": f"{p}.stl"} for p in ("base", "plate", "pin", "cap")],
+        "agents": {"H": {"side": "human"}, "R": {"side": "robot"}},
+        "base_part": "base",
+        "operations": [
+            {"id": "plate", "part": "plate", "agents": {"H": [2, 3], "R": 3}},
+            {"id": "pin", "part": "pin", "agents": {"H": 1, "R": 2}, "held": True,
+             "after": ["plate"]},
+            {"id": "cap", "part": "cap", "agents": {"H": 2}},
+        ],
+    }  # fmt: skip
+    spec = spec_from_dict(data, source="unit.yaml")
+    return spec, build_state_graph(with_subassemblies(spec, [("unit", ["plate", "pin"])]))
+
+
+def test_a_graph_with_units_added_plays_its_own_operations():
+    """Issue 23 item 0 (the APLAN shear mold: 17 operations in the spec, 19 in the graph
+    with its two units): the game is the graph's spec's, whichever spec is given."""
+    spec, graph = unit_job()
+    assert len(spec.operations) == 3 and len(graph.spec.operations) == 4
+    rules = concurrent_rules(spec, graph)
+    assert rules.model.spec is graph.spec
+    own = concurrent_rules(graph.spec, graph)
+    for b in (0, 1, None):
+        assert minimax(rules, rules.start(b)) == minimax(own, own.start(b))
+    adversary = build_game(concurrent_model(spec, graph), None)
+    assert solve(adversary.dag).value is not None
+    fewer = build_state_graph(replace(spec, operations=spec.operations[:2]))
+    with pytest.raises(SpecError, match=r"unit.yaml: the state graph is of other operations"):
+        concurrent_rules(spec, fewer)  # (not a graph of the spec's operations and more)
