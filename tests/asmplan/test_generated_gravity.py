@@ -9,6 +9,7 @@ its ``-y`` unless its content is Z-up; a user's spec is never changed. Geometry 
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -61,24 +62,61 @@ def test_the_bolted_bracket_gets_its_true_gravity(brackets, model, default, chos
     assert ("not the default" in choice.reason) == (chosen != default)
 
 
-def test_fewer_held_parts_alone_never_turn_gravity_sideways():
-    """Pins in through holes are "supported" by the hole walls under a sideways gravity;
-    a Z-up plate with loose pins keeps -z (the pins held), though +-x holds none."""
+def pin_plate() -> dict[str, trimesh.Trimesh]:
+    """A plate 60 x 20 x 5 mm lying flat in z with three pins standing in its through holes."""
     from tests.cad.real_shapes import cylinder, difference
 
     xs = (-20.0, 0.0, 20.0)
     plate = difference(
         box((-30, -10, 0), (30, 10, 5)), *(cylinder(3.1, -1, 6, 32, (x, 0)) for x in xs)
     )
-    parts = [prepare_part("plate", plate, scale=1.0, source="plate")]
-    parts += [
-        prepare_part(f"pin_{k}", cylinder(3.0, -5, 15, 24, (x, 0)), scale=1.0, source="pin")
-        for k, x in enumerate(xs)
-    ]
-    assembly = cad.Assembly(parts=tuple(parts), units="mm", source="built")
+    pins = {f"pin_{k}": cylinder(3.0, -5, 15, 24, (x, 0)) for k, x in enumerate(xs)}
+    return {"plate": plate, **pins}
+
+
+def pin_plate_assembly() -> cad.Assembly:
+    parts = tuple(prepare_part(k, m, scale=1.0, source=k) for k, m in pin_plate().items())
+    return cad.Assembly(parts=parts, units="mm", source="built")
+
+
+def test_fewer_held_parts_alone_never_turn_gravity_sideways():
+    """Pins in through holes are "supported" by the hole walls under a sideways gravity;
+    a Z-up plate with loose pins keeps -z (the pins held), though +-x holds none."""
+    assembly = pin_plate_assembly()
     choice = gravity_choice(cad.compute_relations(assembly), assembly, "-z")
     assert choice.held["-z"] == 3 and choice.held["+x"] == 0
     assert choice.gravity == "-z"
+
+
+def test_a_base_standing_on_edge_turns_a_gltf_z_up():
+    """The same plate in a glTF file (default -y): along -y it stands on its long edge and
+    holds no pin (the hole walls "support" them), along -z it lies flat with the pins held;
+    the base lying flat wins, as for trimesh's glTF export of the Z-up cycloidal drive."""
+    assembly = pin_plate_assembly()
+    choice = gravity_choice(cad.compute_relations(assembly), assembly, "-y")
+    assert choice.held["-y"] == 0 and choice.held["-z"] == 3
+    assert choice.footprint["-y"] == pytest.approx(0.25) and choice.footprint["-z"] == 1.0
+    assert choice.gravity == "-z"
+    assert "the base part plate stands on edge" in choice.reason
+    assert "the file is likely Z up" in choice.reason
+
+
+def test_a_z_up_glb_plans_lying_flat(tmp_path):
+    """End to end: a Z-up scene written as GLB without turning its axes (trimesh's export)
+    plans with gravity -z and says why; ``--gravity -y`` overrules it."""
+    scene = trimesh.Scene()
+    for name, mesh in pin_plate().items():
+        scene.add_geometry(mesh, node_name=name, geom_name=name)
+    source = tmp_path / "pins.glb"
+    scene.export(source)
+    stderr: list[str] = []
+    doc = plan_and_check(source, tmp_path / "out", stderr=stderr)
+    assert doc["gravity"] == "-z"
+    assert "gravity -z: not the default -y" in stderr[0] and "stands on edge" in stderr[0]
+    out = tmp_path / "given"
+    result = CliRunner().invoke(app, ["plan", str(source), "-o", str(out), "--gravity", "-y"])
+    assert result.exit_code == 0, result.output
+    assert json.loads((out / "plan.json").read_text())["gravity"] == "-y"
 
 
 def test_large_parts_held_along_the_default_turn_a_gltf_z_up():
