@@ -1,4 +1,4 @@
-"""Spec keys that correct what the geometry says about parts: ``flex:``.
+"""Spec keys that correct what the geometry says about parts: ``flex:``, ``overlap_ok:``.
 
 A real product is not only rigid bodies. A snap fit's housing flexes over the axle it
 locks: as rigid meshes, the two block each other along every direction, and no sequence
@@ -23,6 +23,7 @@ from dataclasses import replace
 import numpy as np
 
 FLEX_KEY = "flex"
+OVERLAP_KEY = "overlap_ok"
 
 
 def parse_flex(value, part_ids, source: str) -> tuple[str, ...]:
@@ -89,3 +90,30 @@ def flex_hint(pairs: list[tuple[str, str]]) -> str:
         f"second has no way in (if {b} flexes over {a}, a snap fit, the spec line "
         f"`flex: [{b}]` lets it in after {a}); "
     )
+
+
+def parse_overlap_ok(value, part_ids, source: str) -> tuple[tuple[str, str], ...]:
+    """The ``overlap_ok:`` list of a spec: pairs of part ids whose overlap in the file is as
+    modelled (a press fit, a modelled thread, a visual asset's pieces), taken as touching
+    (:func:`cad.fits.accepted_overlap`); a one-line ValueError for anything else.
+    ``value`` is ``[[a, b], [c, d]]`` (one pair: ``[a, b]``); ``part_ids`` and ``source``
+    as for :func:`parse_flex`.
+    """
+    if value is None:
+        return ()
+    if isinstance(value, list) and len(value) == 2 and all(isinstance(v, str) for v in value):
+        value = [value]
+    pairs = []
+    for pair in value if isinstance(value, list) else [value]:
+        if not (isinstance(pair, list) and len(pair) == 2):
+            raise ValueError(
+                f"{source}: {OVERLAP_KEY}: expected pairs of part ids ([[a, b], ...]), got {pair!r}"
+            )
+        a, b = (str(v) for v in pair)
+        for part in (a, b):
+            if part_ids and part not in part_ids:
+                raise ValueError(f"{source}: {OVERLAP_KEY}: unknown part {part!r}")
+        if a == b:
+            raise ValueError(f"{source}: {OVERLAP_KEY}: a pair of one part {a!r}")
+        pairs.append((a, b))
+    return tuple(pairs)

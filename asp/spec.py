@@ -27,6 +27,8 @@ An ``assembly.yaml`` names everything the planner needs besides the part geometr
     penetration_tol: 0.3               # mm, largest overlap that counts as touching
     flex: [lever_housing]              # snap fits: flexes over the parts it locks with
                                        # while inserted (asp/cad_keys.py)
+    overlap_ok: [[pin, block]]         # pairs overlapping as modelled (press fit, thread,
+                                       # visual asset): taken as touching (cad/fits.py)
                                        # (both default to cad/tolerances.py's per-part rule;
                                        # --contact-tol / --penetration-tol override them)
     subassemblies:                     # built on their own, then inserted as one unit
@@ -73,7 +75,7 @@ from pathlib import Path
 
 import networkx as nx
 
-from asp.cad_keys import parse_flex
+from asp.cad_keys import parse_flex, parse_overlap_ok
 from asp.game.dag import MAX_COST
 from asp.game.rules import COST_MODELS
 from cad.bom import PartRecord, part_records, refuse_unknown_keys
@@ -90,7 +92,7 @@ SPEC_FILE = "assembly.yaml"
 TOP_KEYS = (
     "name", "units", "parts", "agents", "tools", "base_part", "gravity", "gripper_approach",
     "constraints", "turn_model", "cost", "operations", "credit", "max_states", "subassemblies",
-    "contact_tol", "penetration_tol", "frame", "flex",
+    "contact_tol", "penetration_tol", "frame", "flex", "overlap_ok",
 )  # fmt: skip
 """The top-level keys of ``assembly.yaml``; any other is refused."""
 OPERATION_KEYS = (
@@ -224,6 +226,9 @@ class AssemblySpec:
     gravity are axes of the build frame. None: the file's own frame."""
     flex: tuple[str, ...] = ()
     """Parts that flex while inserted (``flex:``, :mod:`asp.cad_keys`)."""
+    overlap_ok: tuple[tuple[str, str], ...] = ()
+    """Pairs of parts whose overlap in the file is as modelled, taken as touching
+    (``overlap_ok:``, :mod:`asp.cad_keys`)."""
 
     @property
     def op_ids(self) -> tuple[str, ...]:
@@ -444,6 +449,7 @@ class _Parser:
             max_states=max_states,
             frame=frame,
             flex=parse_flex(data.get("flex"), part_ids, self.source),
+            overlap_ok=parse_overlap_ok(data.get("overlap_ok"), part_ids, self.source),
             **tols,
         )
         raw_units = self.mapping(data.get("subassemblies"), "subassemblies")

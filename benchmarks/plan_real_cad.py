@@ -2,13 +2,15 @@
 
 For each assembly (a CAD file, a folder of part meshes or an ``assembly.yaml``), in a child
 process of its own: ``asmplan plan PATH -o OUT`` with default settings (the command line, a
-time limit per assembly), then :func:`asp.graph.checker.check_line` on the plan's principal line
-against relations loaded afresh from the same file. Prints one row per assembly: parts, parts
-``held``, subassemblies, length unit, the generated spec's gravity, states, seconds, peak
-memory of the plan command, TCT, W*, the CP-SAT status and the checker's verdict, or the
-error (the command's last stderr line).
+time limit per assembly), then :func:`asp.graph.checker.check_line` on the plan's principal
+line against relations loaded afresh from the same file. Prints one row per assembly: format,
+parts, parts ``held``, subassemblies, length unit and size, the generated spec's gravity and
+why (``asp/fromcad/gravity.py``), the exit code, seconds, peak memory of the plan command,
+states, TCT, W*, the CP-SAT status and the checker's verdict, or the error (the command's
+last stderr line, cut; below the table, whole).
 
-Assemblies, by default: the Fabrica assemblies in ``../shared/data/cad/fabrica/``, the built
+Assemblies, by default: the Fabrica assemblies in ``../shared/data/cad/fabrica/`` (or
+``$ASMPLAN_FABRICA``), the built
 rod tower, bolted bracket, finger box, gear pair and bearing stack (tests/cad), and every
 public CAD file found under the folders of ``$ASMPLAN_REAL_CAD`` (``:``-separated; default
 ``/tmp/realcad``), skipped when absent: STEP, 3DXML, GLB/glTF, 3MF and OBJ files, and
@@ -35,24 +37,32 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))  # run from a checkout
 
-FABRICA = ROOT.parent / "shared" / "data" / "cad" / "fabrica"
+FABRICA = Path(
+    os.environ.get("ASMPLAN_FABRICA", ROOT.parent / "shared" / "data" / "cad" / "fabrica")
+)
 BUILT = ("rod_tower", "bolted_bracket", "finger_box", "gear_pair", "bearing_stack", "tilted_pins")
 SCENES = {".step", ".stp", ".3dxml", ".glb", ".gltf", ".3mf"}
 MESHES = {".obj", ".stl", ".ply", ".off"}
 COLUMNS = (
+    "format",
     "parts",
     "held",
     "units",
     "unit",
-    "gravity",
-    "states",
+    "down",
+    "exit",
     "total_s",
     "peak_mb",
+    "states",
     "tct",
     "w_star",
     "cpsat",
     "checker",
 )
+HEADER = (
+    "assembly", "format", "parts", "held", "units", "unit, size", "down (why)", "exit", "s",
+    "peak MB", "states", "TCT", "W*", "CP-SAT", "checker",
+)  # fmt: skip
 
 
 def built(name: str, folder: Path) -> Path:
@@ -102,7 +112,13 @@ def source_unit(path: str) -> str:
 
 
 def check_plan(path: str, doc: dict) -> str:
-    """``"ok"`` if the independent checker accepts the plan's principal line, else why not."""
+    """``"ok"`` if the independent checker accepts the plan's principal line, else why not.
+
+    The spec is loaded afresh from ``path``; the plan's units are added (each inserted by
+    an operation named as the unit), each operation is ``held`` as the plan says (what it
+    claims an agent holds), and each unit is built along its workspace's gravity."""
+    from dataclasses import replace
+
     from asmplan import pipeline
     from asp.graph.checker import PlanCheckError, check_line, plan_operations
     from asp.spec import with_subassemblies
@@ -110,11 +126,14 @@ def check_plan(path: str, doc: dict) -> str:
     assembly = pipeline.load(path, on_step=lambda _: None)
     spec = assembly.spec
     units = doc.get("subassemblies") or {}
-    if units:
-        spec = with_subassemblies(spec, units.items())
-    ops = plan_operations(doc)
+    own = {u for u, _ in spec.subassemblies}
+    spec = with_subassemblies(spec, [(u, ms) for u, ms in units.items() if u not in own])
+    held = {op: bool(info.get("held")) for op, info in doc["operations"].items()}
+    ops = tuple(replace(op, held=held.get(op.id, op.held)) for op in spec.operations)
+    spec = replace(spec, operations=ops)
+    down = {w["id"]: w["gravity"] for w in doc.get("workspaces") or () if w["id"] != "main"}
     try:
-        check_line(spec, assembly.relations, ops)
+        check_line(spec, assembly.relations, plan_operations(doc), units=units, gravity=down)
     except PlanCheckError as exc:
         return f"REJECTED: {exc}"
     return "ok"
@@ -123,7 +142,7 @@ def check_plan(path: str, doc: dict) -> str:
 def plan_one(path: str, out: str, timeout: float) -> dict:
     """Run ``asmplan plan path -o out`` in a child and check its plan (this process is a
     child of :func:`main`, so its children's peak memory is the plan command's)."""
-    row: dict = {"assembly": Path(path).name}
+    row: dict = {"assembly": Path(path).name, "format": source_format(path)}
     cmd = [sys.executable, "-c", "from asmplan.cli import main; main()", "plan", path, "-o", out]
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     t0 = time.perf_counter()
@@ -140,14 +159,17 @@ def plan_one(path: str, out: str, timeout: float) -> dict:
     if run is None:
         return row
     text = run.stdout + run.stderr
+    row["exit"] = run.returncode
     held = re.search(r"held: true for ([^(]*)\(", text)
     row["held"] = len(held.group(1).split(",")) if held else 0
-    gravity = re.search(r"generated spec: gravity (\S+):", text)
-    row["gravity"] = gravity.group(1) if gravity else ""
+    gravity = re.search(r"generated spec: gravity (\S+): (.*)", text)
+    row["down"] = f"{gravity.group(1)}: {gravity.group(2).strip()}" if gravity else ""
+    parts = re.search(r"generated a spec from .* \((\d+) parts", text)
+    row["parts"] = int(parts.group(1)) if parts else ""
     row["unit"] = source_unit(path)
     if run.returncode != 0:
         lines = [s for s in run.stderr.splitlines() if s.strip()]
-        row["error"] = lines[-1][:400] if lines else f"exit code {run.returncode}"
+        row["error"] = lines[-1] if lines else f"exit code {run.returncode}"
         return row
     doc = json.loads((Path(out) / "plan.json").read_text())
     sched = doc.get("schedule") or {}
@@ -166,13 +188,25 @@ def plan_one(path: str, out: str, timeout: float) -> dict:
     return row
 
 
+def source_format(path: str) -> str:
+    """The CAD format of an assembly: its file's suffix, or the meshes of a folder."""
+    p = Path(path)
+    if p.is_file():
+        return p.suffix.lstrip(".").upper()
+    kinds = sorted(
+        {f.suffix.lstrip(".").upper() for f in p.iterdir() if f.suffix.lower() in MESHES}
+    )
+    return f"{'/'.join(kinds)} folder" if kinds else "folder"
+
+
 def print_row(row: dict) -> None:
+    """One Markdown row: an error goes in the checker's column, cut to 200 characters."""
+    cells = [str(row.get(c, "")) for c in COLUMNS[:-1]]
+    last = row.get("checker", "")
     if "error" in row:
-        cells = [str(row.get(c, "")) for c in ("parts", "held", "units", "unit", "gravity")]
-        cells += ["", str(row.get("total_s", "")), str(row.get("peak_mb", ""))]
-        print(f"| {row['assembly']} | " + " | ".join(cells) + f" | error: {row['error']} |")
-    else:
-        print(f"| {row['assembly']} | " + " | ".join(str(row.get(c, "")) for c in COLUMNS) + " |")
+        error = row["error"].removeprefix("asmplan: error: ")
+        last = f"error: {error[:200]}{' ...' if len(error) > 200 else ''}"
+    print(f"| {row['assembly']} | " + " | ".join(cells) + f" | {last} |")
     sys.stdout.flush()
 
 
@@ -200,8 +234,9 @@ def main(argv: list[str]) -> None:
                 else:
                     print(f"skipped {folder}: not found", file=sys.stderr)
         out_root = Path(args.out) if args.out else Path(tmp) / "plans"
-        print("| assembly | " + " | ".join(COLUMNS) + " |")
-        print("|---" * (len(COLUMNS) + 1) + "|")
+        print("| " + " | ".join(HEADER) + " |")
+        print("|---" * len(HEADER) + "|")
+        errors = []
         for k, path in enumerate(paths):
             out = out_root / f"{k:03d}_{Path(path).name}"
             run = subprocess.run(
@@ -215,6 +250,11 @@ def main(argv: list[str]) -> None:
                 row = {"assembly": Path(path).name, "error": run.stderr.strip()[-300:]}
             row["assembly"] = str(path)
             print_row(row)
+            if "error" in row:
+                errors.append(f"{row['assembly']}: {row['error']}")
+        if errors:
+            print("\nThe messages of the assemblies that do not plan, whole:\n")
+            print("\n".join(f"- {e}" for e in errors))
 
 
 if __name__ == "__main__":

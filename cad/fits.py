@@ -23,6 +23,14 @@ An overlap that is not a fit (a face sunk into another part, a part placed wrong
 that needs more than the share stays the one-line error naming the pair and the depth.
 With an explicit penetration tolerance (``--penetration-tol``, the spec's
 ``penetration_tol``) there are no fits: every pair has exactly that tolerance.
+
+A pair the spec accepts (``overlap_ok:``, :mod:`asp.cad_keys`: a press fit, a modelled
+thread, the pieces of a visual asset) is taken as touching whatever its shape
+(:func:`accepted_overlap`): its inner part is eroded for that pair by the least that
+separates the two, up to :data:`ACCEPTED_SHARE` (0.4) of its thickness, as a fit without the
+hole test. A pair nested deeper (an axle drawn through a visual body shell) passes
+*through*: the two touch and rest on each other along every direction and neither blocks
+the other (``Relations.through``; a checker does not test the pair against each other).
 """
 
 from __future__ import annotations
@@ -46,6 +54,8 @@ from cad.tolerances import Tolerances, part_thickness
 
 FIT_SHARE = 0.2
 """Largest extra erosion of the inner part of a fit, as a share of its thickness."""
+ACCEPTED_SHARE = 0.4
+"""Largest extra erosion of the inner part of a pair the spec accepts (``overlap_ok:``)."""
 _BISECTIONS = 10
 
 
@@ -59,6 +69,9 @@ class Fit:
         Part indices: the part in the hole and the part with the hole.
     extra : float
         Extra erosion of the inner part for this pair (mm).
+    through : bool
+        An accepted pair nested too deep to part: they touch and support each other along
+        every direction, neither blocks the other (:func:`accepted_overlap`).
     tc, tt, sp : np.ndarray
         Contact, freedom and support of the pair, shape ``(2, 2, 6)``, order
         ``(inner, outer)``.
@@ -70,6 +83,7 @@ class Fit:
     tc: np.ndarray
     tt: np.ndarray
     sp: np.ndarray
+    through: bool = False
 
     def write_into(self, tc: np.ndarray, tt: np.ndarray, sp: np.ndarray) -> None:
         """Replace the pair's rows of the ``(n, n, 6)`` tables by the fit's."""
@@ -81,8 +95,11 @@ class Fit:
                         full[idx[r], idx[c]] = pair[r, c]
 
 
-def find_fits(assembly: Assembly, tols: Tolerances, eroded) -> list[Fit]:
+def find_fits(assembly: Assembly, tols: Tolerances, eroded, accepted=()) -> list[Fit]:
     """Every pair overlapping deeper than its tolerance, as a fit.
+
+    ``accepted``: pairs of part ids the spec accepts as overlapping (``overlap_ok:``):
+    each is taken as touching (:func:`accepted_overlap`), whatever the tolerance.
 
     Raises
     ------
@@ -90,8 +107,13 @@ def find_fits(assembly: Assembly, tols: Tolerances, eroded) -> list[Fit]:
         Pairs that are not fits, all in one line: ``parts 'a' and 'b' interpenetrate by
         about X mm ...`` (or ``N pairs of parts interpenetrate ...``).
     """
+    ids = assembly.ids
+    ok = {frozenset(pair) for pair in accepted}
     fits, wrong = [], []
     for overlap in overlaps(assembly, tols, eroded):
+        if frozenset((ids[overlap.a], ids[overlap.b])) in ok:
+            fits.append(accepted_overlap(assembly, tols, eroded, overlap.a, overlap.b))
+            continue
         fit = None if tols.explicit else as_fit(assembly, tols, eroded, overlap.a, overlap.b)
         if fit is None:
             wrong.append(overlap)
@@ -104,10 +126,39 @@ def find_fits(assembly: Assembly, tols: Tolerances, eroded) -> list[Fit]:
 
 def as_fit(assembly: Assembly, tols: Tolerances, eroded, a: int, b: int) -> Fit | None:
     """The fit of overlapping parts ``a`` and ``b``, or None when they are not one."""
+    parted = _separated(assembly, tols, eroded, a, b, FIT_SHARE)
+    if parted is None:
+        return None
+    inner, outer, extra = parted
+    fit = _pair_fit(assembly, tols, inner, outer, extra)
+    for axis in range(3):
+        if (
+            fitted_across(fit.tc, fit.tt, axis)[0, 1]
+            and fit.tt[0, 1, 2 * axis : 2 * axis + 2].any()
+        ):
+            return fit
+    return None
+
+
+def accepted_overlap(assembly: Assembly, tols: Tolerances, eroded, a: int, b: int) -> Fit:
+    """Parts ``a`` and ``b``, overlapping as the spec accepts, taken as touching: the
+    smaller eroded for this pair by the least that parts them, or, nested deeper than
+    :data:`ACCEPTED_SHARE` of its thickness, passing through the other (module docstring)."""
+    parted = _separated(assembly, tols, eroded, a, b, ACCEPTED_SHARE)
+    if parted is None:
+        every = np.ones((2, 2, 6), dtype=bool)
+        return Fit(a, b, 0.0, every, every, every, through=True)
+    return _pair_fit(assembly, tols, *parted)
+
+
+def _separated(assembly, tols, eroded, a: int, b: int, share: float):
+    """``(inner, outer, extra)``: the smaller part (by bounding-box diagonal) and the
+    least extra erosion of it, up to ``share`` of its thickness, that parts it from the
+    other's eroded mesh (bisection); None when that is not enough."""
     sizes = [float(np.linalg.norm(np.ptp(assembly.parts[k].bounds, axis=0))) for k in (a, b)]
     inner, outer = (a, b) if sizes[0] <= sizes[1] else (b, a)
     mesh = assembly.parts[inner].mesh
-    limit = FIT_SHARE * part_thickness(mesh)
+    limit = share * part_thickness(mesh)
 
     def apart(extra: float) -> bool:
         shrunk = offset_mesh(mesh, -(float(tols.shrink[inner]) + extra))
@@ -119,15 +170,17 @@ def as_fit(assembly: Assembly, tols: Tolerances, eroded, a: int, b: int) -> Fit 
     for _ in range(_BISECTIONS):
         mid = 0.5 * (lo + hi)
         lo, hi = (lo, mid) if apart(mid) else (mid, hi)
+    return inner, outer, hi
+
+
+def _pair_fit(assembly: Assembly, tols: Tolerances, inner: int, outer: int, extra: float) -> Fit:
+    """The pair's contact, freedom and support with the inner part shrunk ``extra`` more."""
     pair = Assembly(parts=(assembly.parts[inner], assembly.parts[outer]), units=assembly.units)
-    shrink = np.array([tols.shrink[inner] + hi, tols.shrink[outer]], dtype=float)
+    shrink = np.array([tols.shrink[inner] + extra, tols.shrink[outer]], dtype=float)
     reach = None if tols.reach is None else np.asarray(tols.reach)[[inner, outer]]
     pair_tols = Tolerances(tols.contact, shrink, tols.explicit, reach)
     pair_eroded = eroded_meshes(pair, shrink)
     tc = contact_relation(pair, penetration_tol=pair_tols)
     tt = translational_freedom(pair, penetration_tol=pair_tols, check=False, eroded=pair_eroded)
-    for axis in range(3):
-        if fitted_across(tc, tt, axis)[0, 1] and tt[0, 1, 2 * axis : 2 * axis + 2].any():
-            sp = support_relation(pair, pair_tols, pair_eroded, tc, tt)
-            return Fit(inner, outer, hi, tc, tt, sp)
-    return None
+    sp = support_relation(pair, pair_tols, pair_eroded, tc, tt)
+    return Fit(inner, outer, extra, tc, tt, sp)

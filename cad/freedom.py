@@ -360,30 +360,49 @@ def _centred(a: trimesh.Trimesh, b: trimesh.Trimesh) -> tuple[trimesh.Trimesh, t
 
 
 def interpenetration_error(assembly: Assembly, tols, found: list[Overlap]) -> GeometryError:
-    """The one-line error for every pair in ``found`` (the first :data:`MAX_NAMED` named)."""
+    """The one-line error for every pair in ``found`` (the first :data:`MAX_NAMED` named),
+    ending with the one spec line that accepts them all (:func:`overlap_line`) unless the
+    unit is wrong; its ``pairs`` attribute holds the pairs' part ids."""
     parts = assembly.parts
     first = found[0]
-    hint = unit_hint(assembly, first.a, first.b) or _joining_line(parts[first.a], parts[first.b])
-    tail = f"; {hint}" if hint else ""
+    pairs = [(parts[o.a].id, parts[o.b].id) for o in found]
+    hint = unit_hint(assembly, first.a, first.b)
+    if not hint:
+        join = joining_line(parts[first.a], parts[first.b]) if len(found) == 1 else ""
+        hint = (
+            f"if {'they overlap' if len(found) == 1 else 'these overlaps are'} as modelled (a "
+            f"press fit, a thread, a visual asset's pieces), the spec line `{overlap_line(pairs)}`"
+            f" takes {'the pair' if len(found) == 1 else 'each pair'} as touching"
+            + (f"; {join}" if join else "")
+            + " (`asmplan init` writes the spec)"
+        )
     if len(found) == 1:
-        return GeometryError(
+        error = GeometryError(
             f"parts {parts[first.a].id!r} and {parts[first.b].id!r} interpenetrate by "
             f"{first.text()} (penetration tolerance of this pair {tols.pair(first.a, first.b):.3g}"
-            f" mm){tail}"
+            f" mm); {hint}"
         )
-    named = "; ".join(
-        f"{parts[o.a].id!r} and {parts[o.b].id!r} by {o.text()} (tolerance "
-        f"{tols.pair(o.a, o.b):.3g} mm)"
-        for o in found[:MAX_NAMED]
-    )
-    more = f"; and {len(found) - MAX_NAMED} more" if len(found) > MAX_NAMED else ""
-    return GeometryError(
-        f"{len(found)} pairs of parts interpenetrate deeper than their tolerance: {named}{more}"
-        + tail
-    )
+    else:
+        named = "; ".join(
+            f"{parts[o.a].id!r} and {parts[o.b].id!r} by {o.text()} (tolerance "
+            f"{tols.pair(o.a, o.b):.3g} mm)"
+            for o in found[:MAX_NAMED]
+        )
+        more = f"; and {len(found) - MAX_NAMED} more" if len(found) > MAX_NAMED else ""
+        error = GeometryError(
+            f"{len(found)} pairs of parts interpenetrate deeper than their tolerance: "
+            f"{named}{more}; {hint}"
+        )
+    error.pairs = tuple(pairs)
+    return error
 
 
-def _joining_line(a, b) -> str:
+def overlap_line(pairs) -> str:
+    """The ``overlap_ok:`` spec line accepting ``pairs`` (part ids) as modelled."""
+    return "overlap_ok: [" + ", ".join(f"[{a}, {b}]" for a, b in pairs) + "]"
+
+
+def joining_line(a, b) -> str:
     """The spec line that plans two parts of one scene file as one rigid part (their
     meshes together, :mod:`cad.merging`), or "" when they are not nodes of one file."""
     file_a, _, node_a = a.source.partition("#")
@@ -394,7 +413,7 @@ def _joining_line(a, b) -> str:
     return (
         f"if {a.id!r} and {b.id!r} are one component, plan them as one rigid part: in the "
         f"spec's parts, `- {{id: {a.id}, file: '{name}#{node_a}+{node_b}'}}` in place of both, "
-        f"and no operation placing {b.id} (`asmplan init` writes the spec)"
+        f"and no operation placing {b.id}"
     )
 
 

@@ -55,6 +55,10 @@ class Relations:
     fits : tuple of (str, str, float)
         Screws, studs and pins drawn into a hole deeper than the pair's tolerance
         (:mod:`cad.fits`): (inner part, part with the hole, extra tolerance in mm).
+    through : tuple of (str, str)
+        Pairs the spec accepts as overlapping (``overlap_ok:``) that are nested too deep to
+        part: they touch and rest on each other along every direction, neither blocks the
+        other (:func:`cad.fits.accepted_overlap`).
     """
 
     parts: tuple[str, ...]
@@ -69,6 +73,7 @@ class Relations:
     directions: tuple[str, ...] = DIRECTIONS
     sp: np.ndarray | None = None
     fits: tuple[tuple[str, str, float], ...] = ()
+    through: tuple[tuple[str, str], ...] = ()
 
     def __post_init__(self) -> None:
         n = len(self.parts)
@@ -108,6 +113,7 @@ class Relations:
             "tt": self.tt.tolist(),
             **({} if self.sp is None else {"sp": self.sp.tolist()}),
             **({} if not self.fits else {"fits": [list(f) for f in self.fits]}),
+            **({} if not self.through else {"through": [list(t) for t in self.through]}),
         }
 
 
@@ -117,6 +123,7 @@ def compute_relations(
     contact_tol: float | None = None,
     penetration_tol: float | None = None,
     progress: bool = False,
+    overlap_ok=(),
 ) -> Relations:
     """Contact, translational freedom and support of an assembly.
 
@@ -132,6 +139,9 @@ def compute_relations(
         ``(i, j)`` tolerates ``s_i + s_j`` (:mod:`cad.tolerances`).
     progress : bool
         Show tqdm progress bars over the pairs.
+    overlap_ok : iterable of (str, str)
+        Pairs of part ids whose overlap is as modelled (the spec's ``overlap_ok:``): each
+        taken as touching (:func:`cad.fits.accepted_overlap`).
 
     Returns
     -------
@@ -146,7 +156,7 @@ def compute_relations(
     """
     tols = resolve_tolerances(assembly, contact_tol, penetration_tol)
     eroded = eroded_meshes(assembly, tols.shrink)
-    fits = find_fits(assembly, tols, eroded)
+    fits = find_fits(assembly, tols, eroded, overlap_ok)
     tc = contact_relation(assembly, penetration_tol=tols, progress=progress)
     tt = _freedom(assembly, penetration_tol=tols, progress=progress, check=False, eroded=eroded)
     sp = support_relation(assembly, tols, eroded, tc, tt, progress=progress)
@@ -167,7 +177,10 @@ def compute_relations(
         part_reach=() if tols.reach is None else tuple(float(x) for x in tols.reach),
         open_parts=tuple(p.id for p in assembly.parts if not p.mesh.is_watertight),
         sp=sp,
-        fits=tuple((ids[f.inner], ids[f.outer], _up(float(f.extra))) for f in fits),
+        fits=tuple(
+            (ids[f.inner], ids[f.outer], _up(float(f.extra))) for f in fits if not f.through
+        ),
+        through=tuple((ids[f.inner], ids[f.outer]) for f in fits if f.through),
     )
 
 
@@ -184,7 +197,9 @@ def replay_rules(relations: Relations) -> dict:
         (part -> mm, or None when ``contact_tol`` holds for every pair),
         ``support_travel_factor``, ``support`` (the rules a part is supported by,
         :data:`cad.support.SUPPORT_RULES`), ``fits`` (``inner, outer, extra_shrink`` mm: the inner
-        part is shrunk by that much more against the outer one only) and ``open_parts``.
+        part is shrunk by that much more against the outer one only), ``through`` (pairs
+        accepted as overlapping, nested too deep to part: never tested against each other,
+        touching and resting on each other) and ``open_parts``.
     """
     ids = [str(p) for p in relations.parts]
     reach = tuple(getattr(relations, "part_reach", ()))
@@ -199,6 +214,7 @@ def replay_rules(relations: Relations) -> dict:
             {"inner": str(i), "outer": str(o), "extra_shrink": float(e)}
             for i, o, e in getattr(relations, "fits", ())
         ],
+        "through": [[str(a), str(b)] for a, b in getattr(relations, "through", ())],
         "open_parts": [str(p) for p in getattr(relations, "open_parts", ())],
     }
 

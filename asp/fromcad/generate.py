@@ -504,6 +504,7 @@ def decide_generated(
             contact_tol=spec.contact_tol,
             penetration_tol=spec.penetration_tol,
             progress=progress,
+            overlap_ok=spec.overlap_ok,
         )
         tolerances = {"contact_tol": spec.contact_tol, "penetration_tol": spec.penetration_tol}
         framed = replace(turn(spec.gravity if given_gravity else None, rotation), **tolerances)
@@ -548,6 +549,7 @@ def spec_text(
     from dataclasses import replace
 
     import cad
+    from cad.errors import GeometryError
     from cad.unit_hints import size_hint
 
     check_overrides(units, gravity)
@@ -555,9 +557,27 @@ def spec_text(
     size_note = size_hint(assembly)
     if size_note and on_note is not None:
         on_note(f"units: {size_note}")
-    relations = cad.compute_relations(
-        assembly, contact_tol=contact_tol, penetration_tol=penetration_tol
-    )
+    overlapping: tuple = ()  # pairs the file overlaps: the spec names them, commented
+    try:
+        relations = cad.compute_relations(
+            assembly, contact_tol=contact_tol, penetration_tol=penetration_tol
+        )
+    except GeometryError as exc:
+        overlapping = getattr(exc, "pairs", ())
+        if not overlapping:
+            raise
+        relations = cad.compute_relations(
+            assembly,
+            contact_tol=contact_tol,
+            penetration_tol=penetration_tol,
+            overlap_ok=overlapping,
+        )
+        if on_note is not None:
+            on_note(
+                f"overlaps: {len(overlapping)} pair(s) overlap deeper than their tolerance; "
+                "the spec's `overlap_ok:` line is written commented: uncomment it if they "
+                "overlap as modelled"
+            )
     turned: dict = {(data["gravity"], None): (data, assembly)}
 
     def turn(gravity: str | None, frame) -> AssemblySpec:
@@ -567,7 +587,12 @@ def spec_text(
         return replace(spec_from_dict(records[0], source=str(path)), generated=True)
 
     tolerances = {"contact_tol": contact_tol, "penetration_tol": penetration_tol}
-    generated = replace(spec_from_dict(data, source=str(path)), generated=True, **tolerances)
+    generated = replace(
+        spec_from_dict(data, source=str(path)),
+        generated=True,
+        overlap_ok=tuple(overlapping),
+        **tolerances,
+    )
     decided = decide_generated(generated, relations, assembly, turn, given_gravity=bool(gravity))
     spec, relations = decided.spec, decided.relations
     # the records along the chosen gravity, in the chosen frame
@@ -631,6 +656,7 @@ def spec_text(
         "cost: time                 # or steps (1 per operation)",
         _tolerance_line("contact_tol", contact_tol, "largest gap that counts as touching"),
         _tolerance_line("penetration_tol", penetration_tol, "largest overlap that still touches"),
+        *_overlap_lines(overlapping),
         "",
         "operations:   # one placement per part: base first, then from the lowest part up",
     ]
@@ -644,6 +670,19 @@ def spec_text(
             + (", held: true}" if op.held else "}")
         )
     return "\n".join(lines) + "\n"
+
+
+def _overlap_lines(pairs) -> list[str]:
+    """The commented ``overlap_ok:`` line of the pairs the file overlaps (none: no lines)."""
+    if not pairs:
+        return []
+    from cad.freedom import overlap_line
+
+    return [
+        f"# {len(pairs)} pair(s) overlap deeper than their tolerance in the file: uncomment if",
+        "# as modelled (a press fit, a thread, a visual asset's pieces): each pair touches",
+        f"# {overlap_line(pairs)}",
+    ]
 
 
 def _alike_lines(assembly) -> list[str]:

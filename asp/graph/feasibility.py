@@ -836,8 +836,8 @@ def load_relations(spec: AssemblySpec, *, progress: bool = False, geometry=None)
     Reads the meshes of the spec's parts (:func:`asp.fromcad.generate.spec_geometry`: in the
     spec's build frame) unless ``geometry`` (that ``cad.Assembly``, already read) is given,
     with the spec's
-    ``contact_tol`` and ``penetration_tol`` (None: the per-part rule), and its ``flex``
-    parts (:func:`asp.cad_keys.with_flex`).
+    ``contact_tol`` and ``penetration_tol`` (None: the per-part rule), its ``overlap_ok``
+    pairs and its ``flex`` parts (:func:`asp.cad_keys.with_flex`).
     """
     if not spec.has_geometry:
         return None
@@ -852,5 +852,6 @@ def load_relations(spec: AssemblySpec, *, progress: bool = False, geometry=None)
         contact_tol=spec.contact_tol,
         penetration_tol=spec.penetration_tol,
         progress=progress,
+        overlap_ok=spec.overlap_ok,
     )
     return with_flex(relations, spec.flex)

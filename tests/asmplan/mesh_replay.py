@@ -207,6 +207,9 @@ class Replay:
         # a unit built in another orientation (upside down) has its own gravity
         self.down = {w["id"]: vector(w.get("gravity", plan["gravity"])) for w in plan["workspaces"]}
         self.extra = {(f["inner"], f["outer"]): f["extra_shrink"] for f in geo.get("fits", [])}
+        # pairs accepted as overlapping, nested too deep to part: touching, resting on each
+        # other, never blocking each other
+        self.through = {frozenset(pair) for pair in geo.get("through", [])}
         pull = float(geo.get("free_edge_pull", 0.0))
         self.open = {p for p, m in self.meshes.items() if not m.is_watertight}
         said = set(geo.get("open_parts", self.open))
@@ -287,6 +290,8 @@ class Replay:
             raise Rejected(f"{where}: free_along is not the opposite of insert_along")
         for p in body:
             for j in there:
+                if frozenset((p, j)) in self.through:
+                    continue
                 hit = self.first_hit(p, j, d, self.path(p, j, d))
                 if hit is not None:
                     raise Rejected(
@@ -296,6 +301,7 @@ class Replay:
         down = self.down.get(ins["workspace"], self.gravity)
         rests = self.falls_into(body, there, down)
         gaps = {(p, j): self.plain[p].gap(self.plain[j]) for p in body for j in there}
+        gaps.update({(p, j): 0.0 for p, j in gaps if frozenset((p, j)) in self.through})
         touching = any(g <= self.contact(*pj) * 1.01 + 1e-6 for pj, g in gaps.items())
         if not touching and not rests:
             (p, j), gap = min(gaps.items(), key=lambda kv: kv[1])
@@ -315,6 +321,8 @@ class Replay:
         along gravity meets: a dowel in a blind hole), ``threaded`` (fitted across gravity
         around a part passing through it: a nut on its bolt); None when it would fall."""
         if self.falls_into(body, there, down):
+            return "rests"
+        if any(frozenset((p, j)) in self.through for p in body for j in there):
             return "rests"
         axis = int(np.argmax(np.abs(down)))
         for p in body:
