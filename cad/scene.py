@@ -337,11 +337,9 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
         meshes.append(mesh.apply_scale(rescale) if rescale != 1.0 else mesh)
         own = [original(node), str(geom_name)]
         anc = _3dxml_ancestors(node, references) if references else graph_anc
-        raw = (
-            best_raw(own + [original(a) for a in anc if a not in whole])
-            or plain_raw(own)
-            or best_raw([original(a) for a in anc])
-        )
+        # never the product's own name (the node over every part): no such part is in
+        # the tree; a part named by nothing is named by its shape (``alike_a``)
+        raw = best_raw(own + [original(a) for a in anc if a not in whole]) or plain_raw(own)
         names.append(display_name(original(node) if raw is None else raw))
         bases.append("part" if raw is None else part_id(raw))
         generic.append(raw is None or bool(_BODY_WORD.match(clean_name(raw))))
