@@ -7,6 +7,8 @@ greedy policies after each cycle (for the exact metrics of :mod:`asp.game.solve`
 
 from __future__ import annotations
 
+import time
+
 import numpy as np
 import torch
 
@@ -29,20 +31,34 @@ def action_probabilities(model, tables: GameTables, player: int, observer: Obser
     observer : Observer
         Maps nodes to the model's observations.
     """
-    policy = model.policy
     rows = tabulation_chunk(tables.n, observer)
-    parts = []
-    with torch.no_grad():
-        for lo in range(0, tables.n, rows):
-            obs = observer.batch(np.arange(lo, min(lo + rows, tables.n)))
-            obs_tensor, _ = policy.obs_to_tensor(obs)
-            parts.append(policy.get_distribution(obs_tensor).distribution.probs.cpu().numpy())
+    parts = [
+        _chunk(model, observer, lo, min(lo + rows, tables.n)) for lo in range(0, tables.n, rows)
+    ]
     probs = np.concatenate(parts) if parts else np.zeros((0, tables.max_moves))
     mask = tables.masks(player)
     probs = np.where(mask, probs.astype(np.float64), 0.0)
     total = probs.sum(axis=1, keepdims=True)
     uniform = mask / np.maximum(mask.sum(axis=1, keepdims=True), 1)
     return np.where(total > 0, probs / np.where(total > 0, total, 1.0), uniform)
+
+
+def _chunk(model, observer: Observer, lo: int, hi: int) -> np.ndarray:
+    """(hi - lo, max_moves) float32: the model's action probabilities at nodes ``lo:hi``
+    (invalid actions not masked)."""
+    policy = model.policy
+    with torch.no_grad():
+        obs_tensor, _ = policy.obs_to_tensor(observer.batch(np.arange(lo, hi)))
+        return policy.get_distribution(obs_tensor).distribution.probs.cpu().numpy()
+
+
+def tabulation_seconds(model, tables: GameTables, observer: Observer) -> float:
+    """The seconds of a tabulation over all nodes (:func:`action_probabilities`), from
+    its first chunk timed (every chunk but the last has as many nodes)."""
+    rows = tabulation_chunk(tables.n, observer)
+    t0 = time.perf_counter()
+    _chunk(model, observer, 0, min(rows, tables.n))
+    return (time.perf_counter() - t0) * -(-tables.n // rows)
 
 
 CHUNK_CELLS = 1 << 26
@@ -72,4 +88,4 @@ def tabulate(model, tables: GameTables, player: int, observer: Observer) -> np.n
     return greedy_policy(action_probabilities(model, tables, player, observer), tables, player)
 
 
-__all__ = ["NO_MOVE", "action_probabilities", "greedy_policy", "tabulate"]
+__all__ = ["NO_MOVE", "action_probabilities", "greedy_policy", "tabulate", "tabulation_seconds"]

@@ -39,7 +39,8 @@ from arl.envs import GameVecEnv, Observer, TurnEnv
 from arl.memory import check_training_size
 from arl.moves import AGENTS, NO_MOVE, GameTables
 from arl.runfolder import LOG_FORMAT, RunFolder
-from arl.tabulate import action_probabilities, tabulate
+from arl.tabulate import action_probabilities, tabulate, tabulation_seconds
+from asp.errors import GameError
 from asp.game import rules
 from asp.game.dag import HUMAN, ROBOT, GameDAG
 from asp.game.metrics import is_robust_optimal
@@ -320,6 +321,8 @@ def train(
     resume: bool = False,
     callback: CycleCallback | None = None,
     max_memory_gb: float | None = None,
+    max_cycle_seconds: float | None = None,
+    on_estimate: Callable[[CycleEstimate], None] | None = None,
 ) -> TrainResult:
     """Train a robust robot policy by alternating PPO against a learned adversarial human.
 
@@ -343,6 +346,13 @@ def train(
     max_memory_gb : float, optional
         Refuse (before anything heavy runs) a game whose estimated training memory is over
         this (default: three quarters of this machine's memory; :mod:`arl.memory`).
+    max_cycle_seconds : float, optional
+        Refuse (:class:`asp.errors.GameError`, before the run folder is touched) a game
+        whose cycle is estimated (:func:`estimate_cycle`) to take longer than this.
+    on_estimate : callable, optional
+        Called with the :class:`CycleEstimate` once it is within ``max_cycle_seconds``
+        (``asmplan train`` says it on stderr); without it and without a limit nothing is
+        estimated.
 
     Returns
     -------
@@ -353,6 +363,19 @@ def train(
         raise ValueError("resume: expected an output folder to resume from")
     check_training_size(dag, cfg, max_memory_gb)
     folder = None if output is None else RunFolder(output)
+    if max_cycle_seconds is not None or on_estimate is not None:
+        done = 0
+        if resume:  # a run that cannot be resumed says so first
+            folder.recover()
+            done = len(_check_resume(folder, graph_summary(dag), seed, cfg)["cycles"])
+        estimate = estimate_cycle(dag, cfg, seed, cycles_left=max(0, cfg.max_cycles - done))
+        if max_cycle_seconds is not None and estimate.seconds > max_cycle_seconds:
+            raise GameError(
+                f"training this game takes {estimate.text()}, over --max-cycle-seconds "
+                f"{max_cycle_seconds:g} (max_cycle_seconds): raise it, or train a smaller game"
+            )
+        if on_estimate is not None:
+            on_estimate(estimate)
     run = _start_run(dag, cfg, seed, folder, resume)
     try:
         bar = _progress(range(len(run.cycles), cfg.max_cycles), progress, len(run.cycles), cfg)
@@ -408,7 +431,7 @@ def _start_run(
     )
     if resume:
         folder.recover()
-        log = _check_resume(folder, run)
+        log = _check_resume(folder, run.summary, seed, cfg)
         run.cycles, run.rewards, run.wall_before = (
             log["cycles"],
             log["episode_rewards"],
@@ -469,15 +492,17 @@ def _train_cycle(run: _Run, cycle: int, folder: RunFolder | None) -> dict:
     return record
 
 
-def _train_phase(run: _Run, learner: int, cycle: int, folder: RunFolder | None) -> list[float]:
+def _train_phase(
+    run: _Run, learner: int, cycle: int, folder: RunFolder | None, tabulated: bool = True
+) -> list[float]:
     """Train ``learner`` for ``phase_steps`` against the other side, frozen; return the
-    rewards of the games it played.
+    rewards of the games it played (``tabulated``: see :func:`_freeze_opponent`).
 
     Every phase starts fresh games from seeds of ``(seed, cycle, learner)``, so that a
     resumed run repeats it exactly.
     """
     model = run.models[learner]
-    _freeze_opponent(run, learner)
+    _freeze_opponent(run, learner, tabulated)
     model.set_env(run.learning_env(learner), force_reset=True)
     model.set_random_seed(_phase_seed(run.seed, cycle, learner))
     logger = None
@@ -494,17 +519,18 @@ def _train_phase(run: _Run, learner: int, cycle: int, folder: RunFolder | None) 
     return recorder.rewards
 
 
-def _freeze_opponent(run: _Run, learner: int) -> None:
-    """Set the other side's current policy as the learner's frozen opponent."""
+def _freeze_opponent(run: _Run, learner: int, tabulated: bool = True) -> None:
+    """Set the other side's current policy as the learner's frozen opponent (not
+    ``tabulated``: a vectorised environment's opponent plays uniformly at random, as
+    before its first tabulation; :func:`estimate_cycle` times the tabulation apart)."""
     other, env = run.models.get(1 - learner), run.envs[learner]
     if not isinstance(env, GameVecEnv):  # the paper's: the frozen model plays every move
         env.env_method("set_opponent", other)
         return
     table = None  # tabulated once: one forward pass over all nodes
-    if other is not None and run.cfg.opponent_deterministic:
-        table = tabulate(other, run.tables, 1 - learner, run.observer)
-    elif other is not None:
-        table = action_probabilities(other, run.tables, 1 - learner, run.observer)
+    if other is not None and tabulated:
+        tab = tabulate if run.cfg.opponent_deterministic else action_probabilities
+        table = tab(other, run.tables, 1 - learner, run.observer)
     env.set_opponent(table, run.cfg.opponent_epsilon)
 
 
@@ -536,6 +562,107 @@ def _progress(iterable, enabled: bool, initial: int, cfg: TrainConfig):
     return tqdm(iterable, initial=initial, total=cfg.max_cycles, desc="cycles", unit="cycle")
 
 
+# ------------------------------------------------------------- the size check: time
+
+
+SAMPLE_STEPS = 256
+"""Game steps of the sample :func:`estimate_cycle` times (rounded to whole rollouts of
+``n_envs`` games)."""
+
+
+@dataclass(frozen=True)
+class CycleEstimate:
+    """The estimated seconds of a training cycle (:func:`estimate_cycle`).
+
+    Attributes
+    ----------
+    seconds : float
+        One cycle: every learner's phase and tabulations, and the check.
+    step_s, tabulation_s : float
+        One game step of PPO (rollout and updates) and one tabulation over all nodes.
+    cycles : int
+        The cycles still allowed (``max_cycles`` less those done).
+    nodes, edges, sample_steps : int
+    """
+
+    seconds: float
+    step_s: float
+    tabulation_s: float
+    cycles: int
+    nodes: int
+    edges: int
+    sample_steps: int
+
+    def text(self) -> str:
+        """``about 12 s a cycle (...), up to 20 min for 100 cycles``: one clause."""
+        return (
+            f"about {_duration(self.seconds)} a cycle ({self.nodes:,} nodes, {self.edges:,} "
+            f"edges; {1000 * self.step_s:.2f} ms a game step over a sample of "
+            f"{self.sample_steps:,}, {_duration(self.tabulation_s)} a tabulation of every "
+            f"node), up to {_duration(self.cycles * self.seconds)} for {self.cycles:,} "
+            f"cycle{'s' if self.cycles != 1 else ''}"
+        )
+
+
+def _duration(seconds: float) -> str:
+    """``40 ms``, ``0.4 s``, ``12 s``, ``7.5 min``, ``3.2 h``."""
+    if seconds < 0.1:
+        return f"{1000 * seconds:.0f} ms"
+    if seconds < 10:
+        return f"{seconds:.1f} s"
+    if seconds < 600:
+        return f"{seconds:.0f} s"
+    return f"{seconds / 60:.1f} min" if seconds < 3 * 3600 else f"{seconds / 3600:.1f} h"
+
+
+def estimate_cycle(
+    dag: GameDAG, cfg: TrainConfig, seed: int = 0, cycles_left: int | None = None
+) -> CycleEstimate:
+    """The seconds a cycle of training ``dag`` with ``cfg`` will take, from a sample.
+
+    The sample: throwaway models and games of the same configuration but rollouts of
+    :data:`SAMPLE_STEPS` game steps; one learner's phase is run twice (the first warms
+    up) and the second timed, and one chunk of a tabulation is timed
+    (:func:`arl.tabulate.tabulation_seconds`). A cycle is then every learner's
+    ``phase_steps`` (rounded up to whole rollouts, as PPO does) at the measured seconds
+    a step, a tabulation of the frozen opponent per phase (vectorised games), and one
+    tabulation per learner for the check. Nothing of the run folder is read or written.
+    A sample on a busy machine is slower, and a small game's phase, one long rollout in
+    the real configuration, pays PPO's overhead per rollout fewer times: the estimate
+    errs on the long side.
+    """
+    n_envs = cfg.n_envs
+    k = max(1, min(cfg.n_steps, SAMPLE_STEPS // n_envs))
+    sample = cfg.replace(n_steps=k, batch_size=min(cfg.batch_size, k * n_envs))
+    sample = sample.replace(phase_steps=k * n_envs)
+    run = _start_run(dag, sample, seed, None, False)
+    try:
+        step_s = tabulation_s = 0.0
+        if run.models:
+            learner = next(iter(run.models))
+            _train_phase(run, learner, 0, None, tabulated=False)  # warms up
+            t0 = time.perf_counter()
+            _train_phase(run, learner, 1, None, tabulated=False)
+            step_s = (time.perf_counter() - t0) / (k * n_envs)
+            tabulation_s = tabulation_seconds(run.models[learner], run.tables, run.observer)
+    finally:
+        for env in run.envs.values():
+            env.close()
+    rollout = cfg.n_steps * n_envs
+    phase = -(-cfg.phase_steps // rollout) * rollout * step_s
+    opponent = tabulation_s if cfg.vectorized and len(run.models) > 1 else 0.0
+    learners = len(run.models)
+    return CycleEstimate(
+        seconds=learners * (phase + opponent + tabulation_s),
+        step_s=step_s,
+        tabulation_s=tabulation_s,
+        cycles=cfg.max_cycles if cycles_left is None else int(cycles_left),
+        nodes=dag.n_nodes,
+        edges=dag.n_edges,
+        sample_steps=k * n_envs,
+    )
+
+
 def read_log(output: str | Path) -> dict:
     """The ``log.json`` in force in a run folder (``ValueError`` if missing or malformed)."""
     return RunFolder(output).read_log()
@@ -548,14 +675,15 @@ def _saved_config(folder: RunFolder, log: dict) -> TrainConfig:
         raise ValueError(f"{folder.log_path()}: malformed run log (config: {exc})") from None
 
 
-def _check_resume(folder: RunFolder, run: _Run) -> dict:
-    """The saved log, checked to belong to the same graph, seed and config as ``run``."""
-    out, cfg = folder.path, run.cfg
+def _check_resume(folder: RunFolder, summary: dict, seed: int, cfg: TrainConfig) -> dict:
+    """The saved log, checked to belong to the same graph (``summary``, of
+    :func:`graph_summary`), seed and config."""
+    out = folder.path
     log = folder.read_log()
-    if log["graph"]["fingerprint"] != run.summary["fingerprint"]:
+    if log["graph"]["fingerprint"] != summary["fingerprint"]:
         raise ValueError(f"resume: {out} was trained on a different graph")
-    if log["seed"] != run.seed:
-        raise ValueError(f"resume: {out} was trained with seed {log['seed']}, not {run.seed}")
+    if log["seed"] != seed:
+        raise ValueError(f"resume: {out} was trained with seed {log['seed']}, not {seed}")
     saved = _saved_config(folder, log)
     if saved.replace(max_cycles=cfg.max_cycles) != cfg:
         diff = [k for k, v in cfg.to_dict().items() if saved.to_dict()[k] != v]

@@ -163,6 +163,14 @@ def train_command(
         help="Refuse a game whose training needs more GB than this, before any work "
         "(default: 3/4 of this machine's memory; arl/memory.py).",
     ),
+    max_cycle_seconds: float | None = typer.Option(
+        None,
+        "--max-cycle-seconds",
+        min=0.001,
+        max=1e9,
+        help="Refuse, before training, a game whose cycle is estimated to take longer "
+        "(the estimate, from a short sample, is said on stderr either way).",
+    ),
 ) -> None:
     """Train a robust robot policy by alternating PPO against a learned adversarial human."""
     from arl.config import get_config
@@ -185,6 +193,8 @@ def train_command(
         progress=progress,
         resume=resume,
         max_memory_gb=max_memory,
+        max_cycle_seconds=max_cycle_seconds,
+        on_estimate=lambda e: typer.echo(f"training: {e.text()}", err=True),
     )
     status = "converged" if result.converged else "stopped"
     typer.echo(
