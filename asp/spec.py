@@ -81,6 +81,7 @@ from asp.game.rules import COST_MODELS
 from cad.bom import PartRecord, part_records, refuse_unknown_keys
 from cad.directions import DIRECTIONS
 from cad.frame import parse_frame
+from cad.numbers import WRITTEN_PLAINLY, plain_number
 from cad.tolerances import checked_tolerance
 from cad.units import unit_scale
 from cad.yamlfile import read_yaml
@@ -336,10 +337,11 @@ class _Parser:
 
     # ------------------------------------------------------------------ scalars
     def number(self, value, key: str, *, minimum: float = 0.0) -> float:
-        try:
-            x = float(value)
-        except (TypeError, ValueError):
-            raise self.fail(key, f"expected a number, got {value!r}") from None
+        """``value`` as a number (:func:`cad.numbers.plain_number`: ``010``, ``1_000``,
+        ``1:30`` and ``true`` are refused) in ``[minimum, MAX_COST]``."""
+        x = plain_number(value)
+        if x is None:
+            raise self.fail(key, f"expected a number {WRITTEN_PLAINLY}, got {value!r}")
         if not x >= minimum or x == float("inf"):
             raise self.fail(key, f"expected a finite number >= {minimum:g}, got {value!r}")
         if x > MAX_COST:

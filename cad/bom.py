@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from cad.errors import AsmplanError
+from cad.numbers import WRITTEN_PLAINLY, plain_integer
 from cad.yamlfile import read_yaml
 
 PART_KEYS = ("id", "name", "file", "quantity", "type", "shape")
@@ -155,12 +156,13 @@ def _text(value: Any) -> str:
 
 
 def _quantity(value: Any, where: str) -> int:
-    """A positive integer; integer-looking text (``"2"``, as CSV gives) is accepted."""
+    """A positive integer written plainly (:func:`cad.numbers.plain_integer`: text such as
+    ``"2"``, as CSV gives, is accepted; ``010``, ``1_000`` or ``true`` are not)."""
     if value is None or value == "":
         return 1
-    number = value
-    if isinstance(value, str) and value.strip().isdigit():
-        number = int(value.strip())
-    if not isinstance(number, int) or isinstance(number, bool) or number < 1:
-        raise AsmplanError(f"{where}: quantity {value!r} is not a positive integer")
+    number = plain_integer(value)
+    if number is None or number < 1:
+        raise AsmplanError(
+            f"{where}: quantity {value!r} is not a positive integer {WRITTEN_PLAINLY}"
+        )
     return number

@@ -28,6 +28,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from cad.numbers import WRITTEN_PLAINLY, plain_number
+
 Rotation = tuple[tuple[float, float, float], ...]
 """A 3x3 rotation, row by row: ``x_build = R @ x_file``."""
 
@@ -147,10 +149,9 @@ def parse_frame(value) -> Rotation | None:
 
 
 def _float(value, what: str) -> float:
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{what}: expected a number, got {value!r}") from None
+    x = plain_number(value)
+    if x is None:
+        raise ValueError(f"{what}: expected a number {WRITTEN_PLAINLY}, got {value!r}")
     if not np.isfinite(x):
         raise ValueError(f"{what}: expected a finite number, got {value!r}")
     return x

@@ -86,6 +86,7 @@ import numpy as np
 import trimesh
 
 from cad.errors import GeometryError
+from cad.numbers import plain_number
 
 DEFAULT_CONTACT_TOL_MM = 0.01
 """Smallest default contact tolerance (the floor of the per-part rule)."""
@@ -127,12 +128,9 @@ def checked_tolerance(value, name: str) -> float | None:
         return None
     low = "0" if name == "contact_tol" else "above 0"
     wanted = f"{name}: expected a number of mm from {low} to {TOL_LIMIT_MM:g}, got {value!r}"
-    if isinstance(value, bool):
+    number = plain_number(value)
+    if number is None:
         raise GeometryError(wanted)
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise GeometryError(wanted) from None
     too_low = number < 0 if name == "contact_tol" else number <= 0
     if not np.isfinite(number) or too_low or number > TOL_LIMIT_MM:
         raise GeometryError(wanted)

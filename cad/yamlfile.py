@@ -1,4 +1,5 @@
-"""Read YAML safely: no code, bounded alias expansion, optionally decimals kept as text.
+"""Read YAML safely: no code, bounded alias expansion, numbers only in plain decimal
+(:class:`PlainNumbers`), optionally decimals kept as text.
 
 YAML aliases share one node, so a 1 KB file of nested aliases ("billion laughs") loads in
 microseconds but expands to gigabytes once written out (a plan echoes its input). The
@@ -8,25 +9,54 @@ loaded document is therefore measured as if every alias were expanded, and refus
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from typing import Any
 
 import yaml
 
 from cad.errors import AsmplanError
+from cad.numbers import PLAIN_INTEGER
 
 MAX_EXPANDED_VALUES = 1_000_000
 """Most values (scalars, lists, mappings, counted with aliases expanded) a file may hold."""
 
 
-class DecimalsAsText(yaml.SafeLoader):
-    """SafeLoader that keeps decimal-looking scalars as strings (``1.10`` stays ``"1.10"``)."""
+_INT, _FLOAT = "tag:yaml.org,2002:int", "tag:yaml.org,2002:float"
 
 
-DecimalsAsText.yaml_implicit_resolvers = {
-    key: [(tag, regexp) for tag, regexp in resolvers if tag != "tag:yaml.org,2002:float"]
-    for key, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.copy().items()
-}
+class PlainNumbers(yaml.SafeLoader):
+    """SafeLoader that reads only numbers written in plain decimal as numbers
+    (:mod:`cad.numbers`): ``010``, ``0x10``, ``1_000``, ``1:30`` stay text, as written,
+    for the check that names them (``.inf`` and ``.nan`` are still floats)."""
+
+
+class DecimalsAsText(PlainNumbers):
+    """:class:`PlainNumbers` that keeps decimal-looking scalars as strings too (``1.10``
+    stays ``"1.10"``)."""
+
+
+def _resolvers(keep_floats: bool) -> dict:
+    """The implicit resolvers of SafeLoader with ints (and floats) in plain decimal only."""
+    plain_float = re.compile(
+        rf"^(?:{PLAIN_INTEGER}\.[0-9]*(?:[eE][-+]?[0-9]+)?|[-+]?\.[0-9]+(?:[eE][-+]?[0-9]+)?"
+        r"|[-+]?\.(?:inf|Inf|INF)|\.(?:nan|NaN|NAN))$"
+    )
+    plain = {_INT: re.compile(rf"^{PLAIN_INTEGER}$"), _FLOAT: plain_float}
+    out = {}
+    for first, resolvers in yaml.SafeLoader.yaml_implicit_resolvers.items():
+        kept = [
+            (tag, plain.get(tag, regexp))
+            for tag, regexp in resolvers
+            if keep_floats or tag != _FLOAT
+        ]
+        if kept:
+            out[first] = kept
+    return out
+
+
+PlainNumbers.yaml_implicit_resolvers = _resolvers(keep_floats=True)
+DecimalsAsText.yaml_implicit_resolvers = _resolvers(keep_floats=False)
 
 
 def read_yaml(path: str | Path, *, what: str, decimals_as_text: bool = False) -> Any:
@@ -39,7 +69,8 @@ def read_yaml(path: str | Path, *, what: str, decimals_as_text: bool = False) ->
     what : str
         What the file is, for messages (``"assembly spec"``, ``"BOM"``).
     decimals_as_text : bool
-        Keep ``1.10`` as the string ``"1.10"`` (operation ids) instead of a float.
+        Keep ``1.10`` as the string ``"1.10"`` (operation ids) instead of a float. Either
+        way ``010``, ``0x10``, ``1_000`` and ``1:30`` stay text (:class:`PlainNumbers`).
 
     Raises
     ------
@@ -52,7 +83,7 @@ def read_yaml(path: str | Path, *, what: str, decimals_as_text: bool = False) ->
         text = path.read_text(encoding="utf-8")
     except UnicodeDecodeError as exc:
         raise AsmplanError(f"{path}: not a UTF-8 text file ({exc.reason})") from None
-    loader = DecimalsAsText if decimals_as_text else yaml.SafeLoader
+    loader = DecimalsAsText if decimals_as_text else PlainNumbers
     try:
         data = yaml.load(text, Loader=loader)  # noqa: S506 - a SafeLoader subclass
     except yaml.YAMLError as exc:
