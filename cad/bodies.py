@@ -8,9 +8,17 @@ The rule, in this order:
 
 1. Faces are joined where they share a vertex position (coordinates equal to within
    :data:`MERGE_DIGITS` significant digits of the mesh's size). OCCT tessellates each
-   B-rep face on its own: faces of one shell share their corner positions but not their
-   edges (T-junctions), so joining by shared edges would cut a solid into its faces (the
-   toy truck's solid became 542 pieces), while joining by positions keeps each shell whole.
+   B-rep face on its own: faces of one shell may share their corner positions but not
+   their edges (T-junctions), so joining by shared edges alone could cut a solid into its
+   faces, while joining by positions keeps each shell whole. Shells that touch (parts of
+   one fused solid resting face to face: the toy truck's cabin, chassis and supports)
+   share positions too; a piece in which every edge (a pair of positions) is used by an
+   even number of faces has no T-junction, and is split into its shells
+   (:func:`_shells`): faces are joined across an edge of two faces, and where four or more
+   meet with two of them back to back (two shells resting on each other) each face is
+   joined to the face its solid's inside turns to first around the edge; where none lie
+   back to back the solid touches itself along the edge (an Inventor part's lobes meeting
+   along an edge) and all are joined.
 2. Each piece must be a closed surface: its vector area (the sum of the face normals
    times the face areas) is zero for a closed surface whatever its tessellation, and
    equals the area of the hole for an open one. A piece is closed when the vector area is
@@ -36,6 +44,9 @@ MERGE_DIGITS = 8
 vertex with the same coordinates into every face it bounds)."""
 CLOSED_VECTOR_AREA = 1e-4
 """A piece is closed when its vector area is at most this fraction of its area."""
+FLUSH_RADIANS = 1e-3
+"""Two faces about one edge within this angle lie on each other (back to back: two
+shells touching; the tessellations of one curved contact differ by about 2e-5 rad)."""
 
 
 def closed_bodies(mesh: trimesh.Trimesh) -> tuple[trimesh.Trimesh, ...] | None:
@@ -83,7 +94,7 @@ def _pieces(mesh: trimesh.Trimesh) -> np.ndarray:
     vertices = np.asarray(mesh.vertices, dtype=float)
     size = float(np.linalg.norm(np.ptp(vertices, axis=0))) or 1.0
     grid = np.round(vertices / (size * 10.0**-MERGE_DIGITS)).astype(np.int64)
-    _, position = np.unique(grid, axis=0, return_inverse=True)
+    _, first, position = np.unique(grid, axis=0, return_index=True, return_inverse=True)
     faces = position.reshape(-1)[np.asarray(mesh.faces)]
     n_faces, n_positions = len(faces), int(position.max()) + 1
     rows = np.repeat(np.arange(n_faces), 3)  # face k -- its three positions
@@ -92,9 +103,111 @@ def _pieces(mesh: trimesh.Trimesh) -> np.ndarray:
         shape=(n_faces + n_positions,) * 2,
     )
     _, labels = connected_components(graph, directed=False)
-    _, face_labels = np.unique(labels[:n_faces], return_inverse=True)  # first face first
-    order = np.argsort(np.unique(face_labels, return_index=True)[1])
+    labels = labels[:n_faces]
+    shells = _shells(vertices[first], faces, labels)
+    _, face_labels = np.unique(shells, return_inverse=True)
+    order = np.argsort(np.unique(face_labels, return_index=True)[1])  # first face first
     return np.argsort(order)[face_labels]
+
+
+def _shells(vertices: np.ndarray, faces: np.ndarray, pieces: np.ndarray) -> np.ndarray:
+    """A shell label per face: each piece (``pieces``, faces joined by positions) whose
+    edges are all used an even number of times split into its shells (module docstring);
+    ``faces`` index positions, ``vertices`` their coordinates by position index."""
+    n = len(faces)
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    owner = np.tile(np.arange(n), 3)
+    third = np.concatenate([faces[:, 2], faces[:, 0], faces[:, 1]])
+    key = np.sort(edges, axis=1)
+    _, edge, uses = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    edge = edge.reshape(-1)
+    odd = np.zeros(int(pieces.max()) + 1, dtype=bool)
+    odd[pieces[owner[uses[edge] % 2 == 1]]] = True  # T-junctions: keep those pieces whole
+    rows, cols, rested = [], [], []
+    order = np.argsort(edge, kind="stable")
+    starts = np.flatnonzero(np.r_[True, edge[order][1:] != edge[order][:-1]])
+    for lo, hi in zip(starts, np.r_[starts[1:], len(order)], strict=True):
+        ends = order[lo:hi]
+        if odd[pieces[owner[ends[0]]]]:
+            continue
+        if len(ends) == 2:
+            rows.append(owner[ends[0]])
+            cols.append(owner[ends[1]])
+            continue
+        pairs, flush = _pairs_around(vertices, edges[ends], third[ends], owner[ends])
+        for a, b in pairs:
+            rows.append(owner[ends[a]])
+            cols.append(owner[ends[b]])
+        if flush:
+            rested.append(owner[ends])
+    keep = np.flatnonzero(odd[pieces])  # whole pieces: joined to their first face
+    first = np.unique(pieces, return_index=True)[1]
+    rows += keep.tolist()
+    cols += first[pieces[keep]].tolist()
+    graph = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(n, n))
+    shells = connected_components(graph, directed=False)[1]
+    return _joined_at_points(faces, shells, [np.unique(shells[f]) for f in rested])
+
+
+def _joined_at_points(faces: np.ndarray, shells: np.ndarray, rested: list) -> np.ndarray:
+    """``shells`` with shells that share a position joined, unless they rest on each other
+    (both at an edge where faces lie back to back, ``rested``): bodies touching at a
+    point or along an edge only are one solid touching itself."""
+    apart = {(int(a), int(b)) for group in rested for a in group for b in group if a != b}
+    at = np.column_stack([faces.reshape(-1), np.repeat(shells, 3)])
+    at = np.unique(at, axis=0)  # (position, shell) incidences, by position
+    same = at[1:, 0] == at[:-1, 0]
+    pairs = [
+        (int(a), int(b))
+        for a, b in zip(at[:-1, 1][same], at[1:, 1][same], strict=True)
+        if (int(a), int(b)) not in apart
+    ]
+    if not pairs:
+        return shells
+    m = int(shells.max()) + 1
+    rows, cols = zip(*pairs, strict=True)
+    graph = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(m, m))
+    return connected_components(graph, directed=False)[1][shells]
+
+
+def _pairs_around(
+    vertices: np.ndarray, edges: np.ndarray, third: np.ndarray, index: np.ndarray
+) -> tuple[list, bool]:
+    """Which faces around one edge of four or more belong together, and whether two of them
+    lie back to back: each face (row ``k``:
+    its directed edge ``edges[k]`` and third vertex ``third[k]``) along the edge's first
+    direction with the face against it that a turn about the edge towards its inside
+    meets first (a face lying on it, back to back, is met last); the nearest pairs are
+    taken first, each face once; with no two faces back to back (no bodies resting on
+    each other: one solid touching itself along the edge) all are joined. Where two faces
+    lie on each other the same way round
+    (bodies overlapping there) the gaps tie, and the faces nearer in the mesh's order
+    (``index``: OCCT writes a shell's faces together) pair first."""
+    p, q = vertices[edges[0, 0]], vertices[edges[0, 1]]
+    axis = (q - p) / (np.linalg.norm(q - p) or 1.0)
+    sense = np.where(edges[:, 0] == edges[0, 0], 1.0, -1.0)  # along the axis or against it
+    out = vertices[third] - p
+    out -= np.outer(out @ axis, axis)  # from the edge into each face, across the axis
+    ref = out[0] / (np.linalg.norm(out[0]) or 1.0)
+    angle = np.arctan2(np.cross(ref, out) @ axis, out @ ref)
+    along, against = np.flatnonzero(sense > 0), np.flatnonzero(sense < 0)
+    # a face's outward normal is (its edge's direction) x (into it): a turn towards the
+    # inside of a face along the axis goes to decreasing angle
+    gap = np.mod(angle[along][:, None] - angle[against][None, :], 2.0 * np.pi)
+    flush = (gap < FLUSH_RADIANS) | (gap > 2.0 * np.pi - FLUSH_RADIANS)
+    if not flush.any():  # no two bodies resting on each other: one body meets itself here
+        return [(0, k) for k in range(1, len(edges))], False
+    gap[flush] = 2.0 * np.pi
+    near = np.abs(index[along][:, None] - index[against][None, :])
+    tied = np.round(gap / FLUSH_RADIANS)
+    pairs, used_a, used_b = [], set(), set()
+    for flat in np.lexsort((near.ravel(), tied.ravel())):
+        a, b = divmod(int(flat), len(against))
+        if a not in used_a and b not in used_b:
+            pairs.append((int(along[a]), int(against[b])))
+            used_a.add(a)
+            used_b.add(b)
+    return pairs, True
 
 
 def _cavity_owners(triangles: np.ndarray, labels: np.ndarray, volume: np.ndarray) -> np.ndarray:

@@ -53,6 +53,26 @@ def test_a_cylinder_of_separate_faces_is_one_body():
     assert closed_bodies(cylinder) is None
 
 
+@pytest.mark.parametrize("apart", [False, True])
+def test_bodies_resting_face_to_face_are_split_at_their_contact(apart):
+    """Parts of one fused solid resting on each other share the positions (and edges) of
+    their contact, as the APLAN toy truck's cabin, chassis and supports do: a stack of
+    three blocks, one beside the stack on the bottom block, each its own body."""
+    bottom, middle = box([4, 4, 1], [0, 0, 0.5]), box([4, 4, 1], [0, 0, 1.5])
+    top, beside = box([2, 4, 2], [-1, 0, 3.0]), box([2, 4, 1], [1, 0, 2.5])
+    mesh = fused(bottom, middle, top, beside)
+    bodies = closed_bodies(faces_apart(mesh) if apart else mesh)
+    assert volumes(bodies) == [16.0, 16.0, 16.0, 8.0]
+    assert all(b.is_watertight for b in bodies)
+
+
+def test_a_solid_touching_itself_along_an_edge_stays_one_body():
+    """Two lobes of one solid meeting along an edge only (no faces back to back): one
+    part, as a single STEP shell is (an Inventor part of one closed shell)."""
+    lobes = fused(box([1, 1, 1], [0, 0, 0]), box([1, 1, 1], [1, 1, 0]))
+    assert closed_bodies(faces_apart(lobes)) is None
+
+
 def test_a_cavity_stays_with_the_body_around_it():
     hollow = fused(box([4, 4, 4], [0, 0, 0]), inside_out(box([2, 2, 2], [0, 0, 0])))
     bodies = closed_bodies(fused(hollow, box([1, 1, 1], [10, 0, 0])))
