@@ -36,7 +36,7 @@ Every rule that cuts the search, with its proof:
 3. *Budgets.* A human allowed ``b + 1`` deviations can play every strategy of ``b``, so
    ``W(s, b - 1) <= W(s, b) <= W(s, b + 1)``: a new position takes ``lo`` from the same
    position one budget lower and ``hi`` from one budget higher when the table has them. At
-   the root, the search for ``k`` runs in the window ``(W*(k - 1) - 1, W*(inf) + 1)``.
+   the root, the search for ``k`` runs in the window ``(W*(k - 1), W*(inf) + 1)`` (rule 7).
 4. *Instructions that cannot bind.* With the budget at its cap (every deviation affordable,
    :mod:`asp.concurrent.rules`) the person may do anything at no cost, and the child's budget
    is its own cap whatever the instruction (a reply with ``d`` starting deviations has at
@@ -48,6 +48,19 @@ Every rule that cuts the search, with its proof:
    commitment is kept (the one of least bound of rule 2: the instruction a person sees),
    and none whose set has a kept strict subset.
 5. *Symmetry.* Positions are orbits under the alike-part symmetry (rules' docstring).
+6. *A first move without bounds.* The table's move of the position, else the move of the
+   same position one budget lower (then one higher: a position's commitments do not depend
+   on its budget), else the CP-SAT schedule's commitment (:func:`_schedule_choice`) is
+   searched first, before the other commitments' bounds of rule 2 are computed; when it
+   cuts (its value at most the window's bottom) they never are. Any commitment is a legal
+   move, so its value is an upper bound of the position's (rule 1 holds whichever move is
+   tried first, kept by rule 4 or not); only the order changes, never the value.
+7. *Proven floors.* A caller that has proved ``W >= f`` (the CP-SAT bound, a relaxation
+   with the person following at the longest durations, for ``k = 0``; ``W*(k - 1)`` for
+   ``k``, rule 3; ``W*(0)`` for ``k = inf``) searches in the window ``(f, U)``: a result
+   ``v <= f`` proves ``W <= v`` (rule 1), so ``W = f``. Then a first line that reaches the
+   floor ends the search at once (the schedule's line at ``k = 0`` when CP-SAT proved it
+   optimal), instead of refuting every other commitment.
 
 The values ``W*(k)`` for ``k = 0, 1, ...`` and ``W*(inf)`` (the budget at its cap) share one
 table; a curve stops when ``W*(k) = W*(inf)`` (flat), at ``max_k``, or when a limit is hit.
@@ -68,7 +81,8 @@ as ``k`` grows.
 
 Limits and the anytime answer
 -----------------------------
-The table is sized before the search from the memory allowed (``memory``: its bytes per
+The table is sized before the search from the memory allowed (only its key array is read
+before a slot is written, so only the slots in use are resident) (``memory``: its bytes per
 entry are known, :func:`table_entries`); it never grows. The search stops when the table is
 full, at ``max_nodes`` positions expanded, or at ``time_limit``; the policy games stop at
 their own node limit (from the same memory). Stopped, :func:`solve_curve` still answers:
@@ -163,11 +177,13 @@ def table_entries(memory: int, key_words: int) -> int:
 def new_table(entries: int, key_words: int) -> Table:
     """A free table for ``entries`` positions."""
     slots = 1 << max(4, int(np.ceil(entries / LOAD)).bit_length())
+    # Only the keys are read before a slot is written (a zero key: free), so the other
+    # arrays are left as the allocator gives them: pages are only resident once used.
     return Table(
         keys=np.zeros((slots, key_words), dtype=np.int64),
-        lo=np.zeros(slots, dtype=np.int64),
-        hi=np.full(slots, INF, dtype=np.int64),
-        move=np.full(slots, -1, dtype=np.int64),
+        lo=np.empty(slots, dtype=np.int64),
+        hi=np.empty(slots, dtype=np.int64),
+        move=np.empty(slots, dtype=np.int64),
     )
 
 
@@ -306,6 +322,42 @@ def _dominant(T, row, commits, est):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
+def _ordered(T, row, commits, tried):  # pragma: no cover - compiled
+    """Rule 2's bounds of the commitments at ``row`` and the order they are tried in: those
+    rule 4 keeps by increasing bound; ``tried`` (already searched, or -1) and the others
+    get the bound INF (never tried)."""
+    m = commits.shape[0]
+    est = np.empty(m, np.int64)
+    for i in range(m):
+        est[i] = _estimate(T, row, commits[i])
+    keep = _dominant(T, row, commits, est)
+    for i in range(m):
+        if not keep[i] or i == tried:
+            est[i] = INF
+    return est, np.argsort(est, kind="mergesort")
+
+
+@numba.njit(cache=True)
+def _hint(T, H, row, commits, prefs, n_prefs):  # pragma: no cover - compiled
+    """The commitment to try first at a position the table has no move for (rule 6): the
+    move of the same position one budget lower, else one higher (the commitments of a
+    position do not depend on its budget), else the CP-SAT schedule's; -1 for none."""
+    m = commits.shape[0]
+    other = row.copy()
+    b = row[1]
+    for nb in (b - 1, b + 1):
+        if nb < 0 or nb > budget_cap_of(T, row):
+            continue
+        other[1] = nb
+        j = _find(H, key_of(T, other))
+        if j >= 0 and 0 <= H.move[j] < m:
+            return H.move[j]
+    if n_prefs.sum() > 0:
+        return _schedule_choice(T, row, commits, prefs, n_prefs)
+    return -1
+
+
+@numba.njit(cache=True)
 def _tick(st):  # pragma: no cover - compiled
     """Look at the clock (and print the progress line when it is due); True to stop."""
     with numba.objmode(now="float64"):
@@ -338,7 +390,7 @@ ENTER, NEXT_COMMIT, NEXT_REPLY, AFTER_CHILD = 0, 1, 2, 3
 
 
 @numba.njit(cache=True)
-def _search(T, H, root, alpha, beta, st):  # pragma: no cover - compiled
+def _search(T, H, root, alpha, beta, st, prefs, n_prefs):  # pragma: no cover - compiled
     """The value of position ``root`` in the window ``(alpha, beta)`` (fail-soft, module
     docstring); 0 when stopped (``st[ABORT]``; nothing is stored then).
 
@@ -423,24 +475,14 @@ def _search(T, H, root, alpha, beta, st):  # pragma: no cover - compiled
             b_[d] = min(win_b[d], hi)
             commits = commit_rows(T, row)
             m = commits.shape[0]
-            est = np.empty(m, np.int64)
-            for i in range(m):
-                est[i] = _estimate(T, row, commits[i])
-            keep = _dominant(T, row, commits, est)
-            for i in range(m):
-                if not keep[i]:
-                    est[i] = INF
-            order = np.argsort(est, kind="mergesort")
             f = H.move[s_]
-            if f >= 0 and f < m and keep[f]:  # the table's move first
-                k = 0
-                while order[k] != f:
-                    k += 1
-                for q in range(k, 0, -1):
-                    order[q] = order[q - 1]
-                order[0] = f
+            if not (0 <= f < m):
+                f = _hint(T, H, row, commits, prefs, n_prefs)
+            if f >= 0:  # the table's move, else a hint, alone first (rule 6)
+                est = np.zeros(m, np.int64)
+                order = np.full(1, f, np.int64)
             else:
-                f = -1
+                est, order = _ordered(T, row, commits, -1)
             commits_l[d] = commits
             est_l[d] = est
             order_l[d] = order
@@ -455,16 +497,21 @@ def _search(T, H, root, alpha, beta, st):  # pragma: no cover - compiled
             commits = commits_l[d]
             est = est_l[d]
             order = order_l[d]
-            m = commits.shape[0]
+            m = order.shape[0]
             chosen = -1
+            if jc[d] == m and first[d] >= 0 and best[d] > a_[d]:
+                # the first move did not cut: the others in order of their bounds
+                est, order = _ordered(T, rows[d], commits, first[d])
+                est_l[d] = est
+                order_l[d] = order
+                first[d] = -1
+                jc[d] = 0
+                m = order.shape[0]
             while jc[d] < m:
                 i = order[jc[d]]
                 if est[i] >= min(b_[d], best[d]):
                     if est[i] < pruned[d]:
                         pruned[d] = est[i]
-                    if jc[d] == 0 and i == first[d]:
-                        jc[d] += 1
-                        continue  # the table's move went first out of order; the rest are sorted
                     jc[d] = m
                     break
                 chosen = i
@@ -558,13 +605,13 @@ def _choose(T, H, row, commits, kind, prefs, n_prefs, st):  # pragma: no cover -
     """The commitment (index) a policy of ``kind`` takes at ``row``; -1 when stopped."""
     m = commits.shape[0]
     if kind == ROBUST:
-        v = _search(T, H, row, -1, INF, st)
+        v = _search(T, H, row, -1, INF, st, prefs, n_prefs)
         if st[ABORT]:
             return -1
         i = _find(H, key_of(T, row))
         if H.move[i] < 0:  # exact by bounds alone (rule 3): search again for the move
             H.hi[i] = INF
-            _search(T, H, row, v - 1, v + 1, st)
+            _search(T, H, row, v - 1, v + 1, st, prefs, n_prefs)
             if st[ABORT]:
                 return -1
         return H.move[i]
@@ -779,9 +826,18 @@ class Search:
     policy's exact values, the hybrid policy's moves).
     """
 
-    def __init__(self, rules: Rules, limits: Limits | None = None, *, progress: bool = False):
+    def __init__(
+        self,
+        rules: Rules,
+        limits: Limits | None = None,
+        *,
+        progress: bool = False,
+        schedule: list[dict] | None = None,
+    ):
         self.rules = rules
         self.limits = limits or Limits()
+        # The CP-SAT schedule's lists, the search's first guess where the table has none.
+        self.prefs, self.n_prefs = schedule_lists(rules, schedule or [])
         kw = rules.key_words
         # Half the memory for the search table, the rest for the policy games' tables
         # and node arrays.
@@ -818,30 +874,49 @@ class Search:
     def positions(self) -> int:
         return int(self.stats[ENTRIES])
 
-    def value(self, budget: int | None, lower: int = -1, upper: int = INF) -> int | None:
-        """``W*(budget)`` (scaled) searched in the window ``(lower, upper)`` where the caller
-        knows ``lower < W* < upper``; None when a limit stopped it."""
+    def _run(self, row, alpha: int, beta: int) -> int:
+        return int(
+            _search(
+                self.rules.tables,
+                self.table,
+                row,
+                alpha,
+                beta,
+                self.stats,
+                self.prefs,
+                self.n_prefs,
+            )
+        )
+
+    def value(self, budget: int | None, floor: int = 0, upper: int = INF) -> int | None:
+        """``W*(budget)`` (scaled) where the caller has proved ``floor <= W* < upper``; None
+        when a limit stopped it.
+
+        Searched in the window ``(floor, upper)`` (rule 7): a result ``v <= floor`` proves
+        ``W* <= v``, so ``W* = floor``; one inside the window is exact."""
         if self.stopped:
             return None
         row = self.rules.start(budget).row()
         self.stats[BUDGET] = row[1]
         self.stats[ROOT_BEST] = INF
-        v = _search(self.rules.tables, self.table, row, lower, upper, self.stats)
+        v = self._run(row, floor, upper)
         if self.stopped:
             return None
-        if not lower < v < upper:  # the window was wrong: search it again in full
-            v = _search(self.rules.tables, self.table, row, -1, INF, self.stats)
+        if v <= floor:
+            return int(floor)
+        if v >= upper:  # the upper bound was wrong: search it again in full
+            v = self._run(row, -1, INF)
             if self.stopped:
                 return None
-        return int(v)
+        return v
 
     def value_at(self, pos) -> int | None:
         """The exact value (scaled) of any position (:class:`asp.concurrent.rules.Position`),
         None when a limit stopped the search."""
         if self.rules.is_end(pos):
             return 0
-        v = _search(self.rules.tables, self.table, pos.row(), -1, INF, self.stats)
-        return None if self.stopped else int(v)
+        v = self._run(pos.row(), -1, INF)
+        return None if self.stopped else v
 
     def proven(self, budget: int | None) -> tuple[int, int]:
         """The interval the table proves for the start of ``budget`` (scaled)."""
@@ -859,7 +934,9 @@ class Search:
         rules = self.rules
         t0 = time.perf_counter()
         starts = np.array([rules.start(b).row() for b in budgets], dtype=np.int64)
-        prefs, n_prefs = schedule_lists(rules, schedule or [])
+        prefs, n_prefs = (
+            (self.prefs, self.n_prefs) if not schedule else schedule_lists(rules, schedule)
+        )
         nw = rules.n_workers
         kw = rules.key_words
         # Bytes per policy-game node: its row, its table slot, and about two edges.
@@ -1042,7 +1119,7 @@ def solve_curve(
     from asp.game.solve import solve
 
     t0 = time.perf_counter()
-    search = Search(rules, limits, progress=progress)
+    search = Search(rules, limits, progress=progress, schedule=schedule)
     scale = rules.scale
     floor = int(np.ceil((lower or 0) * scale - 1e-9))
     floor = max(floor, int(lower_bound_of(rules.tables, rules.start(0).row())))
@@ -1052,11 +1129,11 @@ def solve_curve(
             print(f"  {text} ({time.perf_counter() - t0:.1f} s)", file=sys.stderr, flush=True)
 
     exact: dict = {}  # budget (None: inf) -> W* (scaled)
-    v0 = search.value(0, floor - 1)
+    v0 = search.value(0, floor)
     if v0 is not None:
         exact[0] = v0
         say(f"W*(0) = {v0 / scale:g}")
-        top = search.value(None, v0 - 1)
+        top = search.value(None, v0)
         if top is not None:
             exact[None] = top
             say(f"W*(inf) = {top / scale:g}")
@@ -1065,7 +1142,7 @@ def solve_curve(
         if exact[k] == exact[None]:
             v = exact[None]  # flat from k on (the curve never falls, never passes W*(inf))
         else:
-            v = search.value(k + 1, exact[k] - 1, exact[None] + 1)
+            v = search.value(k + 1, exact[k], exact[None] + 1)
             if v is None:
                 break
             say(f"W*({k + 1}) = {v / scale:g}")

@@ -165,3 +165,36 @@ def test_limits_are_checked():
     assert search.value(0) is None and search.stopped == "node limit"
     with pytest.raises(ValueError, match="memory"):
         Search(rules, Limits(memory=10))
+
+
+@SETTINGS
+@given(
+    random_jobs(humans=(1, 2), ranges=True), st.randoms(use_true_random=False), st.integers(0, 3)
+)
+def test_schedule_hints_and_proven_floors_keep_the_values(data, rnd, below):
+    """Rules 6 and 7: a schedule's commitments tried first (any schedule, even a poor one)
+    and a search from a proven floor (the value one budget lower, or any bound below it)
+    give the compiled game's values."""
+    ops, agents = data
+    spec, graph = job(ops, agents=agents)
+    rules = concurrent_rules(spec, graph)
+    top = top_budget(agents, ops)
+    want = oracle_values(spec, graph, top)
+    order = list(ops)
+    rnd.shuffle(order)
+    rows = [
+        {"task": op["id"], "agent": rnd.choice(sorted(op["agents"])), "start": i}
+        for i, op in enumerate(order)
+    ]
+    search = Search(rules, schedule=rows)
+    for k in range(top + 1):
+        floor = max(0, (want[k - 1] if k else want[0]) - below)
+        assert search.value(k, floor, want[-1] + 1) == want[k], k
+    assert search.value(None, want[0]) == want[-1]
+    curve = solve_curve(rules, max_k=top, schedule=rows, lower=want[0] / rules.scale)
+    assert curve.stopped is None and all(curve.exact) and curve.policy == "robust"
+    assert [round(x * rules.scale) for x in curve.lower[:-1]] == want[: curve.k + 1]
+    assert (
+        start_values(curve.game, range(curve.k + 1))
+        == [w / rules.scale for w in want][: curve.k + 1]
+    )
