@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -278,6 +279,8 @@ class _Run:
     converged: bool = False
     stopped: bool = False
     started: float = field(default_factory=time.perf_counter)
+    doing: str = "starting"
+    """What the run is doing now (``cycle 3 of 100: the robot's phase``), for the heartbeat."""
 
     def elapsed(self) -> float:
         """Training time so far, over all runs of a resumed training."""
@@ -323,6 +326,7 @@ def train(
     max_memory_gb: float | None = None,
     max_cycle_seconds: float | None = None,
     on_estimate: Callable[[CycleEstimate], None] | None = None,
+    heartbeat: Callable[[str], None] | None = None,
 ) -> TrainResult:
     """Train a robust robot policy by alternating PPO against a learned adversarial human.
 
@@ -353,6 +357,10 @@ def train(
         Called with the :class:`CycleEstimate` once it is within ``max_cycle_seconds``
         (``asmplan train`` says it on stderr); without it and without a limit nothing is
         estimated.
+    heartbeat : callable, optional
+        Called every :data:`HEARTBEAT_S` seconds while training with a line saying what
+        the run is doing and for how long (:class:`_Heartbeat`), so a long cycle is never
+        silent.
 
     Returns
     -------
@@ -377,8 +385,10 @@ def train(
         if on_estimate is not None:
             on_estimate(estimate)
     run = _start_run(dag, cfg, seed, folder, resume)
+    beat = _Heartbeat(run, heartbeat)
     try:
         bar = _progress(range(len(run.cycles), cfg.max_cycles), progress, len(run.cycles), cfg)
+        beat.start()
         for cycle in bar:
             if run.converged or run.stopped:
                 break
@@ -399,9 +409,42 @@ def train(
             folder.discard_uncommitted()
         raise
     finally:
+        beat.stop()
         for env in run.envs.values():
             env.close()
     return result
+
+
+HEARTBEAT_S = 60.0
+"""Seconds between two lines of a training's heartbeat (:class:`_Heartbeat`)."""
+
+
+class _Heartbeat:
+    """A line to ``say`` every :data:`HEARTBEAT_S` seconds while a run trains (a daemon
+    thread; :meth:`line` is what it says: the run's ``doing`` and the time so far)."""
+
+    def __init__(self, run: _Run, say: Callable[[str], None] | None) -> None:
+        self.run, self.say = run, say
+        self._stop = threading.Event()
+        self._thread = None
+
+    def line(self) -> str:
+        run = self.run
+        return f"training: {run.doing}, {_duration(run.elapsed())} so far"
+
+    def start(self) -> None:
+        if self.say is not None:
+            self._thread = threading.Thread(target=self._beat, daemon=True, name="heartbeat")
+            self._thread.start()
+
+    def _beat(self) -> None:
+        while not self._stop.wait(HEARTBEAT_S):
+            self.say(self.line())
+
+    def stop(self) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join()
 
 
 def _start_run(
@@ -469,9 +512,11 @@ def _train_cycle(run: _Run, cycle: int, folder: RunFolder | None) -> dict:
     means: dict[int, float | None] = {ROBOT: None, HUMAN: None}
     counts = {ROBOT: 0, HUMAN: 0}
     for learner in run.models:
+        run.doing = f"cycle {cycle + 1} of {run.cfg.max_cycles}: the {AGENTS[learner]}'s phase"
         episodes = _train_phase(run, learner, cycle, folder)
         run.rewards[AGENTS[learner]].extend(episodes)
         means[learner], counts[learner] = _mean(episodes), len(episodes)
+    run.doing = f"cycle {cycle + 1} of {run.cfg.max_cycles}: the check (tabulations, exact scores)"
     robot_policy = run.greedy(ROBOT)
     _, wcpl = play(run.dag, robot_policy, run.greedy(HUMAN))
     record = {

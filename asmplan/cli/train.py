@@ -55,6 +55,17 @@ def load_training_game(source: Path, turn_model: TurnModel | None = None) -> Gam
     return build_game(concurrent_model(assembly.spec, graph), None).dag
 
 
+def _stderr_line(progress: bool):
+    """A line on stderr: above the progress bar when there is one (``tqdm.write``)."""
+    if not progress:
+        return lambda line: typer.echo(line, err=True)
+    import sys
+
+    from tqdm.auto import tqdm
+
+    return lambda line: tqdm.write(line, file=sys.stderr)
+
+
 MAX_CYCLES = 100_000
 CONCURRENT_CONFIGS = ("concurrent", "concurrent-tiny")
 """The ``--config`` names of :mod:`arl.concurrent_trainer` (checked there)."""
@@ -195,6 +206,7 @@ def train_command(
         max_memory_gb=max_memory,
         max_cycle_seconds=max_cycle_seconds,
         on_estimate=lambda e: typer.echo(f"training: {e.text()}", err=True),
+        heartbeat=_stderr_line(progress),
     )
     status = "converged" if result.converged else "stopped"
     typer.echo(

@@ -5,6 +5,7 @@ the run folder is touched."""
 from __future__ import annotations
 
 import itertools
+import threading
 
 import pytest
 
@@ -102,3 +103,26 @@ def test_cli_says_the_estimate_and_refuses_over_the_flag(tmp_path, capsys):
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and "--max-cycle-seconds 0.001" in err[0], err
     assert not (tmp_path / "slow").exists() or not any((tmp_path / "slow").iterdir())
+
+
+def test_the_heartbeat_says_what_the_run_is_doing(monkeypatch):
+    lines, doing, said = [], [], threading.Event()
+    monkeypatch.setattr(trainer, "HEARTBEAT_S", 0.001)
+
+    def say(line):
+        lines.append(line)
+        said.set()
+
+    def at_each_phase(run, learner, *args, **kwargs):
+        doing.append(run.doing)
+        said.clear()
+        assert said.wait(10)  # the heartbeat speaks while the phase runs
+        return []
+
+    monkeypatch.setattr(trainer, "_train_phase", at_each_phase)
+    train(figure4(), TINY.replace(max_cycles=2), seed=0, heartbeat=say)
+    assert doing == [
+        f"cycle {c} of 2: the {side}'s phase" for c in (1, 2) for side in ("robot", "human")
+    ]
+    assert any("the robot's phase" in line for line in lines)
+    assert all(line.startswith("training: ") and line.endswith(" so far") for line in lines)
