@@ -199,7 +199,7 @@ def replay_rules(relations: Relations) -> dict:
         :data:`cad.support.SUPPORT_RULES`), ``fits`` (``inner, outer, extra_shrink`` mm: the inner
         part is shrunk by that much more against the outer one only), ``through`` (pairs
         accepted as overlapping, nested too deep to part: never tested against each other,
-        touching and resting on each other) and ``open_parts``.
+        touching and resting on each other; only when there are some) and ``open_parts``.
     """
     ids = [str(p) for p in relations.parts]
     reach = tuple(getattr(relations, "part_reach", ()))
@@ -214,7 +214,11 @@ def replay_rules(relations: Relations) -> dict:
             {"inner": str(i), "outer": str(o), "extra_shrink": float(e)}
             for i, o, e in getattr(relations, "fits", ())
         ],
-        "through": [[str(a), str(b)] for a, b in getattr(relations, "through", ())],
+        **(
+            {"through": [[str(a), str(b)] for a, b in through]}
+            if (through := getattr(relations, "through", ()))
+            else {}
+        ),
         "open_parts": [str(p) for p in getattr(relations, "open_parts", ())],
     }
 
