@@ -164,6 +164,10 @@ LOAD = 0.7
 """Largest share of a table's slots in use."""
 MIN_ENTRIES = 1024
 """The least search table worth starting."""
+FIRST_ENTRIES = 1 << 16
+"""Entries of a search table at first; it grows four-fold when full, up to the memory
+allowed (a table sized for all the memory at once would be resident soon: its slots are
+hashed, so a few entries touch every page)."""
 
 
 def table_entries(memory: int, key_words: int) -> int:
@@ -176,7 +180,7 @@ def table_entries(memory: int, key_words: int) -> int:
 
 def new_table(entries: int, key_words: int) -> Table:
     """A free table for ``entries`` positions."""
-    slots = 1 << max(4, int(np.ceil(entries / LOAD)).bit_length())
+    slots = 1 << max(4, (int(np.ceil(entries / LOAD)) - 1).bit_length())
     # Only the keys are read before a slot is written (a zero key: free), so the other
     # arrays are left as the allocator gives them: pages are only resident once used.
     return Table(
@@ -188,6 +192,18 @@ def new_table(entries: int, key_words: int) -> Table:
 
 
 # --------------------------------------------------------------------------- table kernels
+
+
+@numba.njit(cache=True)
+def _rehash(old, new):  # pragma: no cover - compiled
+    """Every entry of the table ``old`` into the (larger, free) table ``new``."""
+    for i in range(old.keys.shape[0]):
+        if old.keys[i, 0] != 0:
+            j = _slot(new, old.keys[i])
+            new.keys[j] = old.keys[i]
+            new.lo[j] = old.lo[i]
+            new.hi[j] = old.hi[i]
+            new.move[j] = old.move[i]
 
 
 @numba.njit(cache=True)
@@ -850,9 +866,9 @@ class Search:
                 f"--max-memory: {self.limits.memory:,} bytes is too little for the concurrent "
                 f"search (at least {need:,.0f} bytes)"
             )
-        self.table = new_table(self.entries, kw)
+        self.table = new_table(min(self.entries, FIRST_ENTRIES), kw)
         self.stats = np.zeros(N_STATS, dtype=np.int64)
-        self.stats[MAX_ENTRIES] = self.entries
+        self.stats[MAX_ENTRIES] = min(self.entries, int(self.table.keys.shape[0] * LOAD))
         self.stats[NODE_LIMIT] = self.limits.max_nodes
         self.stats[PROGRESS] = int(progress)
         self.t0 = time.perf_counter()
@@ -874,19 +890,27 @@ class Search:
     def positions(self) -> int:
         return int(self.stats[ENTRIES])
 
+    def _grow(self) -> bool:
+        """When the table is full below the memory allowed: a table four times larger with
+        every entry; False (the memory limit stands) otherwise."""
+        st = self.stats
+        if st[ABORT] != STOP_MEMORY or st[MAX_ENTRIES] >= self.entries:
+            return False
+        bigger = new_table(min(self.entries, 4 * int(st[MAX_ENTRIES])), self.rules.key_words)
+        _rehash(self.table, bigger)
+        self.table = bigger
+        st[MAX_ENTRIES] = min(self.entries, int(bigger.keys.shape[0] * LOAD))
+        st[ABORT] = 0
+        return True
+
     def _run(self, row, alpha: int, beta: int) -> int:
-        return int(
-            _search(
-                self.rules.tables,
-                self.table,
-                row,
-                alpha,
-                beta,
-                self.stats,
-                self.prefs,
-                self.n_prefs,
-            )
-        )
+        """:func:`_search` of ``row``, again with a larger table while it grows (the entries
+        kept, so the search goes on where it stopped)."""
+        t = self.rules.tables
+        while True:
+            v = _search(t, self.table, row, alpha, beta, self.stats, self.prefs, self.n_prefs)
+            if not self._grow():
+                return int(v)
 
     def value(self, budget: int | None, floor: int = 0, upper: int = INF) -> int | None:
         """``W*(budget)`` (scaled) where the caller has proved ``floor <= W* < upper``; None
@@ -941,14 +965,21 @@ class Search:
         kw = rules.key_words
         # Bytes per policy-game node: its row, its table slot, and about two edges.
         per_node = 8 * (3 + 3 * nw) + (8 * kw + ENTRY_BYTES) / LOAD + 2 * 8 * (5 + 2 * nw)
-        room = max(1024, int((self.limits.memory // 2) / per_node))
-        table = new_table(room, kw)
-        out = _policy_game(
-            rules.tables, self.table, table, starts, kind, prefs, n_prefs, self.stats, room
-        )
+        most = max(1024, int((self.limits.memory // 2) / per_node))
+        room = min(most, max(FIRST_ENTRIES, self.positions))
+        while True:  # a table for ``room`` nodes, four times larger while it is over
+            table = new_table(room, kw)
+            out = _policy_game(
+                rules.tables, self.table, table, starts, kind, prefs, n_prefs, self.stats, room
+            )
+            if out[0]:
+                break
+            if self._grow():
+                continue
+            if self.stats[ABORT] or room >= most:
+                return None
+            room = min(most, 4 * room)
         ok, rows, start_ids, src, dst, cost, side, e_ops, e_dur, e_dev = out
-        if not ok:
-            return None
         edges = (src, dst, cost, side, e_ops, e_dur, e_dev)
         return _as_game(rules, budgets, rows, start_ids, edges, t0)
 

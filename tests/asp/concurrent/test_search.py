@@ -198,3 +198,31 @@ def test_schedule_hints_and_proven_floors_keep_the_values(data, rnd, below):
         start_values(curve.game, range(curve.k + 1))
         == [w / rules.scale for w in want][: curve.k + 1]
     )
+
+
+@SETTINGS
+@given(random_jobs(humans=(1, 2), ranges=True))
+def test_a_table_that_grows_gives_the_same_values(data):
+    """A search table that starts at 16 entries and grows four-fold when full (the entries
+    rehashed, the search run again where it stopped): the compiled game's values and the
+    robust policy's certificate."""
+    import asp.concurrent.search as search_module
+
+    ops, agents = data
+    spec, graph = job(ops, agents=agents)
+    rules = concurrent_rules(spec, graph)
+    top = top_budget(agents, ops)
+    want = oracle_values(spec, graph, top)
+    first = search_module.FIRST_ENTRIES
+    search_module.FIRST_ENTRIES = 16
+    try:
+        search = Search(rules)
+        assert [search.value(k) for k in range(top + 1)] == want
+        curve = solve_curve(rules, max_k=top)
+    finally:
+        search_module.FIRST_ENTRIES = first
+    assert search.stopped is None and all(curve.exact) and curve.policy == "robust"
+    assert (
+        start_values(curve.game, range(curve.k + 1))
+        == [w / rules.scale for w in want][: curve.k + 1]
+    )
