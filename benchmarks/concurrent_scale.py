@@ -4,8 +4,11 @@ A job of ``n`` operations in ``chains`` parallel chains (each operation after th
 before it in its chain, the last operation of every chain before a final check), agents
 ``H`` and ``R1..Rr``; every third operation is the person's (a duration range of
 ``spread`` seconds on the grid of 1 s), the others a robot's or either side's; ``R1``
-screws with a bit the person changes twice (tool changes). Prints game nodes, edges and
-seconds per budget, the curve W*(0..k) and W*(inf), and the peak memory.
+screws with a bit the person changes twice (tool changes). Prints the on-the-fly search's
+curve W*(0..k) and W*(inf) (:func:`asp.concurrent.search.solve_curve`, the CP-SAT schedule
+as its first guesses and its bound as ``L``), its positions, seconds and the peak memory;
+with ``--enumerate`` also the full enumeration's (:func:`asp.concurrent.robustness`, the
+oracle: game nodes and edges, the same values).
 
     python benchmarks/concurrent_scale.py                 # the 20-operation, 3-agent job
     python benchmarks/concurrent_scale.py --sweep         # growth with operations and agents
@@ -19,7 +22,10 @@ import time
 
 from asp.concurrent.model import concurrent_model
 from asp.concurrent.robustness import robustness
+from asp.concurrent.rules import concurrent_rules
+from asp.concurrent.search import solve_curve
 from asp.graph.state_graph import build_state_graph
+from asp.schedule.assembly_makespan import assembly_makespan
 from asp.spec import Agent, AssemblySpec, Operation, Tool
 
 
@@ -65,7 +71,37 @@ def job(n_ops: int = 20, robots: int = 2, chains: int = 4, spread: int = 4) -> A
     )
 
 
+def search(n_ops: int, robots: int, spread: int, max_k: int) -> None:
+    """The on-the-fly search's figures (module docstring)."""
+    spec = job(n_ops, robots, spread=spread)
+    t0 = time.perf_counter()
+    graph = build_state_graph(spec)
+    sched, result = assembly_makespan(spec, graph, time_limit=10.0)
+    t1 = time.perf_counter()
+    rules = concurrent_rules(spec, graph)
+    curve = solve_curve(
+        rules,
+        max_k=max_k,
+        schedule=result.detail.get("schedule"),
+        lower=max(sched.lower_bound, result.bound or 0.0),
+    )
+    t2 = time.perf_counter()
+    mem = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    cells = [
+        f"{r['lower']:g}" if r["exact"] else f"[{r['lower']:g}, {r['upper']:g}]"
+        for r in curve.to_list()
+    ]
+    print(
+        f"{n_ops:3d} ops {1 + robots} agents spread {spread}: state graph {graph.n_states:,} "
+        f"states, CP-SAT {result.objective:g} ({t1 - t0:.2f} s); search k=0..{curve.k}: "
+        f"{curve.positions:,} positions, curve {cells[:-1]} W*(inf) {cells[-1]}, "
+        f"flat {curve.flat}; {t2 - t1:.2f} s; peak {mem:,.0f} MB",
+        flush=True,
+    )
+
+
 def run(n_ops: int, robots: int, spread: int, max_k: int) -> None:
+    """The full enumeration's figures (the oracle)."""
     spec = job(n_ops, robots, spread=spread)
     t0 = time.perf_counter()
     graph = build_state_graph(spec)
@@ -90,13 +126,15 @@ def main() -> None:
     parser.add_argument("--ops", type=int, default=20)
     parser.add_argument("--robots", type=int, default=2)
     parser.add_argument("--spread", type=int, default=4)
-    parser.add_argument("--max-k", type=int, default=3)
+    parser.add_argument("--max-k", type=int, default=12)
+    parser.add_argument("--enumerate", action="store_true", help="the full enumeration too")
     args = parser.parse_args()
-    if not args.sweep:
-        run(args.ops, args.robots, args.spread, args.max_k)
-        return
-    for robots in (1, 2, 3):
-        for n in (8, 12, 16, 20):
+    sizes = [(args.ops, args.robots)]
+    if args.sweep:
+        sizes = [(n, robots) for robots in (1, 2, 3) for n in (8, 12, 16, 20)]
+    for n, robots in sizes:
+        search(n, robots, args.spread, args.max_k)
+        if args.enumerate:
             run(n, robots, args.spread, args.max_k)
 
 
