@@ -9,6 +9,7 @@ also match (the invariants cannot tell them apart); a BOM or spec ``shape:`` ove
 
 from __future__ import annotations
 
+from collections import Counter
 from collections.abc import Sequence
 
 import numpy as np
@@ -40,8 +41,9 @@ def shape_classes(parts: Sequence[Part]) -> tuple[str, ...]:
     """A shape-class id per part: identical parts share one (the first member's id base).
 
     A part whose ``shape`` is already set keeps it. A class's id is the common name of its
-    members without their number (``nut_1``, ``nut_2`` -> ``nut``) when they share one,
-    else the first member's id.
+    members without their number (``nut_1``, ``nut_2`` -> ``nut``) when they share one and
+    no other class does, else the first member's id (the bodies of one split part, all
+    ``truck_body_<n>``, are screws and tyres: two classes, never one).
     """
     free = [k for k, p in enumerate(parts) if not p.shape]
     label = dict(zip(free, alike_labels([parts[k].mesh for k in free]), strict=True))
@@ -49,6 +51,10 @@ def shape_classes(parts: Sequence[Part]) -> tuple[str, ...]:
     for k, cls in label.items():
         members.setdefault(cls, []).append(parts[k].id)
     names = {cls: _class_name(ids) for cls, ids in members.items()}
+    taken = Counter(names.values())
+    for cls, name in names.items():  # two classes of one name base: each its first id
+        if taken[name] > 1:
+            names[cls] = members[cls][0]
     return tuple(p.shape if p.shape else names[label[k]] for k, p in enumerate(parts))
 
 

@@ -205,3 +205,25 @@ def test_open_parts_touching_without_opposing_faces_are_in_contact():
         warnings.simplefilter("ignore")
         apart = compute_relations(Assembly.from_meshes({"lower": lower, "upper": far}))
     assert not apart.tc.any()
+
+
+def test_the_bodies_of_one_part_fall_into_distinct_shape_classes(tmp_path):
+    """The bodies of a split part share the name base ``<part>_body``: three screws and
+    two wheels are two shape classes with two names, never one class of five."""
+    from cad.identical import shape_classes
+
+    screws = [
+        trimesh.creation.cylinder(radius=1, height=8).apply_translation([x, 0, 0])
+        for x in (0, 5, 10)
+    ]
+    wheels = [
+        trimesh.creation.cylinder(radius=4, height=2).apply_translation([x, 20, 0]) for x in (0, 12)
+    ]
+    path = tmp_path / "fused.stl"
+    fused(*screws, *wheels).export(path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assembly = load_assembly(path)
+    classes = shape_classes(assembly.parts)
+    assert len(classes) == 5 and len(set(classes)) == 2
+    assert classes[0] == classes[1] == classes[2] != classes[3] == classes[4]
