@@ -168,12 +168,15 @@ class AssemblyPlan:
     sequences : int
         Number of feasible complete assembly sequences.
     game : Game or None
-        None when :func:`plan` let it go (``keep_game=False``; ``played`` has what the
-        outputs need of it).
+        The alternating game. None when :func:`plan` let it go (``keep_game=False``;
+        ``played`` has what the outputs need of it), and with the turn model
+        ``concurrent``, whose plan never builds it (``concurrent`` has its game).
     solution : asp.game.solve.Solution or None
         Exact solution: TCT, W* and both sides' policies (None with ``game``).
     steps : tuple of asp.game.plan.PlanStep
-        The robust plan, turn by turn (robust robot against a maximising human).
+        The robust plan, turn by turn (robust robot against a maximising human); empty
+        with the turn model ``concurrent`` (its lines are ``concurrent.cooperative`` and
+        ``concurrent.worst``).
     relations_summary : list of dict
         Per part: contacts (with directions) and free directions.
     schedule : Schedule
@@ -188,8 +191,9 @@ class AssemblyPlan:
         With the turn model ``alternate``: the concurrent game's preview
         (:func:`concurrent_preview`; ``plan.json``'s ``concurrent_preview``).
     played : PlayedGame or None
-        What the outputs take from the game, made by :func:`plan` (else from ``game`` and
-        ``solution`` when first needed: :attr:`played_game`).
+        What the outputs take from the alternating game, made by :func:`plan` (else from
+        ``game`` and ``solution`` when first needed: :attr:`played_game`); None with the
+        turn model ``concurrent``.
     """
 
     assembly: Assembly
@@ -211,9 +215,12 @@ class AssemblyPlan:
 
     @functools.cached_property
     def played_game(self) -> PlayedGame:
-        """``played``, or made from ``game`` and ``solution`` (once)."""
+        """``played``, or made from ``game`` and ``solution`` (once); an alternate plan's
+        only (a concurrent plan has no alternating game)."""
         if self.played is not None:
             return self.played
+        if self.concurrent is not None:
+            raise ValueError("a concurrent plan has no alternating game (see its `concurrent`)")
         return played_game(self.graph, self.game, self.solution)
 
     def to_dict(self) -> dict[str, Any]:
@@ -686,15 +693,19 @@ def plan(
     seed : int
         CP-SAT random seed.
     turn_model : {"alternate", "concurrent"}, optional
-        Default: the spec's. ``concurrent`` adds the concurrent game
-        (:func:`asp.concurrent.plan.plan_concurrent`).
+        Default: the spec's. ``alternate``: the alternating game, solved, then CP-SAT and
+        the concurrent preview (:func:`alternate_preview`). ``concurrent``: CP-SAT, then the
+        concurrent game (:func:`asp.concurrent.plan.plan_concurrent`); the alternating game
+        is never built (the result's ``game``, ``solution`` and ``played`` are None, its
+        ``steps`` empty).
     max_k : int, optional
         Largest deviation budget of the concurrent curve (default
         :data:`asp.concurrent.robustness.DEFAULT_MAX_K`).
     duration_step : float or None
         Grid of a person's duration range in the concurrent game (None: its end points).
     on_step : callable, optional
-        Called with one line before each step (progress for a person).
+        Called with one line before each step (progress for a person): ``[1/5]`` to
+        ``[4/5]``, each once and in order (``asmplan plan`` says ``[5/5]`` as it writes).
     max_states : int, optional
         State graph limit (default: the spec's ``max_states``, else 20,000,000).
     contact_tol, penetration_tol : float, optional
@@ -719,7 +730,7 @@ def plan(
     map_large_blocks()  # a freed array of a few MB goes back to the system at once
     say = on_step or (lambda _message: None)
     say("[1/5] reading the assembly and computing part relations ...")
-    assembly = (
+    loaded = assembly = (
         source
         if isinstance(source, Assembly)
         else load(
@@ -756,6 +767,24 @@ def plan(
         assembly = Assembly(graph.spec, assembly.relations)
     sequences = graph.count_sequences()
     release_memory()  # the layers and tables of the build
+    if turn == "concurrent":  # CP-SAT first: its optimum bounds the concurrent game's W*(k)
+        from asp.concurrent.plan import plan_concurrent
+        from asp.concurrent.robustness import DEFAULT_MAX_K
+
+        say("[3/5] CP-SAT minimum-makespan schedule ...")
+        sched = schedule(assembly, graph, time_limit=time_limit, seed=seed)
+        release_memory()  # CP-SAT's model and the replay tables
+        say("[4/5] solving the concurrent game, W*(k) until flat ...")
+        concurrent = plan_concurrent(
+            assembly.spec,
+            graph,
+            max_k=DEFAULT_MAX_K if max_k is None else max_k,
+            step=duration_step,
+            schedule=(sched.result, sched.lower_bound),
+        )
+        return AssemblyPlan(
+            assembly, graph, sequences, None, None, (), summary, sched, concurrent, unit_rows
+        )
     say("[3/5] solving the robot-vs-human game ...")
     the_game = Game(game(graph, cost=cost), assembly.descriptions)
     release_memory()  # the game's per-edge temporaries
@@ -770,23 +799,7 @@ def plan(
     line = [step.operation for step in steps if step.operation]
     sched = schedule(assembly, graph, time_limit=time_limit, seed=seed, sequence=line)
     release_memory()  # CP-SAT's model and the replay tables
-    concurrent = preview = None
-    if turn != "concurrent":
-        preview = concurrent_preview(
-            assembly.spec, graph, schedule=(sched.result, sched.lower_bound)
-        )
-    else:
-        from asp.concurrent.plan import plan_concurrent
-        from asp.concurrent.robustness import DEFAULT_MAX_K
-
-        say("[4/5] solving the concurrent game, W*(k) until flat ...")
-        concurrent = plan_concurrent(
-            assembly.spec,
-            graph,
-            max_k=DEFAULT_MAX_K if max_k is None else max_k,
-            step=duration_step,
-            schedule=(sched.result, sched.lower_bound),
-        )
+    preview = alternate_preview(loaded, graph, schedule=(sched.result, sched.lower_bound))
     return AssemblyPlan(
         assembly,
         graph,
@@ -796,16 +809,69 @@ def plan(
         steps,
         summary,
         sched,
-        concurrent,
+        None,
         unit_rows,
         played,
         preview,
     )
 
 
+def alternate_preview(
+    assembly: Assembly, graph: StateGraph, *, schedule: tuple | None = None
+) -> dict:
+    """``plan.json``'s ``concurrent_preview`` of an alternate plan: the concurrent game that
+    ``--turn-model concurrent`` would play, on the state graph that plan would use.
+
+    The alternate plan's ``graph`` puts alike parts in a fixed order, which keeps the
+    alternating game's values but not the concurrent game's: two alike parts could not go
+    in at once there (the Fabrica duct: W*(0) 26 on it, beside a CP-SAT optimum of 20). The
+    concurrent plan's graph (:func:`state_graph` with ``concurrent=True``: alike parts in a
+    loose order, the concurrent rules doing the rest) keeps both, so the preview's W*(0)
+    equals the CP-SAT optimum where both are exact. It is built from ``assembly`` (as
+    loaded, before any subassembly) up to :data:`PREVIEW_MAX_STATES` states.
+
+    Parameters
+    ----------
+    assembly : Assembly
+        The assembly as :func:`load` gives it.
+    graph : asp.graph.state_graph.StateGraph
+        The alternate plan's graph (larger than :data:`PREVIEW_MAX_STATES`: no preview).
+    schedule : (BaselineResult, float), optional
+        The plan's CP-SAT schedule and its lower bound (its value is the same on either
+        graph: :mod:`asp.graph.fixed_order`); not used when the concurrent graph's
+        operations differ (other subassemblies), CP-SAT then runs again.
+
+    Returns
+    -------
+    dict
+        :func:`concurrent_preview` of the concurrent graph, or ``{"why": reason}``.
+    """
+    if graph.n_states > PREVIEW_MAX_STATES:
+        return {"why": _too_large(f"{graph.n_states:,} assembly states")}
+    try:
+        loose = state_graph(assembly, max_states=PREVIEW_MAX_STATES, concurrent=True)
+    except ValueError as exc:  # over the limit (StateLimit), or any reason it cannot be built
+        from asp.errors import StateLimit
+
+        if isinstance(exc, StateLimit):
+            return {
+                "why": _too_large(
+                    f"over {PREVIEW_MAX_STATES:,} assembly states with alike parts in any order"
+                )
+            }
+        return {"why": str(exc).splitlines()[0]}
+    if loose.spec.op_ids != graph.spec.op_ids:
+        schedule = None
+    return concurrent_preview(loose.spec, loose, schedule=schedule)
+
+
+def _too_large(what: str) -> str:
+    return f"{what} (the report solves the concurrent game up to {PREVIEW_MAX_STATES:,})"
+
+
 def concurrent_preview(spec: AssemblySpec, graph: StateGraph, *, schedule=None) -> dict:
-    """``plan.json``'s ``concurrent_preview`` of an alternate plan: its concurrent game,
-    solved for the report when the state graph is small.
+    """The concurrent game of ``spec`` on ``graph``, solved for the report when the graph
+    is small (:func:`alternate_preview` gives it the graph the concurrent plan would use).
 
     Parameters
     ----------
@@ -819,15 +885,13 @@ def concurrent_preview(spec: AssemblySpec, graph: StateGraph, *, schedule=None) 
     dict
         The concurrent plan's ``robustness``, ``concurrent`` (without its ``seconds``) and
         ``schedule`` (its ``objective`` and ``status`` only) keys
-        (:func:`asp.concurrent.plan.plan_entries`) when the graph has at most
-        :data:`PREVIEW_MAX_STATES` states and the game could be solved, else ``{"why":
-        reason}``. No timings: two runs give the same preview.
+        (:func:`asp.concurrent.plan.plan_entries`), with ``states`` and ``sequences`` of
+        ``graph``, when the graph has at most :data:`PREVIEW_MAX_STATES` states and the game
+        could be solved, else ``{"why": reason}``. No timings: two runs give the same
+        preview.
     """
     if graph.n_states > PREVIEW_MAX_STATES:
-        return {
-            "why": f"{graph.n_states:,} assembly states (the report solves the concurrent "
-            f"game up to {PREVIEW_MAX_STATES:,})"
-        }
+        return {"why": _too_large(f"{graph.n_states:,} assembly states")}
     from asp.concurrent.plan import plan_concurrent, plan_entries
 
     try:
@@ -837,7 +901,13 @@ def concurrent_preview(spec: AssemblySpec, graph: StateGraph, *, schedule=None) 
     entries = plan_entries(preview)
     game = {k: v for k, v in entries["concurrent"].items() if k != "seconds"}
     sched = {k: entries["schedule"][k] for k in ("objective", "status")}
-    return {"robustness": entries["robustness"], "concurrent": game, "schedule": sched}
+    return {
+        "robustness": entries["robustness"],
+        "concurrent": game,
+        "schedule": sched,
+        "states": graph.n_states,
+        "sequences": graph.count_sequences(),
+    }
 
 
 def build_plan(
@@ -876,8 +946,10 @@ def write_plan(
     on_step: Progress | None = None,
     force: bool = False,
 ) -> tuple[Path, ...]:
-    """Write ``plan.json``, ``timings.json``, ``dag.png`` and ``report.html`` (and, with the
-    turn model ``concurrent``, the curve and timeline PNGs) into ``output`` as one unit.
+    """Write ``plan.json``, ``timings.json`` and ``report.html``, with the turn model
+    ``alternate`` the game DAG picture ``dag.png``, with ``concurrent`` the curve and
+    timeline PNGs of its game instead, into ``output`` as one unit: each report shows the
+    figures of its own game only.
 
     ``plan.json`` holds no time measured while planning (those are ``timings.json``'s), so
     two runs on the same input write the same ``plan.json``.
@@ -893,28 +965,32 @@ def write_plan(
         The files written (the manifest last).
     """
     from asmplan.report.html import plan_report
-    from asmplan.report.plot import draw_dag
     from asp.atomic import OutputSet
 
-    played = result.played_game
     with OutputSet(output, force=force) as out:
         doc = result.to_dict()
         out.write_text("plan.json", json.dumps(doc, separators=(",", ":"), allow_nan=False) + "\n")
         out.write_text("timings.json", json.dumps(result.timings(), indent=1) + "\n")
-        game = played.policy
-        draw_dag(
-            played.figure,
-            out.path("dag.png"),
-            title=f"{result.assembly.spec.name}: game DAG ({game.cost_model}), robust plan "
-            f"in red, TCT {game.tct:g}, W* {game.minimax:g}",
-        )
-        if result.concurrent is not None:
+        dag_png = None
+        if result.concurrent is None:
+            from asmplan.report.plot import draw_dag
+
+            played = result.played_game
+            game = played.policy
+            draw_dag(
+                played.figure,
+                out.path("dag.png"),
+                title=f"{result.assembly.spec.name}: game DAG ({game.cost_model}), robust plan "
+                f"in red, TCT {game.tct:g}, W* {game.minimax:g}",
+            )
+            dag_png = out.path("dag.png").read_bytes()
+        else:
             from asmplan.report.gantt import write_figures
 
             write_figures(doc, out.path)
         if on_step is not None:
             on_step("  writing report.html ...")
-        out.write_text("report.html", plan_report(doc, out.path("dag.png").read_bytes()))
+        out.write_text("report.html", plan_report(doc, dag_png))
     return out.written
 
 

@@ -1,8 +1,11 @@
 """``asmplan plan``: plan an assembly end to end (:func:`asmplan.pipeline.plan`).
 
 The pipeline computes; this module prints the summary for a person and writes the outputs
-(:func:`asmplan.pipeline.write_plan`: ``plan.json``, ``dag.png`` and ``manifest.json``, one
-unit).
+(:func:`asmplan.pipeline.write_plan`: ``plan.json``, ``report.html``, the figures of the
+plan's game and ``manifest.json``, one unit). Progress goes to stderr, each step numbered
+once and in order: ``[1/5]`` relations, ``[2/5]`` state graph, ``[3/5]`` and ``[4/5]`` the
+alternating game then CP-SAT (turn model ``alternate``) or CP-SAT then the concurrent game
+(``concurrent``, which builds no alternating game), ``[5/5]`` the files.
 """
 
 from __future__ import annotations
@@ -127,7 +130,10 @@ def plan_command(
         "3DXML) or folder of part meshes (a spec is generated; `asmplan init` writes it).",
     ),
     output: Path | None = typer.Option(
-        None, "--output", "-o", help="Folder for plan.json, dag.png (and manifest.json)."
+        None,
+        "--output",
+        "-o",
+        help="Folder for plan.json, report.html, the figures (and manifest.json).",
     ),
     cost: CostModel | None = typer.Option(None, "--cost", help="Cost model (default: spec's)."),
     time_limit: float | None = time_limit_option(None, AUTO_TIME_LIMIT_HELP),
@@ -164,7 +170,8 @@ def plan_command(
     units: str | None = units_option(),
     gravity: str | None = gravity_option(),
 ) -> None:
-    """Plan an assembly end to end: relations, state graph, game, robust plan, CP-SAT."""
+    """Plan an assembly end to end: relations, state graph, game, robust plan, CP-SAT
+    (concurrent: CP-SAT, then the concurrent game)."""
     from asmplan import pipeline
 
     t0 = time.perf_counter()

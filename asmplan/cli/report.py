@@ -1,8 +1,9 @@
 """``asmplan report``: redraw ``report.html`` from a plan folder, solving nothing.
 
-The page is a function of the folder's ``plan.json`` and ``dag.png``
-(:func:`asmplan.report.html.plan_report`), so a report can be drawn again, e.g. after the
-page's layout changed, without planning again.
+The page is a function of the folder's ``plan.json`` and, for an alternate plan, its
+``dag.png`` (:func:`asmplan.report.html.plan_report`; a concurrent plan's page draws its
+concurrent game's figures only), so a report can be drawn again, e.g. after the page's
+layout changed, without planning again.
 """
 
 from __future__ import annotations
@@ -18,13 +19,13 @@ from asmplan.cli.options import check_output
 @app.command("report")
 def report_command(
     plan_dir: Path = typer.Argument(
-        ..., help="A folder written by 'asmplan plan' (its plan.json and dag.png)."
+        ..., help="A folder written by 'asmplan plan' (its plan.json, alternate: dag.png)."
     ),
     output: Path | None = typer.Option(
         None, "--output", "-o", help="The page to write (default: PLAN_DIR/report.html)."
     ),
 ) -> None:
-    """Redraw report.html from a plan folder's plan.json and dag.png."""
+    """Redraw report.html from a plan folder's plan.json (and an alternate plan's dag.png)."""
     from asmplan.planfile import read_plan
     from asmplan.report.html import plan_report
     from asp.atomic import write_text

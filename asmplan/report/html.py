@@ -4,11 +4,14 @@ It shows the metrics, the price-of-robustness curve and the Gantt charts of the 
 game (when it could be solved; drawn by :mod:`asmplan.report.gantt`), the CP-SAT schedule's Gantt
 chart, the relations table, the principal line as pictures of the assembly growing step by
 step (:mod:`asmplan.report.steps`: rendered from the part meshes, the parts of each step
-highlighted, an arrow for each way in) and the game DAG picture.
+highlighted, an arrow for each way in) and, for an alternate plan, the game DAG picture. One
+solution, one set of figures: a concurrent plan's page shows its concurrent game's figures
+only (the curve and the timelines), never an alternating game's DAG.
 
 The page is a function of the plan document (``plan.json``, whose ``concurrent_preview``
 holds an alternate plan's concurrent game, computed by :mod:`asmplan.pipeline`) and the
-``dag.png`` beside it: nothing is solved here, so ``asmplan report PLAN_DIR`` redraws it.
+``dag.png`` beside an alternate plan: nothing is solved here, so ``asmplan report PLAN_DIR``
+redraws it.
 """
 
 from __future__ import annotations
@@ -28,11 +31,15 @@ def _img(uri: str, alt: str, width: int | None = None) -> str:
 # --------------------------------------------------------------------------- figures
 
 
+def _concurrent(doc: dict) -> bool:
+    return doc.get("turn_model") == "concurrent"
+
+
 def concurrent_part(doc: dict) -> dict:
     """The concurrent game's part of a plan document: the plan's own keys (``robustness``,
     ``concurrent``, ``schedule``) with the turn model ``concurrent``, else its
     ``concurrent_preview`` (empty when it has none; ``{"why": ...}`` when not solved)."""
-    if doc.get("turn_model") == "concurrent":
+    if _concurrent(doc):
         return doc
     return doc.get("concurrent_preview") or {}
 
@@ -86,9 +93,10 @@ def report_figures(doc: dict) -> dict[str, bytes]:
 
 def plan_report(doc: dict, dag_png: bytes | None = None) -> str:
     """``report.html`` of a plan document: :func:`report_html` with :func:`report_figures`
-    and the game DAG picture ``dag_png`` (``dag.png``'s bytes)."""
+    and, for an alternate plan, the game DAG picture ``dag_png`` (``dag.png``'s bytes;
+    ignored for a concurrent plan, whose figures are its own game's)."""
     figures = report_figures(doc)
-    if dag_png:
+    if dag_png and not _concurrent(doc):
         figures["dag"] = dag_png
     return report_html(doc, figures)
 
@@ -105,7 +113,7 @@ def report_html(plan: dict, figures: dict[str, bytes] | None = None) -> str:
 
     ``figures``: PNGs by name (``dag``, ``robustness``, ``gantt_cooperative``,
     ``gantt_worst``, ``gantt_schedule``; :func:`report_figures`) and ``why`` (bytes), the
-    reason the concurrent ones are missing.
+    reason the concurrent ones are missing. ``dag`` is drawn for an alternate plan only.
     """
     figures = figures or {}
     esc = html.escape
@@ -113,7 +121,7 @@ def report_html(plan: dict, figures: dict[str, bytes] | None = None) -> str:
     m = plan.get("metrics", {})
     sched = plan.get("schedule") or {}
     # The plan's game: the policy, lines and metrics are those of its turn model.
-    game = "concurrent game" if plan.get("turn_model") == "concurrent" else "alternating game"
+    game = "concurrent game" if _concurrent(plan) else "alternating game"
     rows = [
         ("assembly", plan.get("assembly", "")),
         ("turn model / cost", f"{plan.get('turn_model', '')} / {plan.get('cost', '')}"),
@@ -152,6 +160,8 @@ def report_html(plan: dict, figures: dict[str, bytes] | None = None) -> str:
 
     body.append("<h2>Price of robustness and the concurrent game</h2>")
     if "robustness" in figures:
+        if note := _graph_note(plan):
+            body.append(note)
         body.append(_img(_data_uri(figures["robustness"]), "price of robustness"))
         for name in ("gantt_cooperative", "gantt_worst"):
             body.append(_img(_data_uri(figures[name]), name.replace("_", " ")))
@@ -197,12 +207,28 @@ def report_html(plan: dict, figures: dict[str, bytes] | None = None) -> str:
                 f"<td>{esc(' '.join(r['free']) or 'none')}</td></tr>"
             )
         body.append("</table>")
-    if "dag" in figures:
+    if "dag" in figures and not _concurrent(plan):
         body.append("<h2>The game DAG</h2>")
         body.append(_img(_data_uri(figures["dag"]), "game DAG", width=1100))
     if plan.get("credit"):
         body.append(f"<p class='note'>{esc(plan['credit'])}</p>")
     return PAGE.format(title=esc(str(plan.get("assembly", "plan"))), body="\n".join(body))
+
+
+def _graph_note(plan: dict) -> str:
+    """What an alternate plan's concurrent preview was solved on (empty for a concurrent
+    plan, whose metrics say it): the concurrent plan's state graph, alike parts in any
+    order, beside the alternating game's, where they go in a fixed order."""
+    preview = plan.get("concurrent_preview") or {}
+    if _concurrent(plan) or "states" not in preview:
+        return ""
+    return (
+        "<p class='note'>The concurrent game is solved on the state graph a concurrent plan "
+        f"uses (alike parts in any order): {preview['states']} states, "
+        f"{preview['sequences']} feasible sequences; the alternating game's has alike parts "
+        f"in a fixed order ({plan.get('states', '-')} states, {plan.get('sequences', '-')} "
+        "feasible sequences).</p>"
+    )
 
 
 def _line_table(steps: list[dict], unit: str) -> str:

@@ -28,8 +28,12 @@ def test_pump_concurrent_plan(tmp_path):
     r = run("plan", str(PUMP), "--turn-model", "concurrent", "-o", str(out))
     assert r.returncode == 0, r.stderr
     assert "robust plan W*(k)" in r.stdout and "(fully adversarial)" in r.stdout
+    steps = [line[:5] for line in r.stderr.splitlines() if line.startswith("[")]
+    assert steps == ["[1/5]", "[2/5]", "[3/5]", "[4/5]", "[5/5]"], r.stderr  # each once
+    assert "robot-vs-human" not in r.stderr  # no alternating game (issue 23 item 4)
     for name in ("plan.json", *FIGURES):
         assert (out / name).stat().st_size > 0, name
+    assert not (out / "dag.png").exists()  # the figures of the concurrent game only
     plan = json.loads((out / "plan.json").read_text())
     assert plan["turn_model"] == "concurrent"
     assert plan["schedule"]["objective"] == 215 and plan["schedule"]["status"] == "OPTIMAL"

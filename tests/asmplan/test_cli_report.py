@@ -86,11 +86,38 @@ def test_the_alternate_plan_keeps_its_concurrent_preview(plan_dir):
     doc = json.loads((plan_dir / "plan.json").read_text())
     page = (plan_dir / "report.html").read_text()
     if doc["turn_model"] == "alternate":
-        assert set(doc["concurrent_preview"]) == {"robustness", "concurrent", "schedule"}
+        preview = doc["concurrent_preview"]
+        assert set(preview) == {"robustness", "concurrent", "schedule", "states", "sequences"}
+        assert "solved on the state graph a concurrent plan uses" in page
     else:
         assert "concurrent_preview" not in doc
     assert "The concurrent game was not solved" not in page
-    assert page.count("<img") >= 4  # the curve, two timelines and the game DAG
+    for alt in ("price of robustness", "gantt cooperative", "gantt worst", "CP-SAT Gantt chart"):
+        assert f'alt="{alt}"' in page
+    assert ('alt="game DAG"' in page) == (doc["turn_model"] == "alternate")
+
+
+def test_one_solution_one_set_of_figures(plan_dir, tmp_path, monkeypatch):
+    """Issue 23 item 4: a concurrent plan's report shows its concurrent game's figures only
+    (its metrics are that game's), never the alternating game's DAG picture ("TCT 259, W*
+    259" under metrics that say 215): no dag.png is written, and one found in the folder is
+    not drawn (the page stays a function of plan.json)."""
+    doc = json.loads((plan_dir / "plan.json").read_text())
+    page = (plan_dir / "report.html").read_text()
+    if doc["turn_model"] == "alternate":
+        assert (plan_dir / "dag.png").is_file() and "<h2>The game DAG</h2>" in page
+        return
+    assert not (plan_dir / "dag.png").exists()
+    assert "The game DAG" not in page and "alternating game" not in page
+    folder = tmp_path / "plan"
+    folder.mkdir()
+    for name in ("plan.json", "report.html"):
+        (folder / name).write_bytes((plan_dir / name).read_bytes())
+    (folder / "dag.png").write_bytes(b"\x89PNG an alternating game's picture")
+    refuse_to_solve(monkeypatch)
+    result = CliRunner().invoke(app, ["report", str(folder)])
+    assert result.exit_code == 0, result.output
+    assert (folder / "report.html").read_bytes() == (plan_dir / "report.html").read_bytes()
 
 
 @pytest.mark.parametrize(

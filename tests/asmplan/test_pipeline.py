@@ -17,6 +17,7 @@ from tests.cad.test_subassemblies import rod_tower, tower_spec
 from tests.conftest import REPO
 
 PUMP = REPO / "examples" / "vacuum_pump"
+FIRST_STEPS = ("[1/5] reading the assembly", "[2/5] building the assembly state graph")
 
 
 def test_steps_one_by_one_agree_with_the_whole_plan():
@@ -26,13 +27,97 @@ def test_steps_one_by_one_agree_with_the_whole_plan():
     dag = pipeline.game(graph, cost="time")
     solution = pipeline.solve_game(dag)
     steps = pipeline.robust_plan(pipeline.Game(dag, assembly.descriptions), solution)
-    whole = pipeline.plan(assembly, cost="time", time_limit=20)
+    lines = []
+    whole = pipeline.plan(assembly, cost="time", time_limit=20, on_step=lines.append)
+    assert numbered(lines) == [
+        *FIRST_STEPS,
+        "[3/5] solving the robot-vs-human game",
+        "[4/5] CP-SAT minimum-makespan schedule",
+    ]
     assert (whole.solution.tct, whole.solution.minimax) == (solution.tct, solution.minimax)
     assert whole.steps == steps
     assert whole.graph.n_states == graph.n_states
     data = whole.to_dict()
     assert data["format"] == pipeline.PLAN_FORMAT and data["cost"] == "time"
     assert [s["operation"] for s in data["robust_plan"]] == [s.operation for s in steps]
+
+
+def numbered(lines: list[str]) -> list[str]:
+    """The numbered progress lines (``[3/5] ...``), up to their first ``" ..."``/``" and"``."""
+    return [line.split(" ...")[0].split(" and")[0] for line in lines if line[:1] == "["]
+
+
+def test_a_concurrent_plan_builds_no_alternating_game(monkeypatch):
+    """Issue 23 item 4: with the turn model ``concurrent`` the alternating game is neither
+    built nor solved (every entry to it refuses), CP-SAT comes first and each step is
+    numbered once, in order; the plan keeps its keys (the policy, lines and metrics are
+    the concurrent game's)."""
+    import asp.graph.game_dag
+
+    def refuse(*_args, **_kwargs):
+        raise AssertionError("a concurrent plan must not build or solve the alternating game")
+
+    for module, name in (
+        (pipeline, "game"),
+        (pipeline, "solve_game"),
+        (pipeline, "robust_plan"),
+        (pipeline, "played_game"),
+        (asp.graph.game_dag, "game_dag"),
+    ):
+        monkeypatch.setattr(module, name, refuse)
+    lines = []
+    result = pipeline.plan(PUMP, turn_model="concurrent", time_limit=20, on_step=lines.append)
+    assert numbered(lines) == [
+        *FIRST_STEPS,
+        "[3/5] CP-SAT minimum-makespan schedule",
+        "[4/5] solving the concurrent game, W*(k) until flat",
+    ]
+    assert result.game is None and result.solution is None and result.played is None
+    assert result.steps == ()
+    with pytest.raises(ValueError, match="a concurrent plan has no alternating game"):
+        _ = result.played_game
+    doc = result.to_dict()
+    assert doc["turn_model"] == "concurrent" and doc["policy"]["turn_model"] == "concurrent"
+    assert doc["minimax"] == doc["robustness"][-2]["bound"] == 215  # W*(k) at the plan's k
+    assert doc["tct"] == doc["metrics"]["w0"] == doc["schedule"]["objective"] == 215
+
+
+def test_the_preview_is_solved_on_the_concurrent_plans_graph():
+    """Issue 23 item 4: an alternate plan's graph puts the pinned disc's alike pins in a
+    fixed order, so its concurrent game cannot place two at once (W*(0) 13 there, the
+    schedule run as a plan 15, beside a CP-SAT optimum of 11). The preview is solved on
+    the graph the concurrent plan uses, alike parts in any order: W*(0) and the schedule's
+    worst case at k = 0 are the optimum, and it says that graph's size."""
+    from tests.asp.graph.test_symmetry import pinned_disc
+
+    spec, rel = pinned_disc(3, 1)
+    assembly = pipeline.Assembly(spec, rel)
+    graph = pipeline.state_graph(assembly)
+    sched = pipeline.schedule(assembly, graph, time_limit=5)
+    assert (sched.result.status, sched.result.objective) == ("OPTIMAL", 11)
+    bounds = (sched.result, sched.lower_bound)
+    fixed = pipeline.concurrent_preview(graph.spec, graph, schedule=bounds)
+    assert fixed["robustness"][0]["bound"] == 13  # the conservative figure of before
+    preview = pipeline.alternate_preview(assembly, graph, schedule=bounds)
+    assert preview["robustness"][0] == {"k": 0, "bound": 11}
+    assert preview["concurrent"]["schedule_worst_case"][0] == {"k": 0, "bound": 11}
+    loose = pipeline.state_graph(assembly, concurrent=True)
+    assert (preview["states"], preview["sequences"]) == (10, 4)
+    assert (loose.n_states, loose.count_sequences()) == (10, 4)
+    assert (graph.n_states, graph.count_sequences()) == (7, 1)
+
+
+def test_a_preview_whose_concurrent_graph_is_too_large_says_so(monkeypatch):
+    from tests.asp.graph.test_symmetry import pinned_disc
+
+    spec, rel = pinned_disc(3, 1)
+    assembly = pipeline.Assembly(spec, rel)
+    graph = pipeline.state_graph(assembly)
+    monkeypatch.setattr("asmplan.pipeline.PREVIEW_MAX_STATES", 8)  # 7 fixed, 10 loose
+    assert pipeline.alternate_preview(assembly, graph) == {
+        "why": "over 8 assembly states with alike parts in any order (the report solves the "
+        "concurrent game up to 8)"
+    }
 
 
 @pytest.mark.parametrize("proved", [True, False])

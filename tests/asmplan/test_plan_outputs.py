@@ -45,6 +45,18 @@ def test_a_complete_run_names_its_files_last(pump_plan, tmp_path):
     )
 
 
+def test_a_concurrent_run_writes_its_own_game_s_figures_only(tmp_path):
+    """Issue 23 item 4: a concurrent plan has no alternating game, so no ``dag.png`` (whose
+    title gave that game's TCT and W* beside the concurrent metrics); its figures are the
+    curve and the two timelines, named by the manifest, the report last."""
+    result = pipeline.plan(PUMP, turn_model="concurrent", time_limit=20, keep_game=False)
+    written = pipeline.write_plan(result, tmp_path)
+    files = ["plan.json", "timings.json", "robustness.png", "gantt_cooperative.png"]
+    files += ["gantt_worst.png", "report.html"]
+    assert [p.name for p in written] == files
+    assert json.loads((tmp_path / MANIFEST).read_text())["files"] == files
+
+
 def test_a_failure_mid_write_leaves_no_mixed_folder(pump_plan, tmp_path, monkeypatch):
     """A new plan.json never sits beside an old dag.png: the write fails after plan.json."""
     pipeline.write_plan(pump_plan, tmp_path)
