@@ -19,6 +19,7 @@ SOLVERS = (
     ("asmplan.pipeline", "solve_game"),
     ("asmplan.pipeline", "schedule"),
     ("asmplan.pipeline", "concurrent_preview"),
+    ("asmplan.pipeline", "alternate_preview"),
     ("asp.graph.state_graph", "build_state_graph"),
     ("asp.game.solve", "solve"),
     ("asp.concurrent.plan", "plan_concurrent"),
