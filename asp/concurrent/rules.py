@@ -947,12 +947,16 @@ def lower_bound_of(T, row):  # pragma: no cover - compiled
 def _fits(T, t, rems, forced, todo):  # pragma: no cover - compiled
     """Whether the remaining work fits both sides by time ``t`` (:func:`lower_bound_of`)."""
     nw = T.side.shape[0]
-    cap = np.zeros(2, np.int64)
+    cap0 = 0  # (scalars, not an array: this runs a dozen times per bound)
+    cap1 = 0
     for w in range(nw):
         if t > rems[w]:
-            cap[T.side[w]] += t - rems[w]
-    room = cap[1] - forced[1]
-    if room < 0 or cap[0] < forced[0]:
+            if T.side[w] == 0:
+                cap0 += t - rems[w]
+            else:
+                cap1 += t - rems[w]
+    room = cap1 - forced[1]
+    if room < 0 or cap0 < forced[0]:
         return False
     need = 0.0  # robot work of the operations both may do, the person taking the best ratio
     for i in range(T.flex.shape[0]):
@@ -966,4 +970,4 @@ def _fits(T, t, rems, forced, todo):  # pragma: no cover - compiled
             frac = 1.0 - room / h if h > 0 else 0.0
             room = 0
             need += frac * T.side_dur[0, o]
-    return need <= cap[0] - forced[0] + 1e-9
+    return need <= cap0 - forced[0] + 1e-9
