@@ -34,8 +34,10 @@ Every rule that cuts the search, with its proof:
    tried in increasing order of it, and the loop stops at the first whose bound reaches the
    best value found (or the window's top), which neither it nor any later one can beat.
 3. *Budgets.* A human allowed ``b + 1`` deviations can play every strategy of ``b``, so
-   ``W(s, b - 1) <= W(s, b) <= W(s, b + 1)``: a new position takes ``lo`` from the same
-   position one budget lower and ``hi`` from one budget higher when the table has them. At
+   ``W(s, b - 1) <= W(s, b) <= W(s, b + 1) <= W(s, R)`` (``R`` the cap): a new position takes
+   ``lo`` from the same position one budget lower and ``hi`` from one budget higher or from
+   the cap when the table has them (``W*(inf)`` is searched second, so the cap's entries are
+   there for most positions the later budgets meet). At
    the root, the search for ``k`` runs in the window ``(W*(k - 1), W*(inf) + 1)`` (rule 7).
 4. *Instructions that cannot bind.* With the budget at its cap (every deviation affordable,
    :mod:`asp.concurrent.rules`) the person may do anything at no cost, and the child's budget
@@ -241,7 +243,7 @@ def _find(H, key):  # pragma: no cover - compiled
 def _entry(T, H, row, st, lb):  # pragma: no cover - compiled
     """The slot of the position ``row``, made when new: ``lo`` its lower bound (``lb`` when
     given, >= 0), raised to the same position's one budget lower and ``hi`` lowered to its
-    one budget higher (rule 3). -1 (and the stop flag) when the table is full."""
+    one budget higher or the cap's (rule 3). -1 (and the stop flag) when the table is full."""
     key = key_of(T, row)
     i = _slot(H, key)
     if H.keys[i, 0] != 0:
@@ -258,11 +260,13 @@ def _entry(T, H, row, st, lb):  # pragma: no cover - compiled
         j = _find(H, key_of(T, other))
         if j >= 0 and H.lo[j] > lo:
             lo = H.lo[j]
-    if b < budget_cap_of(T, row):
-        other[1] = b + 1
-        j = _find(H, key_of(T, other))
-        if j >= 0:
-            hi = H.hi[j]
+    cap = budget_cap_of(T, row)
+    for nb in (b + 1, cap):  # one budget higher, and the cap (k = inf): W never falls
+        if nb > b:
+            other[1] = nb
+            j = _find(H, key_of(T, other))
+            if j >= 0 and H.hi[j] < hi:
+                hi = H.hi[j]
     i = _slot(H, key)  # (the probes above did not write)
     H.keys[i] = key
     H.lo[i] = lo
