@@ -46,9 +46,10 @@ class ConcurrentModel:
         Transitions of the state graph between co-reachable states, with the tool-change
         time (scaled) the operation adds there.
     succ : dict (state, op) -> (state, change)
-        The same as a dictionary (the Python builder's lookups).
+        The same as a dictionary (the Python builder's lookups; made when first asked for:
+        the compiled rules never do, and on millions of transitions it takes gigabytes).
     enabled : list of tuple of int
-        Per state, the operations with a transition.
+        Per state, the operations with a transition (made with ``succ``).
     conflict : (n_ops, n_ops) bool
         Tool conflicts: one changes a tool the other needs or changes.
     complete : (N,) bool
@@ -60,11 +61,36 @@ class ConcurrentModel:
     scale: int
     choices: list
     steps: LiveSteps
-    succ: dict
-    enabled: list
     conflict: np.ndarray
     complete: np.ndarray
     _memo: dict = field(default_factory=dict, repr=False)
+    _lookups: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def succ(self) -> dict:
+        if not self._lookups:
+            self._make_lookups()
+        return self._lookups["succ"]
+
+    @property
+    def enabled(self) -> list:
+        if not self._lookups:
+            self._make_lookups()
+        return self._lookups["enabled"]
+
+    def _make_lookups(self) -> None:
+        steps = self.steps
+        succ = {}
+        enabled = [[] for _ in range(self.graph.n_states)]
+        pairs = zip(
+            steps.src.tolist(), steps.dst.tolist(), steps.op.tolist(), steps.change.tolist(),
+            strict=True,
+        )  # fmt: skip
+        for s, d, o, c in pairs:
+            succ[(s, o)] = (d, int(c))
+            enabled[s].append(o)
+        self._lookups["succ"] = succ
+        self._lookups["enabled"] = [tuple(e) for e in enabled]
 
     @property
     def n_ops(self) -> int:
@@ -248,18 +274,6 @@ def concurrent_model(
         return model.tool_changes(graph.keys[src], op).astype(np.int64) @ change
 
     steps = LiveSteps(graph, change_time if model.tool_names else None)
-    succ = {}
-    enabled = [[] for _ in range(graph.n_states)]
-    pairs = zip(
-        steps.src.tolist(),
-        steps.dst.tolist(),
-        steps.op.tolist(),
-        steps.change.tolist(),
-        strict=True,
-    )
-    for s, d, o, c in pairs:
-        succ[(s, o)] = (d, int(c))
-        enabled[s].append(o)
     conflict = tool_conflicts(spec)
     return ConcurrentModel(
         spec=spec,
@@ -268,8 +282,6 @@ def concurrent_model(
         scale=scale,
         choices=choices,
         steps=steps,
-        succ=succ,
-        enabled=[tuple(e) for e in enabled],
         conflict=conflict,
         complete=graph.complete,
     )
