@@ -39,6 +39,7 @@ if TYPE_CHECKING:  # pragma: no cover - types only
     from asmplan.planfile import AlternateStates, PlayedPolicy
     from asmplan.report.plot import DagFigure
     from asp.concurrent.plan import ConcurrentPlan
+    from asp.concurrent.search import Limits
     from asp.game.dag import GameDAG
     from asp.game.plan import PlanStep
     from asp.game.solve import Solution
@@ -54,6 +55,13 @@ GRAPH_SUFFIXES = (".json", ".graphml", ".xml")
 PREVIEW_MAX_STATES = 5_000
 """Largest state graph whose concurrent game an alternate plan previews (``plan.json``'s
 ``concurrent_preview``, drawn in ``report.html``)."""
+
+PREVIEW_MAX_POSITIONS = 200_000
+"""Positions the preview's concurrent search may expand (past them: an interval)."""
+
+SEARCH_SECONDS = 120.0
+"""Default ``--search-time-limit``: seconds of the concurrent search before it answers with
+certified intervals (:mod:`asp.concurrent.search`)."""
 
 Progress = Callable[[str], None]
 """A callback that shows one line of progress (e.g. prints it on stderr)."""
@@ -679,6 +687,9 @@ def plan(
     keep_game: bool = True,
     units: str | None = None,
     gravity: str | None = None,
+    search_time_limit: float | None = SEARCH_SECONDS,
+    max_nodes: int | None = None,
+    max_memory: float | None = None,
 ) -> AssemblyPlan:
     """Plan an assembly end to end, as ``asmplan plan`` does.
 
@@ -703,6 +714,9 @@ def plan(
         :data:`asp.concurrent.robustness.DEFAULT_MAX_K`).
     duration_step : float or None
         Grid of a person's duration range in the concurrent game (None: its end points).
+    search_time_limit, max_nodes, max_memory : optional
+        The concurrent search's limits (:func:`search_limits`): seconds (None: none),
+        positions expanded and GB; past them ``W*(k)`` is a certified interval.
     on_step : callable, optional
         Called with one line before each step (progress for a person): ``[1/5]`` to
         ``[4/5]``, each once and in order (``asmplan plan`` says ``[5/5]`` as it writes).
@@ -780,7 +794,9 @@ def plan(
             graph,
             max_k=DEFAULT_MAX_K if max_k is None else max_k,
             step=duration_step,
+            limits=search_limits(search_time_limit, max_nodes, max_memory),
             schedule=(sched.result, sched.lower_bound),
+            progress=on_step is not None,
         )
         return AssemblyPlan(
             assembly, graph, sequences, None, None, (), summary, sched, concurrent, unit_rows
@@ -869,6 +885,22 @@ def _too_large(what: str) -> str:
     return f"{what} (the report solves the concurrent game up to {PREVIEW_MAX_STATES:,})"
 
 
+def search_limits(
+    time_limit: float | None, max_nodes: int | None, max_memory: float | None
+) -> Limits:
+    """The concurrent search's :class:`~asp.concurrent.search.Limits` from ``plan``'s
+    ``--search-time-limit`` (seconds, None: none), ``--max-nodes`` (positions expanded) and
+    ``--max-memory`` (GB); None keeps the search's default."""
+    from asp.concurrent.search import Limits
+
+    given = {"time_limit": time_limit}
+    if max_nodes is not None:
+        given["max_nodes"] = int(max_nodes)
+    if max_memory is not None:
+        given["memory"] = int(max_memory * 2**30)
+    return Limits(**given)
+
+
 def concurrent_preview(spec: AssemblySpec, graph: StateGraph, *, schedule=None) -> dict:
     """The concurrent game of ``spec`` on ``graph``, solved for the report when the graph
     is small (:func:`alternate_preview` gives it the graph the concurrent plan would use).
@@ -895,7 +927,9 @@ def concurrent_preview(spec: AssemblySpec, graph: StateGraph, *, schedule=None) 
     from asp.concurrent.plan import plan_concurrent, plan_entries
 
     try:
-        preview = plan_concurrent(spec, graph, max_nodes=200_000, schedule=schedule)
+        preview = plan_concurrent(
+            spec, graph, limits=search_limits(None, PREVIEW_MAX_POSITIONS, None), schedule=schedule
+        )
     except (ValueError, MemoryError) as exc:
         return {"why": str(exc).splitlines()[0]}
     entries = plan_entries(preview)

@@ -29,6 +29,7 @@ from asmplan.cli.options import (
     turn_model_option,
     units_option,
 )
+from asmplan.pipeline import SEARCH_SECONDS
 from asp.atomic import check_output_folder
 from asp.schedule.assembly_makespan import AUTO_PATIENCE, AUTO_TIME_LIMIT
 
@@ -169,6 +170,25 @@ def plan_command(
     ),
     units: str | None = units_option(),
     gravity: str | None = gravity_option(),
+    search_time_limit: float = typer.Option(
+        SEARCH_SECONDS,
+        "--search-time-limit",
+        min=0.0,
+        help="Concurrent: seconds of the search for W*(k) (0: no limit); past it, W*(k) is a "
+        "certified interval [L, U] and the plan's policy the one certified at U.",
+    ),
+    max_nodes: int | None = typer.Option(
+        None,
+        "--max-nodes",
+        min=1,
+        help="Concurrent: positions the search may expand (default 50,000,000).",
+    ),
+    max_memory: float | None = typer.Option(
+        None,
+        "--max-memory",
+        min=0.001,
+        help="Concurrent: GB for the search's table and its policy games (default 1).",
+    ),
 ) -> None:
     """Plan an assembly end to end: relations, state graph, game, robust plan, CP-SAT
     (concurrent: CP-SAT, then the concurrent game)."""
@@ -193,6 +213,9 @@ def plan_command(
         units=units,
         gravity=gravity,
         keep_game=False,  # let the game go once solved: less memory for CP-SAT and the files
+        search_time_limit=search_time_limit or None,
+        max_nodes=max_nodes,
+        max_memory=max_memory,
     )
     for line in plan_summary(result):
         typer.echo(line)

@@ -187,11 +187,13 @@ def _scripted_policy(dag, describe, script: dict[str, list[str]]) -> np.ndarray:
 
 
 def _concurrent_plan(result, condition: Condition) -> dict:
+    from asp.concurrent.plan import exact_curve
     from asp.concurrent.robustness import certified_worst_case, policy_array, schedule_rule
     from asp.game.play import fast_greedy_policy
 
     plan = result.concurrent
-    curve = plan.curve
+    compiled = plan.compiled()  # a fixed robot may reach any state: the whole game
+    curve = exact_curve(compiled)
     game, solution = curve.game, curve.solution
     rule = None
     if condition.robot == "fast-greedy":
@@ -199,8 +201,8 @@ def _concurrent_plan(result, condition: Condition) -> dict:
     elif condition.robot == "run":
         from arl.trainer import load_policies
 
-        learned = load_policies(curve.adversary.dag, condition.run)[0]
-        rule = learned_rule(curve.adversary, learned, solution)
+        learned = load_policies(compiled.adversary.dag, condition.run)[0]
+        rule = learned_rule(compiled.adversary, learned, solution)
         policy = policy_array(game, rule)
     else:
         if condition.robot == "cp-sat":
@@ -216,7 +218,7 @@ def _concurrent_plan(result, condition: Condition) -> dict:
     fixed = _fixed_solution(game.dag, solution, policy)
     worst = [{"k": k, "bound": certified_worst_case(game, policy, k)} for k in range(curve.k + 1)]
     if rule is not None:
-        worst.append({"k": None, "bound": certified_worst_case(curve.adversary, rule)})
+        worst.append({"k": None, "bound": certified_worst_case(compiled.adversary, rule)})
     swapped = dataclasses.replace(curve, solution=fixed)
     doc = dataclasses.replace(result, concurrent=dataclasses.replace(plan, curve=swapped)).to_dict()
     return _tagged(doc, condition, worst)

@@ -35,7 +35,9 @@ The rooms, in the order they build on each other: :mod:`asp.concurrent.model` (t
 and state graph compiled), :mod:`asp.concurrent.build` (the game DAG, with its numba
 builder :mod:`asp.concurrent.kernel` beside it), :mod:`asp.concurrent.robustness` (the
 curve and what a policy guarantees), :mod:`asp.concurrent.describe` (the game read back)
-and :mod:`asp.concurrent.plan` (the concurrent plan of an assembly). The CP-SAT makespan
+the on-the-fly search :mod:`asp.concurrent.search` (``W*(k)`` without compiling the game,
+exact or a certified interval) and :mod:`asp.concurrent.plan` (the concurrent plan of an
+assembly). The CP-SAT makespan
 stage it is compared with is :mod:`asp.schedule.assembly_makespan`.
 """
 
@@ -49,12 +51,14 @@ __all__, __getattr__ = lazy_exports(
         "model": ("WAIT", "concurrent_model"),
         "plan": (
             "ConcurrentPlan",
+            "exact_curve",
             "plan_concurrent",
             "plan_entries",
             "robustness_table",
             "timeline_text",
         ),
         "robustness": ("DEFAULT_MAX_K", "certified_worst_case", "policy_array", "schedule_rule"),
+        "search": ("Curve", "Limits", "solve_curve"),
         "rules": (
             "NONE",
             "Position",

@@ -4,16 +4,20 @@
 
 - the CP-SAT makespan schedule, replayed through the state graph
   (:func:`asp.schedule.assembly_makespan.assembly_makespan`);
-- ``W*(k)`` for ``k = 0, 1, ...`` until it reaches ``W*(inf)``
-  (:func:`asp.concurrent.robustness.robustness`);
-- the CP-SAT schedule run as a plan that ignores the person (:func:`asp.concurrent.schedule_rule`)
-  and its certified worst case under the same budgets: what deviations cost a plan that
-  does not plan for them;
+- ``W*(k)`` for ``k = 0, 1, ...`` until it reaches ``W*(inf)``, by the on-the-fly search
+  (:func:`asp.concurrent.search.solve_curve`): exact where the search finishes within its
+  limits, else a certified interval ``[L(k), U(k)]``, the policy given to the cell being
+  the one certified at ``U``;
+- the CP-SAT schedule run as a plan that ignores the person and its certified worst case
+  under the same budgets (an exact best response of the person to it): what deviations
+  cost a plan that does not plan for them;
 - the robust plan played when the person follows it and against the worst person.
 
-:func:`robustness_table` and :func:`plan_entries` turn it into text and ``plan.json``
-keys; :func:`asmplan.report.gantt.write_figures` draws the PNGs ``robustness.png``,
-``gantt_cooperative.png`` and ``gantt_worst.png``.
+The game is never compiled in full here; :meth:`ConcurrentPlan.compiled` compiles it on
+demand (:func:`asp.concurrent.robustness.robustness`) for what needs every state of it (a
+study's fixed robots). :func:`robustness_table` and :func:`plan_entries` turn the plan into
+text and ``plan.json`` keys; :func:`asmplan.report.gantt.write_figures` draws the PNGs
+``robustness.png``, ``gantt_cooperative.png`` and ``gantt_worst.png``.
 """
 
 from __future__ import annotations
@@ -23,14 +27,9 @@ from dataclasses import dataclass
 from asp.concurrent.build import DEFAULT_MAX_NODES
 from asp.concurrent.describe import Bar, timeline
 from asp.concurrent.model import concurrent_model
-from asp.concurrent.robustness import (
-    DEFAULT_MAX_K,
-    Robustness,
-    certified_worst_case,
-    policy_array,
-    robustness,
-    schedule_rule,
-)
+from asp.concurrent.robustness import DEFAULT_MAX_K, Robustness, robustness
+from asp.concurrent.rules import concurrent_rules
+from asp.concurrent.search import Curve, Limits, solve_curve
 from asp.numbers import json_number
 from asp.schedule.assembly_makespan import assembly_makespan
 
@@ -41,7 +40,11 @@ class ConcurrentPlan:
 
     Attributes
     ----------
-    curve : Robustness
+    spec, graph, step
+        What the game was made of (:meth:`compiled` makes it again).
+    curve : asp.concurrent.search.Curve
+        ``W*(k)`` exact or as certified intervals, the policy game of the plan's policy
+        and its solution (each state's bound is that policy's certified worst case).
     schedule : BaselineResult
         The CP-SAT makespan schedule (``status``, ``objective``, ``detail["schedule"]``).
     lower_bound : float
@@ -54,12 +57,26 @@ class ConcurrentPlan:
     """
 
     spec: object
-    curve: Robustness
+    graph: object
+    step: float | None
+    curve: Curve
     schedule: object
     lower_bound: float
     schedule_worst: list
     cooperative: tuple[list[Bar], float]
     worst: tuple[list[Bar], float]
+
+    def compiled(self, max_nodes: int = DEFAULT_MAX_NODES) -> Robustness:
+        """The full concurrent game for the plan's budgets, compiled and solved exactly
+        (every state, not only those the plan's policy reaches).
+
+        Raises
+        ------
+        asp.errors.GameError
+            The game is over ``max_nodes`` nodes or the memory allowed.
+        """
+        model = concurrent_model(self.spec, self.graph, step=self.step)
+        return robustness(model, max_k=self.curve.k, max_nodes=max_nodes)
 
 
 def plan_concurrent(
@@ -70,7 +87,7 @@ def plan_concurrent(
     step: float | None = 1.0,
     time_limit: float = 30.0,
     seed: int = 0,
-    max_nodes: int = DEFAULT_MAX_NODES,
+    limits: Limits | None = None,
     schedule: tuple | None = None,
     progress: bool = False,
 ) -> ConcurrentPlan:
@@ -78,47 +95,68 @@ def plan_concurrent(
 
     Parameters
     ----------
+    max_k : int
+        The largest deviation budget of the curve (it stops earlier once flat).
+    step : float or None
+        Grid of a person's duration range (:func:`asp.concurrent.concurrent_model`).
+    time_limit, seed
+        CP-SAT's, when ``schedule`` is not given.
+    limits : asp.concurrent.search.Limits, optional
+        Memory, positions and seconds of the search (default: its defaults); past them the
+        curve is a certified interval.
     schedule : (BaselineResult, float), optional
         The CP-SAT schedule (from :func:`asp.schedule.assembly_makespan.assembly_makespan`)
         and its lower bound, when already computed.
+    progress : bool
+        The search's progress on stderr.
 
     Raises
     ------
     ValueError
         ``max_k < 0``, a bad duration or agent (:func:`asp.concurrent.concurrent_model`), or
-        a game over ``max_nodes`` nodes (the message names ``--max-k``).
+        a memory limit that certifies no policy (the message names ``--max-memory``).
     """
     if max_k < 0:
         from asp.errors import GameError
 
         raise GameError(f"--max-k: expected a deviation budget >= 0, got {max_k}")
-    model = concurrent_model(spec, graph, step=step)
+    rules = concurrent_rules(spec, graph, step=step)
     if schedule is None:
         sched, result = assembly_makespan(spec, graph, time_limit=time_limit, seed=seed)
         schedule = (result, sched.lower_bound)
     result, lower_bound = schedule
-    curve = robustness(model, max_k=max_k, max_nodes=max_nodes, progress=progress)
+    curve = solve_curve(
+        rules,
+        max_k=max_k,
+        limits=limits,
+        schedule=result.detail.get("schedule") or None,
+        lower=cpsat_lower_bound(result, lower_bound),
+        progress=progress,
+    )
     game, solution = curve.game, curve.solution
-    schedule_worst = []
-    rows = result.detail.get("schedule")
-    if rows:
-        rule = schedule_rule(rows)
-        policy = policy_array(game, rule)
-        for k in range(curve.k + 1):
-            schedule_worst.append({"k": k, "bound": certified_worst_case(game, policy, k)})
-        top = certified_worst_case(curve.adversary, rule)
-        schedule_worst.append({"k": None, "bound": top})
     cooperative = timeline(game, solution.robot_policy, "follow")
     worst = timeline(game, solution.robot_policy, "worst")
     return ConcurrentPlan(
         spec=spec,
+        graph=graph,
+        step=step,
         curve=curve,
         schedule=result,
         lower_bound=lower_bound,
-        schedule_worst=schedule_worst,
+        schedule_worst=curve.schedule_worst,
         cooperative=cooperative,
         worst=worst,
     )
+
+
+def cpsat_lower_bound(result, lower_bound: float) -> float:
+    """A proven lower bound of ``W*(0)``: the CP-SAT optimum when proven (the cooperative
+    makespan: the person follows, so no robust plan does better), else its best bound,
+    and never below the state graph's bound ``lower_bound``."""
+    best = float(lower_bound or 0.0)
+    if result.status == "OPTIMAL" and result.objective is not None:
+        return max(best, float(result.objective))
+    return best if result.bound is None else max(best, float(result.bound))
 
 
 def _fmt(x) -> str:
@@ -128,32 +166,70 @@ def _fmt(x) -> str:
     return f"{x:g}"
 
 
+def exact_curve(compiled: Robustness) -> Curve:
+    """The curve of a compiled, exactly solved game (:meth:`ConcurrentPlan.compiled`) as a
+    :class:`~asp.concurrent.search.Curve`: every value exact, the robust policy's game."""
+    values = (*compiled.bounds, compiled.unbounded)
+    return Curve(
+        lower=values,
+        upper=values,
+        bounds=values,
+        flat=compiled.flat,
+        game=compiled.game,
+        solution=compiled.solution,
+        policy="robust",
+        schedule_worst=[],
+        stopped=None,
+        nodes=0,
+        positions=compiled.game.dag.n_nodes,
+        seconds=compiled.seconds,
+    )
+
+
+def _value_text(curve: Curve, i: int) -> str:
+    """``W*(k)`` of entry ``i``: the value, or ``in [L, U] (gap %)``."""
+    lo, hi = curve.lower[i], curve.upper[i]
+    if lo == hi:
+        return _fmt(lo)
+    return f"in [{_fmt(lo)}, {_fmt(hi)}] ({curve.gap(i):.1f} %)"
+
+
 def robustness_table(plan: ConcurrentPlan) -> str:
     """The curve on one time axis, with the CP-SAT makespan and its certified worst case."""
-    res = plan.schedule
+    res, curve = plan.schedule, plan.curve
     lines = [
         f"CP-SAT makespan (agents in parallel, replayed through the state graph): "
         f"{_fmt(res.objective)} ({res.status}: {res.detail.get('status_note', '')}); "
         f"state-graph lower bound {plan.lower_bound:g}",
-        "deviations k | robust plan W*(k) | CP-SAT schedule, certified worst case",
+        "deviations k | robust plan W*(k) | the plan's policy, certified worst case | "
+        "CP-SAT schedule, certified worst case",
     ]
     worst = {r["k"]: r["bound"] for r in plan.schedule_worst}
-    for row in plan.curve.to_list():
+    for i, row in enumerate(curve.to_list()):
         k = row["k"]
         name = "inf" if k is None else str(k)
         note = " (cooperative)" if k == 0 else (" (fully adversarial)" if k is None else "")
-        lines.append(f"{name:>12} | {_fmt(row['bound']):>17} | {_fmt(worst.get(k)):>8}{note}")
-    if not plan.curve.flat:
         lines.append(
-            f"the curve is not flat at k = {plan.curve.k} (--max-k, or the next budget's game "
-            f"was over the node limit): W*(k) may still rise to W*(inf) = "
-            f"{plan.curve.unbounded:g}"
+            f"{name:>12} | {_value_text(curve, i)} | {_fmt(row['bound'])} | "
+            f"{_fmt(worst.get(k))}{note}"
         )
-    game = plan.curve.game
+    if curve.stopped:
+        gaps = max(curve.gap(i) for i in range(len(curve.lower)))
+        lines.append(
+            f"the search stopped at its {curve.stopped} (--search-time-limit, --max-nodes, "
+            f"--max-memory give it more): W*(k) lies in [L, U] (largest gap {gaps:.1f} %); "
+            f"the plan's policy is the {curve.policy} one, certified at U"
+        )
+    elif not curve.flat:
+        lines.append(
+            f"the curve is not flat at k = {curve.k} (--max-k): W*(k) may still rise to "
+            f"W*(inf) = {_fmt(curve.upper[-1])}"
+        )
+    game = curve.game
     lines.append(
-        f"concurrent game: {game.dag.n_nodes:,} nodes, {game.dag.n_edges:,} edges (budgets "
-        f"0..{plan.curve.k}), unbounded {plan.curve.adversary.dag.n_nodes:,} nodes; "
-        f"solved in {plan.curve.seconds:.2f} s"
+        f"concurrent search: {curve.nodes:,} positions expanded, {curve.positions:,} in its "
+        f"table; the plan's policy game {game.dag.n_nodes:,} nodes, {game.dag.n_edges:,} "
+        f"edges (budgets 0..{curve.k}); solved in {curve.seconds:.2f} s"
     )
     return "\n".join(lines)
 
@@ -174,8 +250,10 @@ def plan_entries(plan: ConcurrentPlan) -> dict:
 
     ``turn_model``, ``schedule`` (the CP-SAT result, ``objective`` and ``status``),
     ``robustness`` (``[{"k": 0, "bound": ...}, ..., {"k": None, ...}]``) and ``concurrent``:
-    the CP-SAT schedule's certified worst case, the two timelines and the game's size. The
-    robust policy itself is the plan file's ``policy`` (:mod:`asmplan.planfile`).
+    the CP-SAT schedule's certified worst case, the two timelines and the search's size.
+    Each ``robustness`` row has ``lower``, ``upper`` and ``exact`` (``W*(k)`` in ``[lower,
+    upper]``) and ``bound``, the plan's policy's certified worst case. The policy itself is
+    the plan file's ``policy`` (:mod:`asmplan.planfile`).
     """
     curve = plan.curve
     game = curve.game
@@ -186,6 +264,8 @@ def plan_entries(plan: ConcurrentPlan) -> dict:
         "concurrent": {
             "flat": curve.flat,
             "plan_budget": curve.k,
+            "certified_policy": curve.policy,
+            "stopped": curve.stopped,
             "schedule_worst_case": [
                 {"k": r["k"], "bound": _plain(r["bound"])} for r in plan.schedule_worst
             ],
@@ -193,7 +273,8 @@ def plan_entries(plan: ConcurrentPlan) -> dict:
             "worst": _line(*plan.worst),
             "game_nodes": game.dag.n_nodes,
             "game_edges": game.dag.n_edges,
-            "unbounded_game_nodes": curve.adversary.dag.n_nodes,
+            "positions_expanded": curve.nodes,
+            "table_positions": curve.positions,
             "seconds": round(curve.seconds, 3),
         },
     }

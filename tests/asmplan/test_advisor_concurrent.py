@@ -123,7 +123,7 @@ def test_pump_cooperative_line_ends_at_w0(pump_plans, name, w0):
     if name not in pump_plans:
         pytest.skip(f"examples/{name} not found")
     doc = pump_plans[name]
-    assert doc["robustness"][0] == {"k": 0, "bound": w0}
+    assert doc["robustness"][0] == {"k": 0, "bound": w0, "lower": w0, "upper": w0, "exact": True}
     advice = _cooperative(Advisor(doc))
     assert advice.elapsed == w0 and advice.deviations == 0
 

@@ -38,7 +38,8 @@ def test_pump_concurrent_plan(tmp_path):
     assert plan["turn_model"] == "concurrent"
     assert plan["schedule"]["objective"] == 215 and plan["schedule"]["status"] == "OPTIMAL"
     rows = plan["robustness"]
-    assert rows[0] == {"k": 0, "bound": 215} and rows[-1]["k"] is None
+    assert rows[0] == {"k": 0, "bound": 215, "lower": 215, "upper": 215, "exact": True}
+    assert rows[-1]["k"] is None and plan["concurrent"]["certified_policy"] == "robust"
     assert [r["k"] for r in rows[:-1]] == list(range(len(rows) - 1))
     bounds = [r["bound"] for r in rows]
     assert bounds == sorted(bounds)
@@ -53,6 +54,29 @@ def test_pump_concurrent_plan(tmp_path):
     assert states["turn"][start] == "robot"
     assert plan["minimax"] == 215 and plan["metrics"]["w0"] == 215
     assert plan["robust_plan"][-1]["elapsed"] == 215
+
+
+def test_a_search_stopped_by_its_limit_answers_a_certified_interval(tmp_path):
+    """Past --max-nodes the plan still answers, exit 0: each W*(k) in [L, U] containing the
+    exact value, the plan's policy certified at U (its policy game's bound), and says so."""
+    exact = json.loads((_plan(tmp_path / "exact")).read_text())["robustness"]
+    path = _plan(tmp_path / "cut", "--max-nodes", "3")
+    r_doc = json.loads(path.read_text())
+    rows, game = r_doc["robustness"], r_doc["concurrent"]
+    assert game["stopped"] and game["certified_policy"] in {"hybrid", "greedy", "schedule"}
+    for row, true in zip(rows, exact, strict=True):
+        assert row["lower"] <= true["bound"] <= row["upper"] <= row["bound"]
+        assert row["exact"] == (row["lower"] == row["upper"])
+    for key in ("lower", "upper"):
+        assert [r[key] for r in rows] == sorted(r[key] for r in rows)  # never fall with k
+
+
+def _plan(out: Path, *flags: str) -> Path:
+    r = run("plan", str(PUMP), "--turn-model", "concurrent", "-o", str(out), *flags)
+    assert r.returncode == 0, r.stderr
+    if flags:
+        assert "W*(k) lies in [L, U]" in r.stdout, r.stdout
+    return out / "plan.json"
 
 
 def small_spec(**changes) -> dict:
