@@ -33,7 +33,7 @@ ROOT = Path(__file__).resolve().parents[1]
 FILES = ("asm_shear_mold.step", "as1-oc-214.stp", "rod.3DXML", "cycloidal.3DXML")
 
 
-def one(path: Path, time_limit: float | None, loose: bool = False) -> dict:
+def one(path: Path, time_limit: float | None, loose: bool = False, memory: float = 0) -> dict:
     """The figures of one file (in this process)."""
     from asmplan import pipeline
     from asp.concurrent.rules import concurrent_rules
@@ -55,7 +55,7 @@ def one(path: Path, time_limit: float | None, loose: bool = False) -> dict:
         rules,
         schedule=result.detail.get("schedule"),
         lower=lower,
-        limits=Limits(time_limit=time_limit),
+        limits=Limits(time_limit=time_limit, **({"memory": int(memory * 2**30)} if memory else {})),
         progress=True,
     )
     t3 = time.perf_counter()
@@ -96,10 +96,11 @@ def main() -> None:
     parser.add_argument("files", nargs="*", type=Path)
     parser.add_argument("--time-limit", type=float, default=None)
     parser.add_argument("--loose", action="store_true", help="the loose-order graph")
+    parser.add_argument("--memory", type=float, default=0, help="GiB for the search")
     parser.add_argument("--one", type=Path, help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.one:
-        print(json.dumps(one(args.one, args.time_limit, args.loose)), flush=True)
+        print(json.dumps(one(args.one, args.time_limit, args.loose, args.memory)), flush=True)
         return
     folder = Path(os.environ.get("ASMPLAN_REAL_CAD", "/tmp/realcad"))
     files = args.files or [folder / f for f in FILES]
@@ -112,6 +113,8 @@ def main() -> None:
             cmd += ["--time-limit", str(args.time_limit)]
         if args.loose:
             cmd.append("--loose")
+        if args.memory:
+            cmd += ["--memory", str(args.memory)]
         env = {**os.environ, "PYTHONPATH": str(ROOT)}
         out = subprocess.run(cmd, capture_output=True, text=True, env=env)
         lines = [x for x in out.stdout.splitlines() if x.startswith("{")]
