@@ -567,6 +567,8 @@ class _Parser:
                     durations.append((a, hi))
                 else:
                     durations.append((a, self.number(d, key)))
+            if "part" in item and "parts" in item:
+                raise self.fail(where, "both part and parts: give one (a list goes in either)")
             placed = item.get("part", item.get("parts"))
             if placed is None:
                 placed = []

@@ -23,12 +23,31 @@ MAX_EXPANDED_VALUES = 1_000_000
 
 
 _INT, _FLOAT = "tag:yaml.org,2002:int", "tag:yaml.org,2002:float"
+_MERGE = "tag:yaml.org,2002:merge"
 
 
 class PlainNumbers(yaml.SafeLoader):
     """SafeLoader that reads only numbers written in plain decimal as numbers
     (:mod:`cad.numbers`): ``010``, ``0x10``, ``1_000``, ``1:30`` stay text, as written,
-    for the check that names them (``.inf`` and ``.nan`` are still floats)."""
+    for the check that names them (``.inf`` and ``.nan`` are still floats); and a mapping
+    that repeats a key is refused (YAML's keys are unique; PyYAML would keep the last)."""
+
+    def construct_mapping(self, node, deep=False):
+        first: dict[str, int] = {}
+        for key_node, _ in node.value:
+            if not isinstance(key_node, yaml.ScalarNode) or key_node.tag == _MERGE:
+                continue
+            line = key_node.start_mark.line + 1
+            if key_node.value in first:
+                raise yaml.constructor.ConstructorError(
+                    None,
+                    None,
+                    f"duplicate key {key_node.value!r} at line {line} (first at line "
+                    f"{first[key_node.value]}): give each key once",
+                    None,
+                )
+            first[key_node.value] = line
+        return super().construct_mapping(node, deep=deep)
 
 
 class DecimalsAsText(PlainNumbers):

@@ -48,6 +48,7 @@ import yaml
 from asmplan.study.assignment import DESIGNS, ORDERS, PLAN_ORDERS
 from asmplan.study.conditions import ROBOTS, Condition
 from asmplan.study.questionnaire import Item, items_from_data, scale_from_data
+from cad.yamlfile import PlainNumbers
 
 FORMAT = "asmplan-study/1"
 MAX_TEXT = 20_000
@@ -126,7 +127,7 @@ def load_study(path: str | Path) -> Study:
     except OSError as exc:
         raise ValueError(f"{path}: cannot read ({exc.strerror or exc})") from None
     try:
-        data = yaml.safe_load(text)
+        data = yaml.load(text, Loader=PlainNumbers)  # noqa: S506 - a SafeLoader
     except yaml.YAMLError as exc:
         raise ValueError(f"{path}: not YAML ({_yaml_problem(exc)})") from None
     top = _Keys(
@@ -254,7 +255,7 @@ def _questionnaire(data, where: str, base: Path) -> list[Item]:
             raise ValueError(f"{where}: give items or file, not both")
         source = base / keys.text("file", limit=1000)
         try:
-            loaded = yaml.safe_load(source.read_text(encoding="utf-8"))
+            loaded = yaml.load(source.read_text(encoding="utf-8"), Loader=PlainNumbers)  # noqa: S506
         except OSError as exc:
             raise ValueError(f"{where}: file {source}: cannot read ({exc.strerror})") from None
         except yaml.YAMLError as exc:

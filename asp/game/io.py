@@ -93,6 +93,11 @@ def dag_from_dict(data: dict, source: str = "<dict>") -> GameDAG:
         labels = [n.get("label") if isinstance(n, dict) else None for n in data["nodes"]]
         edges = data["edges"]
         pairs = [(e["source"], e["target"]) for e in edges]
+        _check_ids(source, "node id", ids)
+        _check_ids(source, "edge end", [x for pair in pairs for x in pair])
+        _check_ids(
+            source, "start/end", [data[k] for k in ("start", "end") if data.get(k) is not None]
+        )
         costs = [float(e.get("cost", 1)) for e in edges]
         sides = [side_from_name(e.get("side", "any")) for e in edges]
         has_ops = any("operation" in e for e in edges)
@@ -116,6 +121,16 @@ def dag_from_dict(data: dict, source: str = "<dict>") -> GameDAG:
         raise GraphError(f"{source}: a cost is too large (the limit is {MAX_COST:g})") from None
     except ValueError as exc:
         raise GraphError(f"{source}: {exc}") from None
+
+
+def _check_ids(source: str, what: str, values: list) -> None:
+    """Node ids are strings or integers, as written: a float, bool or null id would match
+    another id silently (``1.0`` is ``1``, ``true`` is ``1``) and is refused."""
+    for value in values:
+        if isinstance(value, bool) or not isinstance(value, int | str):
+            raise FormatError(
+                f"{source}: {what} {json.dumps(value)}: expected a string or an integer"
+            )
 
 
 def load_dag(path: str | os.PathLike[str]) -> GameDAG:

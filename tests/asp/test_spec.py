@@ -78,6 +78,7 @@ def test_valid_spec_defaults():
         (("tools", "R1.bit", "initial"), KeyError, r"tools\.R1\.bit: missing 'initial'"),
         (("parts",), [{"id": "A"}, {"id": "A"}], r"parts: duplicate part id 'A'"),
         (("operations",), [], r"operations: expected a non-empty list"),
+        (("operations", 1, "parts"), ["A"], r"operations\[2\]: both part and parts: give one"),
     ],
 )
 def test_validation_errors_name_file_key_and_culprit(path, value, message):
@@ -85,6 +86,24 @@ def test_validation_errors_name_file_key_and_culprit(path, value, message):
         spec_from_dict(variant(path, value), source="toy.yaml")
     text = str(info.value)
     assert text.startswith("toy.yaml: ") and "\n" not in text
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "name: a\nname: b\n",  # top level
+        "agents:\n  H: {side: human}\n  H: {side: robot}\n",  # nested
+        "operations:\n  - {id: 1, id: 2}\n",  # flow mapping
+    ],
+)
+def test_a_repeated_yaml_key_is_refused_with_its_line(tmp_path, text):
+    path = tmp_path / "assembly.yaml"
+    path.write_text(text)
+    with pytest.raises(
+        ValueError, match=r"duplicate key '(name|H|id)' at line \d+ \(first at"
+    ) as info:
+        load_spec(path)
+    assert str(info.value).startswith(str(path)) and "\n" not in str(info.value)
 
 
 def test_ids_stay_strings(tmp_path):

@@ -66,6 +66,11 @@ def test_plain_networkx_graphml(tmp_path):
         ('{"nodes": [1, 2], "edges": [{"source": 1, "target": 3}]}', "unknown node 3"),
         ('{"nodes": [1, 2], "edges": [{"source": 1, "target": 2, "cost": -2}]}', "negative"),
         ("[1, 2]", "expected a JSON object"),
+        ('{"nodes": [1, 2.0], "edges": [{"source": 1, "target": 2.0}]}', "node id 2.0: expected"),
+        ('{"nodes": [1, true], "edges": [{"source": 1, "target": true}]}', "node id true"),
+        ('{"nodes": [1, null], "edges": [{"source": 1, "target": null}]}', "node id null"),
+        ('{"nodes": [1, 2], "edges": [{"source": 1.0, "target": 2}]}', "edge end 1.0"),
+        ('{"nodes": [1, 2], "edges": [{"source": 1, "target": 2}], "start": 1.0}', "start/end 1.0"),
     ],
 )
 def test_bad_json_names_the_file(tmp_path, content, message):
