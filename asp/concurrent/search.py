@@ -829,6 +829,26 @@ def _policy_game(T, H, P, starts, kind, prefs, n_prefs, st, max_nodes):  # pragm
 # --------------------------------------------------------------------------- Python side
 
 
+def _compile_kernels(rules: Rules, prefs: np.ndarray, n_prefs: np.ndarray) -> None:
+    """Compile (or load from numba's cache) the search and policy-game kernels for these
+    argument types, so that a time limit counts search, not compilation (the first run on
+    a machine compiles for minutes under load). Each kernel is called once on throwaway
+    tables and counters that stop it at its first position; nothing of the search is
+    touched."""
+    kw = rules.key_words
+    row = rules.start(0).row()
+    for kernel in (_search, _policy_game):
+        stats = np.zeros(N_STATS, dtype=np.int64)
+        stats[MAX_ENTRIES], stats[NODE_LIMIT] = MIN_ENTRIES // 2, 1
+        table = new_table(MIN_ENTRIES, kw)
+        if kernel is _search:
+            _search(rules.tables, table, row, -1, INF, stats, prefs, n_prefs)
+        else:
+            starts = np.array([row], dtype=np.int64)
+            other = new_table(MIN_ENTRIES, kw)
+            _policy_game(rules.tables, table, other, starts, GREEDY, prefs, n_prefs, stats, 1)
+
+
 @dataclass
 class Limits:
     """What the search may use: ``memory`` bytes (the table and the policy games),
@@ -875,6 +895,7 @@ class Search:
         self.stats[MAX_ENTRIES] = min(self.entries, int(self.table.keys.shape[0] * LOAD))
         self.stats[NODE_LIMIT] = self.limits.max_nodes
         self.stats[PROGRESS] = int(progress)
+        _compile_kernels(rules, self.prefs, self.n_prefs)  # before the clock starts
         self.t0 = time.perf_counter()
         self.stats[T0] = int(self.t0 * 1000)
         if self.limits.time_limit is not None:
