@@ -76,6 +76,26 @@ def _remove_tree(path: Path) -> None:
         path.unlink(missing_ok=True)
 
 
+def refuse_existing_run(path: str | os.PathLike[str] | None, *, force: bool) -> None:
+    """Refuse to start a fresh run in a folder that holds a training run (its log, models
+    or checkpoint pointer) unless ``force``: training over it would delete it.
+
+    Raises
+    ------
+    ValueError
+        One line naming the folder and the two ways on (``--resume``, ``--force``).
+    """
+    if path is None or force:
+        return
+    folder = Path(path)
+    held = [n for n in (LOG, POINTER, *MODELS) if (folder / n).exists()]
+    if held:
+        raise ValueError(
+            f"{folder}: holds a training run ({', '.join(held)}); --resume continues it, "
+            "--force replaces it"
+        )
+
+
 class RunFolder:
     """The run folder at ``path`` (see the module docstring for its layout)."""
 

@@ -39,7 +39,7 @@ from arl.config import TrainConfig, get_config
 from arl.envs import GameVecEnv, Observer, TurnEnv
 from arl.memory import check_training_size
 from arl.moves import AGENTS, NO_MOVE, GameTables
-from arl.runfolder import LOG_FORMAT, RunFolder
+from arl.runfolder import LOG_FORMAT, RunFolder, refuse_existing_run
 from arl.tabulate import action_probabilities, tabulate, tabulation_seconds
 from asp.errors import GameError
 from asp.game import rules
@@ -327,6 +327,7 @@ def train(
     max_cycle_seconds: float | None = None,
     on_estimate: Callable[[CycleEstimate], None] | None = None,
     heartbeat: Callable[[str], None] | None = None,
+    force: bool = False,
 ) -> TrainResult:
     """Train a robust robot policy by alternating PPO against a learned adversarial human.
 
@@ -345,6 +346,9 @@ def train(
     resume : bool
         Continue the run saved in ``output`` (same graph, seed and config but for
         ``max_cycles``) from its last committed cycle.
+    force : bool
+        Without ``resume``: replace a run already in ``output`` (else refused,
+        :func:`arl.runfolder.refuse_existing_run`).
     callback : callable, optional
         ``callback(record) -> bool | None`` after each cycle; ``False`` stops training.
     max_memory_gb : float, optional
@@ -369,6 +373,8 @@ def train(
     cfg = get_config(config, dag.metadata.get("turn_model"))
     if resume and output is None:
         raise ValueError("resume: expected an output folder to resume from")
+    if not resume:
+        refuse_existing_run(output, force=force)
     check_training_size(dag, cfg, max_memory_gb)
     folder = None if output is None else RunFolder(output)
     if max_cycle_seconds is not None or on_estimate is not None:

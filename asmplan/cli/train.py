@@ -162,6 +162,9 @@ def train_command(
     seed: int = seed_option("Seed of models, environments and torch."),
     output: Path = typer.Option(..., "--output", "-o", help="Run folder (models, log, plots)."),
     resume: bool = typer.Option(False, "--resume", help="Continue the run saved in --output."),
+    force: bool = typer.Option(
+        False, "--force", help="Replace a training run already in --output (else refused)."
+    ),
     max_cycles: int | None = typer.Option(
         None, "--max-cycles", min=1, max=MAX_CYCLES, help="Stop after N cycles."
     ),
@@ -185,10 +188,13 @@ def train_command(
 ) -> None:
     """Train a robust robot policy by alternating PPO against a learned adversarial human."""
     from arl.config import get_config
+    from arl.runfolder import refuse_existing_run
     from arl.trainer import train
 
     check_output(output, folder=True)
     if config in CONCURRENT_CONFIGS:
+        if not resume:  # (train() checks its own folder)
+            refuse_existing_run(output, force=force)
         _train_concurrent(graph, turn_model, config, seed, output, max_cycles, progress)
         return
     get_config(config)  # a bad name fails before any work
@@ -207,6 +213,7 @@ def train_command(
         max_cycle_seconds=max_cycle_seconds,
         on_estimate=lambda e: typer.echo(f"training: {e.text()}", err=True),
         heartbeat=_stderr_line(progress),
+        force=force,
     )
     status = "converged" if result.converged else "stopped"
     typer.echo(

@@ -134,3 +134,25 @@ def test_a_malformed_log_is_one_line_naming_the_file(tmp_path, capsys, text, pro
         assert exit_info.value.code == 2
         err = capsys.readouterr().err.strip()
         assert len(err.splitlines()) == 1 and str(run / "log.json") in err and problem in err
+
+
+def test_a_fresh_run_never_deletes_an_existing_one_without_force(tmp_path, capsys):
+    """Issue 26 item 6: training without --resume into a run folder is refused, naming the
+    folder and both ways on; --force replaces the run."""
+    dag = figure4()
+    run = tmp_path / "run"
+    train(dag, CFG, seed=2, output=run)
+    before = (run / runfolder.LOG).read_bytes()
+    with pytest.raises(ValueError, match=r"holds a training run .*--resume continues it"):
+        train(dag, CFG, seed=3, output=run)
+    assert (run / runfolder.LOG).read_bytes() == before  # untouched
+    graph = tmp_path / "g.json"
+    save_dag(dag, graph)
+    with pytest.raises(SystemExit) as info:
+        main(["train", str(graph), "--config", "fast", "-o", str(run), "--no-progress"])
+    assert info.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert "--force replaces it" in err and "\n" not in err
+    assert (run / runfolder.LOG).read_bytes() == before
+    replaced = train(dag, CFG, seed=3, output=run, force=True)
+    assert read_log(run)["seed"] == 3 and len(replaced.cycles) >= 1
