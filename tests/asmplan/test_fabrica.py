@@ -27,7 +27,14 @@ def test_fabrica_assembly_plans_and_the_checker_accepts(tmp_path, shared_data, n
     if name in ("plumbers_block", "duct"):  # alike pins: small graphs, CP-SAT proves it
         assert "robustness" in preview and schedule["status"] == "OPTIMAL", preview
     if "robustness" in preview and schedule["status"] == "OPTIMAL":
-        assert preview["robustness"][0] == {"k": 0, "bound": schedule["objective"]}
+        best = schedule["objective"]
+        assert preview["robustness"][0] == {
+            "k": 0,
+            "bound": best,
+            "lower": best,
+            "upper": best,
+            "exact": True,
+        }
         worst = preview["concurrent"]["schedule_worst_case"][0]
         assert worst == {"k": 0, "bound": schedule["objective"]}
 
