@@ -111,6 +111,12 @@ def experiment_command(
         1, "--curve-trial", min=1, max=TRIALS_MAX, help="Trial whose ARL curves make Figure 11."
     ),
     progress: bool = typer.Option(True, "--progress/--no-progress", help="Show a progress bar."),
+    force: bool = typer.Option(
+        False,
+        "--force",
+        help="Replace the finished tasks of another sweep (another --solver, --config, --seed "
+        "or --games) in --output (else refused).",
+    ),
 ) -> None:
     """Reproduce the paper's synthetic experiments (Tables 3-4, Figures 11-13)."""
     _run(
@@ -126,4 +132,5 @@ def experiment_command(
         n_games=games,
         curve_trial=curve_trial,
         progress=progress,
+        force=force,
     )

@@ -12,7 +12,13 @@ Layout of an output folder::
 
 Every file is written atomically (:mod:`asp.atomic`). A task file is reused when the spec
 it records equals the task's spec (same experiment, configuration, trial, base seed,
-solver, ARL configuration and game count); otherwise the task runs again.
+solver, ARL configuration and game count). A folder holds one sweep: a run whose experiment,
+``--seed``, ``--solver``, ``--config`` or ``--games`` differs from that of a task file
+already there is refused (it would overwrite finished results), unless ``force``, which
+removes the other sweep's task files first. More or fewer ``--trials`` are the same sweep.
+The tables, figures and summary describe the sweep just run: the figures and summary of
+the previous run are removed before ``results.csv`` is written, so a figure never stands
+beside results it was not drawn from (Figure 11 is absent when ARL did not run).
 """
 
 from __future__ import annotations
@@ -33,6 +39,7 @@ from asmplan.experiments.figures import (
 from asmplan.experiments.summary import RunInfo, summary_markdown
 from asmplan.experiments.tables import results_csv, results_markdown
 from asmplan.experiments.tasks import (
+    TASK_FORMAT,
     ResultRow,
     Solver,
     TaskResult,
@@ -48,6 +55,7 @@ FIGURE11, FIGURE12, FIGURE13 = (
     "figure12_resilience.png",
     "figure13_path_lengths.png",
 )
+SUMMARY = "summary.md"
 
 
 class TasksFailed(RuntimeError):
@@ -92,6 +100,50 @@ def load_finished(output: Path, specs: list[TaskSpec]) -> dict[str, TaskResult]:
     return finished
 
 
+def held_tasks(output: Path) -> list[tuple[Path, TaskSpec]]:
+    """The task files in ``output/tasks/`` with the specs they record (files of another
+    format, or unreadable, are not this module's and are left out)."""
+    held = []
+    folder = Path(output) / TASKS_DIR
+    for path in sorted(folder.glob("*.json")) if folder.is_dir() else ():
+        try:
+            data = json.loads(path.read_text(encoding="utf-8"))
+            if data.get("format") == TASK_FORMAT:
+                held.append((path, TaskSpec.from_dict(data["spec"])))
+        except (OSError, ValueError, KeyError, TypeError, AttributeError):
+            continue
+    return held
+
+
+def refuse_other_sweep(output: Path, specs: list[TaskSpec], *, force: bool) -> None:
+    """Refuse to run ``specs`` into a folder holding another sweep's finished tasks, unless
+    ``force`` (then those task files are removed).
+
+    Raises
+    ------
+    ValueError
+        One line naming the folder, what differs (flag: held -> asked) and the ways on.
+    """
+    wanted = specs[0].sweep
+    others = [(path, spec) for path, spec in held_tasks(output) if spec.sweep != wanted]
+    if not others:
+        return
+    if force:
+        for path, _ in others:
+            _remove(path)
+        return
+    held = others[0][1].sweep
+    differs = ", ".join(f"{k} {held[k]} -> {wanted[k]}" for k in wanted if held[k] != wanted[k])
+    raise ValueError(
+        f"{output}: holds {len(others)} finished task(s) of another sweep ({differs}); "
+        "use another --output, or --force to replace them"
+    )
+
+
+def _remove(path: Path) -> None:
+    path.unlink(missing_ok=True)
+
+
 def save_result(output: Path, result: TaskResult) -> Path:
     """Write one task's result atomically under ``output/tasks/``."""
     return write_text(task_path(output, result.spec), json.dumps(result.to_dict()) + "\n")
@@ -111,6 +163,7 @@ def run_experiment(
     n_games: int = 1000,
     curve_trial: int = 1,
     progress: bool = True,
+    force: bool = False,
 ) -> ExperimentReport:
     """Run (or resume) the sweep of ``experiment`` and write its tables and figures.
 
@@ -137,11 +190,13 @@ def run_experiment(
         paper's Figure 11 graph).
     progress : bool
         Show a tqdm bar counting tasks.
+    force : bool
+        Replace the finished tasks of another sweep in ``output`` (else refused).
 
     Raises
     ------
     ValueError
-        Bad parameters, the ARL trainer or Ray missing.
+        Bad parameters, the ARL trainer or Ray missing, ``output`` holding another sweep.
     TasksFailed
         Some tasks raised (the others are saved; rerun to resume).
     """
@@ -153,6 +208,7 @@ def run_experiment(
         require_trainer()
     runner = make_backend(backend, workers=workers, address=address)
     output = Path(output)
+    refuse_other_sweep(output, specs, force=force)
     output.mkdir(parents=True, exist_ok=True)
 
     finished = load_finished(output, specs)
@@ -217,7 +273,13 @@ def write_outputs(
     info: RunInfo,
     curve_trial: int = 1,
 ) -> list[Path]:
-    """Write results.csv/.md, the figures and summary.md; return the paths written."""
+    """Write results.csv/.md, the figures and summary.md; return the paths written.
+
+    The previous run's figures and summary go first: a kill part way leaves files missing,
+    never a figure beside results it was not drawn from.
+    """
+    for name in (FIGURE11, FIGURE12, FIGURE13, SUMMARY):
+        _remove(output / name)
     rows = [row for result in results for row in result.rows]
     files = [
         write_text(output / "results.csv", results_csv(rows)),
@@ -237,7 +299,7 @@ def write_outputs(
         )
     figures = tuple(p.name for p in files if p.suffix == ".png")
     info = RunInfo(**{**info.__dict__, "figures": figures})
-    files.append(write_text(output / "summary.md", summary_markdown(info, rows)))
+    files.append(write_text(output / SUMMARY, summary_markdown(info, rows)))
     return files
 
 

@@ -32,6 +32,9 @@ from asp.game.metrics import PlanMetrics
 EXPERIMENT_KEYS = {"table3": 3, "table4": 4}
 """Spawn-key component of each experiment (its table number in the paper)."""
 
+TASK_FORMAT = "asmplan-experiment-task/1"
+"""The ``format`` of a task file (``tasks/<task id>.json``)."""
+
 
 class Solver(StrEnum):
     """Which planner(s) a task runs."""
@@ -126,6 +129,18 @@ class TaskSpec:
         """File-name-safe identity within a sweep, e.g. ``table4-L20-M10-A4-t03``."""
         g = self.graph
         return f"{self.experiment}-L{g.layers}-M{g.max_nodes}-A{g.max_actions}-t{self.trial:02d}"
+
+    @property
+    def sweep(self) -> dict[str, object]:
+        """What the tasks of one sweep share, by command-line flag: the results of two specs
+        with different sweeps never share an output folder."""
+        return {
+            "experiment": self.experiment,
+            "--seed": self.base_seed,
+            "--solver": self.solver,
+            "--config": self.config,
+            "--games": self.n_games,
+        }
 
     @property
     def seeds(self) -> TaskSeeds:
@@ -261,7 +276,7 @@ class TaskResult:
     def to_dict(self) -> dict:
         """A JSON-ready dict (the inverse of :meth:`from_dict`)."""
         return {
-            "format": "asmplan-experiment-task/1",
+            "format": TASK_FORMAT,
             "spec": self.spec.to_dict(),
             "rows": [asdict(r) for r in self.rows],
             "episode_rewards": (

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import csv
+import io
 import json
 from types import SimpleNamespace
 
@@ -32,6 +33,10 @@ from asmplan.experiments.tasks import (
 )
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+def _text(path) -> str:
+    return path.read_text(encoding="utf-8")
 
 
 def comparable(report) -> list[dict]:
@@ -183,9 +188,17 @@ def test_resume_skips_finished_tasks(serial_sweep, tmp_path):
         "table4", out, trials=4, solver="exact", workers=1, n_games=200, progress=False
     )
     assert more.ran == 2 and more.resumed == 2
-    # A different seed is a different task: nothing is reused.
+    # A different seed is a different task: nothing is reused (another sweep: --force).
     other = run_experiment(
-        "table4", out, trials=1, seed=3, solver="exact", workers=1, n_games=200, progress=False
+        "table4",
+        out,
+        trials=1,
+        seed=3,
+        solver="exact",
+        workers=1,
+        n_games=200,
+        progress=False,
+        force=True,
     )
     assert other.ran == 1
 
@@ -277,6 +290,47 @@ def test_arl_path_with_a_stand_in_trainer(monkeypatch, tmp_path):
     assert "ARL's learned-vs-learned WCPL" in (tmp_path / "summary.md").read_text()
 
 
+@pytest.mark.parametrize(
+    "change, flag",
+    [
+        ({"solver": "exact"}, "--solver both -> exact"),
+        ({"config": "paper"}, "--config fast -> paper"),
+        ({"seed": 5}, "--seed 0 -> 5"),
+        ({"n_games": 100}, "--games 200 -> 100"),
+    ],
+)
+def test_another_sweep_is_refused_and_force_replaces_it(monkeypatch, tmp_path, change, flag):
+    """Issue 26 item 6: a re-run with another --solver/--config/--seed/--games never
+    overwrites finished results silently, and never leaves a figure of the earlier sweep."""
+    monkeypatch.setattr(tasks_module, "require_trainer", lambda: fake_train)
+    monkeypatch.setattr("asmplan.experiments.runner.require_trainer", lambda: fake_train)
+    first = {"solver": "both", "config": "fast", "seed": 0, "n_games": 200}
+    options = {"trials": 2, "workers": 1, "progress": False}
+    run_experiment("table4", tmp_path, **first, **options)
+    before = {p: p.read_bytes() for p in sorted(tmp_path.rglob("*")) if p.is_file()}
+    assert tmp_path / FIGURE11 in before
+
+    with pytest.raises(ValueError, match="another sweep") as refused:
+        run_experiment("table4", tmp_path, **{**first, **change}, **options)
+    message = str(refused.value)
+    assert "\n" not in message and str(tmp_path) in message and "--force" in message
+    assert flag in message
+    assert {p: p.read_bytes() for p in sorted(tmp_path.rglob("*")) if p.is_file()} == before
+
+    again = run_experiment("table4", tmp_path, **{**first, **change}, **options, force=True)
+    assert again.ran == 2 and again.resumed == 0
+    held = [json.loads(p.read_text())["spec"] for p in sorted((tmp_path / "tasks").iterdir())]
+    assert len(held) == 2
+    assert all(TaskSpec.from_dict(h) == r.spec for h, r in zip(held, again.results, strict=True))
+    solvers = {r["solver"] for r in csv.DictReader(io.StringIO(_text(tmp_path / "results.csv")))}
+    assert solvers == ({"exact"} if change.get("solver") == "exact" else {"arl", "exact"})
+    # Figure 11 is there exactly when the results beside it hold an ARL run.
+    assert (tmp_path / FIGURE11).exists() == ("arl" in solvers)
+    # More trials of the same sweep are no other sweep.
+    more = run_experiment("table4", tmp_path, **{**first, **change}, **{**options, "trials": 3})
+    assert more.ran == 1 and more.resumed == 2
+
+
 def test_arl_task_with_the_real_trainer():
     pytest.importorskip("arl.trainer")
     spec = TaskSpec("table3", GraphConfig(4, 10), 1, solver="both", config="fast", n_games=200)
@@ -325,3 +379,9 @@ def test_cli_runs_and_reports_bad_input(tmp_path):
     bad = runner.invoke(app, [*args[:4], "--trials", "0", "--output", str(tmp_path)])
     assert bad.exit_code == 2
     assert "asmplan: error: trials" in bad.output
+    other = runner.invoke(app, [*args[:-2], "--seed", "1", "--output", str(tmp_path)])
+    assert other.exit_code == 2, other.output
+    assert "another sweep (--seed 0 -> 1)" in other.output and "--force" in other.output
+    forced = runner.invoke(app, [*args[:-2], "--seed", "1", "--force", "--output", str(tmp_path)])
+    assert forced.exit_code == 0, forced.output
+    assert "2 tasks (2 run, 0 resumed)" in forced.output
