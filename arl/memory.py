@@ -2,7 +2,9 @@
 
 :func:`train` (and ``asmplan train``) refuses a game whose estimate exceeds the limit with
 one line naming the game's size, the estimate and the option that raises the limit
-(``--max-memory``, ``max_memory_gb``), before it builds tables, solves or makes a network.
+(``--max-memory``, ``max_memory_gb``) and the memory available, before it builds tables,
+solves or makes a network. The default limit is the one rule of every build with a memory
+bound, :func:`asp.heap.memory_budget` (a share of the memory available when it starts).
 
 The estimate (bytes) adds, for ``n`` nodes, ``E`` edges, ``k`` the most moves at a node and
 ``w`` the observation width (``n`` for ``obs="node"``, which SB3 feeds one-hot; the feature
@@ -22,26 +24,16 @@ count for ``obs="features"``):
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 
 from arl.config import TrainConfig
 from arl.tabulate import CHUNK_CELLS
+from asp import heap
 from asp.errors import GameError
 
 BASE_BYTES = 2**30
 """Python, numpy, torch and Stable-Baselines3 loaded, and their working memory: set so that
 a 40,000-node graph, which peaked at 1.56 GB (issue 14), is estimated at about 1.5 GB."""
-
-
-def default_max_memory_gb() -> float:
-    """Three quarters of this machine's physical memory, in GB (8 GB when unknown)."""
-    try:
-        total = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    except (AttributeError, ValueError, OSError):
-        return 8.0
-    return 0.75 * total / 2**30
 
 
 def training_bytes(n_nodes: int, n_edges: int, max_moves: int, cfg: TrainConfig, width=None) -> int:
@@ -65,14 +57,16 @@ def check_training_size(dag, cfg: TrainConfig, max_memory_gb: float | None = Non
     Parameters
     ----------
     max_memory_gb : float, optional
-        The limit (default :func:`default_max_memory_gb`).
+        The limit (default :func:`asp.heap.memory_budget`).
     """
-    limit = default_max_memory_gb() if max_memory_gb is None else float(max_memory_gb)
+    gb = 2**30
+    limit = heap.memory_budget() / gb if max_memory_gb is None else float(max_memory_gb)
     k = int(np.diff(dag.indptr).max(initial=1))
     need = training_bytes(dag.n_nodes, dag.n_edges, k, cfg)
-    if need > limit * 2**30:
+    if need > limit * gb:
         raise GameError(
-            f"training this game needs about {need / 2**30:.1f} GB ({dag.n_nodes:,} nodes, "
+            f"training this game needs about {need / gb:.1f} GB ({dag.n_nodes:,} nodes, "
             f"{dag.n_edges:,} edges, obs {cfg.obs!r}, first layer {cfg.net_arch[0]} wide), "
-            f"over the {limit:.1f} GB limit; --max-memory GB (max_memory_gb) raises it"
+            f"over the {limit:.1f} GB limit ({heap.available_memory() / gb:.1f} GB available); "
+            "--max-memory GB (max_memory_gb) raises it"
         )

@@ -353,7 +353,8 @@ def train(
         ``callback(record) -> bool | None`` after each cycle; ``False`` stops training.
     max_memory_gb : float, optional
         Refuse (before anything heavy runs) a game whose estimated training memory is over
-        this (default: three quarters of this machine's memory; :mod:`arl.memory`).
+        this (default: :func:`asp.heap.memory_budget`, 3/4 of the memory available;
+        :mod:`arl.memory`).
     max_cycle_seconds : float, optional
         Refuse (:class:`asp.errors.GameError`, before the run folder is touched) a game
         whose cycle is estimated (:func:`estimate_cycle`) to take longer than this.

@@ -175,7 +175,7 @@ def train_command(
         min=0.001,
         max=1e6,
         help="Refuse a game whose training needs more GB than this, before any work "
-        "(default: 3/4 of this machine's memory; arl/memory.py).",
+        "(default: 3/4 of the memory available; arl/memory.py).",
     ),
     max_cycle_seconds: float | None = typer.Option(
         None,

@@ -34,3 +34,25 @@ def test_fast_on_the_concurrent_game_uses_32_steps():
     assert get_config("fast", "concurrent").n_steps == 32
     assert get_config("fast").n_steps == get_config("fast", "alternate").n_steps == 16
     assert get_config("paper", "concurrent") == get_config("paper")
+
+
+def test_the_default_limit_is_the_one_memory_rule(monkeypatch):
+    """Issue 26 item 3: without --max-memory, training may use asp.heap.memory_budget (3/4 of
+    the memory available now, not of the machine's physical memory), and the refusal says
+    the estimate, the limit, the memory available and the flag."""
+    from asp import heap
+
+    dag = synthetic_dag(10, 10, 4, 0)
+    cfg = get_config("fast")
+    need = training_bytes(dag.n_nodes, dag.n_edges, 4, cfg)
+    monkeypatch.setattr(heap, "available_memory", lambda: int(need))  # 3/4 of it: too little
+    with pytest.raises(ValueError, match=r"--max-memory") as info:
+        check_training_size(dag, cfg)
+    message = str(info.value)
+    assert "\n" not in message
+    gb = 2**30
+    assert f"about {need / gb:.1f} GB" in message
+    assert f"the {heap.memory_budget() / gb:.1f} GB limit" in message
+    assert f"({need / gb:.1f} GB available)" in message
+    monkeypatch.setattr(heap, "available_memory", lambda: int(2 * need))  # 3/4 of it fits
+    check_training_size(dag, cfg)
