@@ -519,10 +519,12 @@ def state_graph(
     on_step : callable, optional
         Called with a line for each round of automatic subassemblies.
     concurrent : bool
-        Reduce so that the concurrent game keeps its values too: alike parts in a loose
-        order, not a fixed one (more states; :func:`asp.graph.symmetry.symmetry_reduction`). The
-        CP-SAT schedule keeps its value either way (it undoes a fixed order,
-        :mod:`asp.graph.fixed_order`).
+        Reduce so that the compiled concurrent game keeps its values too: alike parts in a
+        loose order, not a fixed one (more states; :func:`asp.graph.symmetry.symmetry_reduction`;
+        the alternate plan's concurrent preview). The CP-SAT schedule and the concurrent
+        plan's search keep their values either way (they undo a fixed order,
+        :mod:`asp.graph.fixed_order`, :mod:`asp.concurrent.rules`), so :func:`plan` builds
+        the fixed order for both turn models.
 
     Returns
     -------
@@ -767,13 +769,9 @@ def plan(
         from asp.errors import GraphError
 
         raise GraphError(f"--turn-model: expected alternate or concurrent, got {turn!r}")
-    graph = state_graph(
-        assembly,
-        progress=True,
-        max_states=max_states,
-        on_step=on_step,
-        concurrent=turn == "concurrent",
-    )
+    # Alike parts in a fixed order for both turn models: the concurrent rules undo it
+    # exactly (:mod:`asp.concurrent.rules`), and the loose order's graph is larger.
+    graph = state_graph(assembly, progress=True, max_states=max_states, on_step=on_step)
     from asp.subassemblies import units_report
 
     unit_rows = units_report(assembly.spec, assembly.relations, graph.spec.subassemblies)
