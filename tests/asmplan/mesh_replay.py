@@ -9,7 +9,8 @@ tests each insertion with python-fcl. The rules (``geometry``):
   ``geometry.step_chord`` mm, as the planner read it), times its ``scale`` (else
   ``geometry.scale``: mm per coordinate as trimesh reads the file), turned into the build
   frame by ``geometry.build_rotation`` (``x_build = R @ x_file``; directions are its axes), its
-  coincident vertices merged when ``merge_vertices`` (a STEP or 3DXML tessellation gives
+  coincident vertices merged when ``merge_vertices`` (by position alone: a glTF's vertices
+  at one corner with different texture coordinates or normals are one) (a STEP or 3DXML tessellation gives
   every face its own vertices; an unmerged mesh cannot be eroded: every vertex would move
   along its own face only, leaving the edges in place), a closed mesh with its normals
   inwards turned outwards;
@@ -106,8 +107,8 @@ def load_meshes(plan: dict) -> dict[str, trimesh.Trimesh]:
             turn = np.eye(4)
             turn[:3, :3] = np.asarray(geo["build_rotation"], float)
             mesh = mesh.apply_transform(turn)
-        if geo.get("merge_vertices", False):
-            mesh.merge_vertices()
+        if geo.get("merge_vertices", False):  # by position: a glTF's UV seams are no holes
+            mesh.merge_vertices(merge_tex=True, merge_norm=True)
         if mesh.is_watertight and mesh.volume < 0:
             mesh.invert()  # a closed mesh drawn inside out: erode it inwards all the same
         out[part["id"]] = mesh

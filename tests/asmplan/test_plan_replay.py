@@ -213,3 +213,27 @@ def test_a_step_plan_replays_from_the_meshes_the_planner_read(step_deflections):
     }
     assert read == {k: len(m.faces) for k, m in meshes.items()}
     replayed(plan)
+
+
+def test_a_textured_glb_counts_open_parts_as_the_planner_does(tmp_path):
+    """A glTF mesh has a vertex per corner and texture coordinate: a box's faces meet at
+    seams of vertices at one position with different UVs (the Cesium milk truck's
+    wheels). Merged by position, as the planner merges them, each box is closed; the
+    replay, merging the same way, agrees (it had called them open: trimesh keeps
+    vertices of different UVs apart)."""
+    from PIL import Image
+
+    from tests.asmplan.mesh_replay import load_meshes
+
+    scene = trimesh.Scene()
+    texture = Image.new("RGB", (4, 4), (200, 80, 40))
+    for k, (lo, hi) in enumerate((((0, 0, 0), (40, 40, 10)), ((5, 5, 10), (35, 35, 30)))):
+        mesh = unmerged(box(lo, hi))
+        uv = np.random.default_rng(k).random((len(mesh.vertices), 2))
+        mesh.visual = trimesh.visual.TextureVisuals(uv=uv, image=texture)
+        scene.add_geometry(mesh.apply_scale(0.001), node_name=f"block_{k}")
+    scene.export(str(tmp_path / "blocks.glb"))
+    plan = pipeline.plan(tmp_path / "blocks.glb", time_limit=5).to_dict()
+    assert plan["geometry"]["open_parts"] == []
+    assert all(m.is_watertight for m in load_meshes(plan).values())
+    replayed(plan)
