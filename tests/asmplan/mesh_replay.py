@@ -10,10 +10,10 @@ tests each insertion with python-fcl. The rules (``geometry``):
   ``geometry.scale``: mm per coordinate as trimesh reads the file), turned into the build
   frame by ``geometry.build_rotation`` (``x_build = R @ x_file``; directions are its axes), its
   coincident vertices merged when ``merge_vertices`` (by position alone: a glTF's vertices
-  at one corner with different texture coordinates or normals are one) (a STEP or 3DXML tessellation gives
-  every face its own vertices; an unmerged mesh cannot be eroded: every vertex would move
-  along its own face only, leaving the edges in place), a closed mesh with its normals
-  inwards turned outwards;
+  at one corner with different texture coordinates or normals are one; a STEP or 3DXML
+  tessellation gives every face its own vertices; an unmerged mesh cannot be eroded: every
+  vertex would move along its own face only, leaving the edges in place), a closed mesh
+  with its normals inwards turned outwards;
 - **erosion**: every part shrunk by its ``part_shrink``: each vertex moved inwards along
   its normal, never moving any face plane by more than the shrink (conservative: the
   replay tolerates at most what the plan says), and the free edges of an open part (edges
