@@ -19,6 +19,11 @@ The certificate is exact whatever the network learned: it is a third candidate f
 upper bound ``U(k)`` beside the greedy and the CP-SAT schedule policies
 (:mod:`asp.concurrent.search`).
 
+Before training, when asked (``max_cycle_seconds``, ``on_estimate``), a cycle's seconds are
+estimated from a sample (:func:`estimate_cycle`, said in the words of :mod:`arl.pace`, the
+same rule as the alternating trainer's) and a cycle over the limit is refused before the
+run folder is touched; while training, a heartbeat line says what the run is doing.
+
 Seeds: ``seed`` fixes torch, numpy and both models; every phase reseeds its model (and so
 its environment) from ``(seed, cycle, side)``. Torch runs on one thread on the CPU, so a
 seed gives the same log.
@@ -37,6 +42,7 @@ import io
 import json
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -44,6 +50,7 @@ import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
 from arl.concurrent_env import ConcurrentHumanEnv, ConcurrentRobotEnv, robot_choose
+from arl.pace import SAMPLE_STEPS, CycleEstimate, Heartbeat, phase_seconds
 from asp.concurrent.certify import certify
 from asp.concurrent.rules import Rules
 
@@ -198,6 +205,71 @@ def learned_policy(rules: Rules, robot):
     return robot_choose(rules, robot, deterministic=True)
 
 
+def _learners(rules: Rules, cfg: ConcurrentConfig, seed: int):
+    """The robot and human models of a run, each playing against the other (torch on one
+    thread, every random source seeded from ``seed``)."""
+    import torch
+    from stable_baselines3.common.utils import set_random_seed
+
+    torch.set_num_threads(1)
+    set_random_seed(seed)
+    train_budgets = list(cfg.train_budgets)
+    robot_env = ConcurrentRobotEnv(rules, budgets=train_budgets)
+    human_env = ConcurrentHumanEnv(rules, budgets=train_budgets)
+    robot = _model(robot_env, cfg, _phase_seed(seed, 0, 0))
+    human = _model(human_env, cfg, _phase_seed(seed, 0, 1))
+    robot_env.set_opponent(human)
+    human_env.set_opponent(robot)
+    return robot, human
+
+
+DEFAULT_BUDGETS = [0, 1, 2, None]
+"""The budgets certified after every cycle unless told (None: ``k = inf``)."""
+
+CERTIFICATION = "a certification (exact best response)"
+"""What a cycle's check is, in the words of :class:`arl.pace.CycleEstimate`."""
+
+
+def estimate_cycle(
+    rules: Rules,
+    config: str | ConcurrentConfig = "concurrent",
+    *,
+    seed: int = 0,
+    budgets: list[int | None] | None = None,
+    cycles_left: int | None = None,
+) -> CycleEstimate:
+    """The seconds a cycle of :func:`train_concurrent` will take, from a sample.
+
+    The sample: throwaway models of the same configuration but rollouts of at most
+    :data:`arl.pace.SAMPLE_STEPS` steps; the robot's phase is run twice (the first warms
+    up) and the second timed, and the robot's greedy policy is certified once at
+    ``budgets`` (:func:`asp.concurrent.certify.certify`), timed. A cycle is then both
+    sides' ``phase_steps`` (rounded up to whole rollouts) at the measured seconds a step,
+    and one certification. Nothing of a run folder is read or written. The untrained
+    robot's policy game may be larger or smaller than a trained one's.
+    """
+    cfg = get_config(config)
+    budgets = list(budgets) if budgets is not None else list(DEFAULT_BUDGETS)
+    k = max(1, min(cfg.n_steps, SAMPLE_STEPS))
+    robot, _ = _learners(rules, cfg.replace(n_steps=k, batch_size=min(cfg.batch_size, k)), seed)
+    robot.learn(k)  # warms up
+    t0 = time.perf_counter()
+    robot.learn(k, reset_num_timesteps=False)
+    step_s = (time.perf_counter() - t0) / k
+    t0 = time.perf_counter()
+    certify(rules, learned_policy(rules, robot), budgets)
+    check_s = time.perf_counter() - t0
+    return CycleEstimate(
+        seconds=2 * phase_seconds(cfg.phase_steps, cfg.n_steps, step_s) + check_s,
+        step_s=step_s,
+        sample_steps=k,
+        cycles=cfg.cycles if cycles_left is None else int(cycles_left),
+        size=f"{rules.model.n_ops:,} operations, {rules.n_workers} workers",
+        check_s=check_s,
+        check=CERTIFICATION,
+    )
+
+
 def train_concurrent(
     rules: Rules,
     config: str | ConcurrentConfig = "concurrent",
@@ -206,46 +278,62 @@ def train_concurrent(
     budgets: list[int | None] | None = None,
     output: Path | None = None,
     progress: bool = False,
+    max_cycle_seconds: float | None = None,
+    on_estimate: Callable[[CycleEstimate], None] | None = None,
+    heartbeat: Callable[[str], None] | None = None,
 ) -> ConcurrentTrainResult:
     """Alternating PPO on the concurrent game of ``rules`` (module docstring).
 
     Parameters
     ----------
     budgets : list of int or None
-        The budgets certified after every cycle (default ``[0, 1, 2, None]``); the last one
-        ranks the cycles' robots.
+        The budgets certified after every cycle (default :data:`DEFAULT_BUDGETS`); the
+        last one ranks the cycles' robots.
     output : Path, optional
         The run folder (written after every cycle).
     progress : bool
         A line on stderr per cycle.
+    max_cycle_seconds : float, optional
+        Refuse (:class:`asp.errors.GameError`, before the run folder is touched) a game
+        whose cycle is estimated (:func:`estimate_cycle`) to take longer than this.
+    on_estimate : callable, optional
+        Called with the :class:`arl.pace.CycleEstimate` once it is within
+        ``max_cycle_seconds``; without it and without a limit nothing is estimated.
+    heartbeat : callable, optional
+        Called every :data:`arl.pace.HEARTBEAT_S` seconds, from the estimate on, with a
+        line saying what the run is doing and for how long (:class:`arl.pace.Heartbeat`).
     """
-    import torch
-    from stable_baselines3.common.utils import set_random_seed
-
     cfg = get_config(config)
-    budgets = list(budgets) if budgets is not None else [0, 1, 2, None]
-    torch.set_num_threads(1)
-    set_random_seed(seed)
+    budgets = list(budgets) if budgets is not None else list(DEFAULT_BUDGETS)
     t0 = time.perf_counter()
-    train_budgets = list(cfg.train_budgets)
-    robot_env = ConcurrentRobotEnv(rules, budgets=train_budgets)
-    human_env = ConcurrentHumanEnv(rules, budgets=train_budgets)
-    robot = _model(robot_env, cfg, _phase_seed(seed, 0, 0))
-    human = _model(human_env, cfg, _phase_seed(seed, 0, 1))
-    robot_env.set_opponent(human)
-    human_env.set_opponent(robot)
+    with Heartbeat(heartbeat, lambda: time.perf_counter() - t0) as beat:
+        if max_cycle_seconds is not None or on_estimate is not None:
+            beat.doing = "estimating a cycle's time (a sample of steps, one certification)"
+            estimate = estimate_cycle(rules, cfg, seed=seed, budgets=budgets)
+            estimate.refuse_over(max_cycle_seconds)
+            if on_estimate is not None:
+                on_estimate(estimate)
+        return _train(rules, cfg, seed, budgets, output, progress, beat)
+
+
+def _train(rules, cfg, seed, budgets, output, progress, beat) -> ConcurrentTrainResult:
+    """The loop of :func:`train_concurrent` (``beat``: its heartbeat, told each step)."""
+    t0 = time.perf_counter()
+    robot, human = _learners(rules, cfg, seed)
     records: list[dict] = []
     best, best_cycle, best_bytes = None, 0, b""
     steps = 0
     for cycle in range(1, cfg.cycles + 1):
         makespans: list[float] = []
         for side, model in ((0, robot), (1, human)):
+            beat.doing = f"cycle {cycle} of {cfg.cycles}: the {('robot', 'human')[side]}'s phase"
             model.set_random_seed(_phase_seed(seed, cycle, side))
             callback = _Makespans() if side == 0 else None
             model.learn(cfg.phase_steps, callback=callback, reset_num_timesteps=False)
             if callback is not None:
                 makespans = callback.makespans
         steps = int(robot.num_timesteps + human.num_timesteps)
+        beat.doing = f"cycle {cycle} of {cfg.cycles}: {CERTIFICATION}"
         cert = certify(rules, learned_policy(rules, robot), budgets)
         record = {
             "cycle": cycle,

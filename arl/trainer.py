@@ -23,7 +23,6 @@ from __future__ import annotations
 
 import hashlib
 import json
-import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -39,9 +38,9 @@ from arl.config import TrainConfig, get_config
 from arl.envs import GameVecEnv, Observer, TurnEnv
 from arl.memory import check_training_size
 from arl.moves import AGENTS, NO_MOVE, GameTables
+from arl.pace import SAMPLE_STEPS, CycleEstimate, Heartbeat, phase_seconds
 from arl.runfolder import LOG_FORMAT, RunFolder, refuse_existing_run
 from arl.tabulate import action_probabilities, tabulate, tabulation_seconds
-from asp.errors import GameError
 from asp.game import rules
 from asp.game.dag import HUMAN, ROBOT, GameDAG
 from asp.game.metrics import is_robust_optimal
@@ -363,9 +362,9 @@ def train(
         (``asmplan train`` says it on stderr); without it and without a limit nothing is
         estimated.
     heartbeat : callable, optional
-        Called every :data:`HEARTBEAT_S` seconds while training with a line saying what
-        the run is doing and for how long (:class:`_Heartbeat`), so a long cycle is never
-        silent.
+        Called every :data:`arl.pace.HEARTBEAT_S` seconds while training with a line
+        saying what the run is doing and for how long (:class:`arl.pace.Heartbeat`), so a
+        long cycle is never silent.
 
     Returns
     -------
@@ -384,15 +383,11 @@ def train(
             folder.recover()
             done = len(_check_resume(folder, graph_summary(dag), seed, cfg)["cycles"])
         estimate = estimate_cycle(dag, cfg, seed, cycles_left=max(0, cfg.max_cycles - done))
-        if max_cycle_seconds is not None and estimate.seconds > max_cycle_seconds:
-            raise GameError(
-                f"training this game takes {estimate.text()}, over --max-cycle-seconds "
-                f"{max_cycle_seconds:g} (max_cycle_seconds): raise it, or train a smaller game"
-            )
+        estimate.refuse_over(max_cycle_seconds)
         if on_estimate is not None:
             on_estimate(estimate)
     run = _start_run(dag, cfg, seed, folder, resume)
-    beat = _Heartbeat(run, heartbeat)
+    beat = Heartbeat(heartbeat, run.elapsed, lambda: run.doing)
     try:
         bar = _progress(range(len(run.cycles), cfg.max_cycles), progress, len(run.cycles), cfg)
         beat.start()
@@ -420,38 +415,6 @@ def train(
         for env in run.envs.values():
             env.close()
     return result
-
-
-HEARTBEAT_S = 60.0
-"""Seconds between two lines of a training's heartbeat (:class:`_Heartbeat`)."""
-
-
-class _Heartbeat:
-    """A line to ``say`` every :data:`HEARTBEAT_S` seconds while a run trains (a daemon
-    thread; :meth:`line` is what it says: the run's ``doing`` and the time so far)."""
-
-    def __init__(self, run: _Run, say: Callable[[str], None] | None) -> None:
-        self.run, self.say = run, say
-        self._stop = threading.Event()
-        self._thread = None
-
-    def line(self) -> str:
-        run = self.run
-        return f"training: {run.doing}, {_duration(run.elapsed())} so far"
-
-    def start(self) -> None:
-        if self.say is not None:
-            self._thread = threading.Thread(target=self._beat, daemon=True, name="heartbeat")
-            self._thread.start()
-
-    def _beat(self) -> None:
-        while not self._stop.wait(HEARTBEAT_S):
-            self.say(self.line())
-
-    def stop(self) -> None:
-        self._stop.set()
-        if self._thread is not None:
-            self._thread.join()
 
 
 def _start_run(
@@ -617,56 +580,6 @@ def _progress(iterable, enabled: bool, initial: int, cfg: TrainConfig):
 # ------------------------------------------------------------- the size check: time
 
 
-SAMPLE_STEPS = 256
-"""Game steps of the sample :func:`estimate_cycle` times (rounded to whole rollouts of
-``n_envs`` games)."""
-
-
-@dataclass(frozen=True)
-class CycleEstimate:
-    """The estimated seconds of a training cycle (:func:`estimate_cycle`).
-
-    Attributes
-    ----------
-    seconds : float
-        One cycle: every learner's phase and tabulations, and the check.
-    step_s, tabulation_s : float
-        One game step of PPO (rollout and updates) and one tabulation over all nodes.
-    cycles : int
-        The cycles still allowed (``max_cycles`` less those done).
-    nodes, edges, sample_steps : int
-    """
-
-    seconds: float
-    step_s: float
-    tabulation_s: float
-    cycles: int
-    nodes: int
-    edges: int
-    sample_steps: int
-
-    def text(self) -> str:
-        """``about 12 s a cycle (...), up to 20 min for 100 cycles``: one clause."""
-        return (
-            f"about {_duration(self.seconds)} a cycle ({self.nodes:,} nodes, {self.edges:,} "
-            f"edges; {1000 * self.step_s:.2f} ms a game step over a sample of "
-            f"{self.sample_steps:,}, {_duration(self.tabulation_s)} a tabulation of every "
-            f"node), up to {_duration(self.cycles * self.seconds)} for {self.cycles:,} "
-            f"cycle{'s' if self.cycles != 1 else ''}"
-        )
-
-
-def _duration(seconds: float) -> str:
-    """``40 ms``, ``0.4 s``, ``12 s``, ``7.5 min``, ``3.2 h``."""
-    if seconds < 0.1:
-        return f"{1000 * seconds:.0f} ms"
-    if seconds < 10:
-        return f"{seconds:.1f} s"
-    if seconds < 600:
-        return f"{seconds:.0f} s"
-    return f"{seconds / 60:.1f} min" if seconds < 3 * 3600 else f"{seconds / 3600:.1f} h"
-
-
 def estimate_cycle(
     dag: GameDAG, cfg: TrainConfig, seed: int = 0, cycles_left: int | None = None
 ) -> CycleEstimate:
@@ -700,18 +613,17 @@ def estimate_cycle(
     finally:
         for env in run.envs.values():
             env.close()
-    rollout = cfg.n_steps * n_envs
-    phase = -(-cfg.phase_steps // rollout) * rollout * step_s
+    phase = phase_seconds(cfg.phase_steps, cfg.n_steps * n_envs, step_s)
     opponent = tabulation_s if cfg.vectorized and len(run.models) > 1 else 0.0
     learners = len(run.models)
     return CycleEstimate(
         seconds=learners * (phase + opponent + tabulation_s),
         step_s=step_s,
-        tabulation_s=tabulation_s,
-        cycles=cfg.max_cycles if cycles_left is None else int(cycles_left),
-        nodes=dag.n_nodes,
-        edges=dag.n_edges,
         sample_steps=k * n_envs,
+        cycles=cfg.max_cycles if cycles_left is None else int(cycles_left),
+        size=f"{dag.n_nodes:,} nodes, {dag.n_edges:,} edges",
+        check_s=tabulation_s,
+        check="a tabulation of every node",
     )
 
 

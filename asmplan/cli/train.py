@@ -89,9 +89,12 @@ def _certified_text(certified: dict) -> str:
     return ", ".join(f"k={'inf' if b is None else b}: {certified[b]:g}" for b in certified)
 
 
-def _train_concurrent(source, turn_model, config, seed, output, max_cycles, progress) -> None:
+def _train_concurrent(
+    source, turn_model, config, seed, output, max_cycles, progress, **pace
+) -> None:
     """``train --config concurrent``: alternating PPO on the assembly's concurrent game played
-    from its rules (:func:`arl.concurrent_trainer.train_concurrent`)."""
+    from its rules (:func:`arl.concurrent_trainer.train_concurrent`; ``pace``: the cycle
+    limit, the estimate's and the heartbeat's lines, as for the alternating trainer)."""
     from arl.concurrent_trainer import get_config as concurrent_config
     from arl.concurrent_trainer import train_concurrent
 
@@ -104,7 +107,7 @@ def _train_concurrent(source, turn_model, config, seed, output, max_cycles, prog
         cfg = cfg.replace(cycles=max_cycles)
     rules = _concurrent_rules(source, f"--config {config}")
     result = train_concurrent(
-        rules, cfg, seed=seed, budgets=CERTIFIED_BUDGETS, output=output, progress=progress
+        rules, cfg, seed=seed, budgets=CERTIFIED_BUDGETS, output=output, progress=progress, **pace
     )
     typer.echo(
         f"trained {result.steps:,} steps in {result.seconds:.1f} s; the robot of cycle "
@@ -192,10 +195,15 @@ def train_command(
     from arl.trainer import train
 
     check_output(output, folder=True)
+    pace = {
+        "max_cycle_seconds": max_cycle_seconds,
+        "on_estimate": lambda e: typer.echo(f"training: {e.text()}", err=True),
+        "heartbeat": _stderr_line(progress),
+    }
     if config in CONCURRENT_CONFIGS:
         if not resume:  # (train() checks its own folder)
             refuse_existing_run(output, force=force)
-        _train_concurrent(graph, turn_model, config, seed, output, max_cycles, progress)
+        _train_concurrent(graph, turn_model, config, seed, output, max_cycles, progress, **pace)
         return
     get_config(config)  # a bad name fails before any work
     dag = load_training_game(graph, turn_model)
@@ -210,10 +218,8 @@ def train_command(
         progress=progress,
         resume=resume,
         max_memory_gb=max_memory,
-        max_cycle_seconds=max_cycle_seconds,
-        on_estimate=lambda e: typer.echo(f"training: {e.text()}", err=True),
-        heartbeat=_stderr_line(progress),
         force=force,
+        **pace,
     )
     status = "converged" if result.converged else "stopped"
     typer.echo(

@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import itertools
 import json
 
 import pytest
 
+import arl.concurrent_trainer as concurrent_trainer
+import arl.pace as pace
 from arl.concurrent_trainer import (
     ConcurrentConfig,
     get_config,
@@ -15,6 +18,7 @@ from arl.concurrent_trainer import (
 )
 from asp.concurrent.certify import certify
 from asp.concurrent.search import Search
+from asp.errors import GameError
 from tests.arl.test_concurrent_env import small_rules
 
 
@@ -57,3 +61,60 @@ def test_configs_and_folders_are_checked(tmp_path):
         ConcurrentConfig.from_dict({"speed": 1})
     with pytest.raises(ValueError, match="not a concurrent run folder"):
         load_robot(tmp_path)
+
+
+# ------------------------------------------- the size check before training (issue 26 item 11)
+
+
+def test_a_cycle_is_both_phases_and_a_certification(monkeypatch):
+    """Every reading of the clock is one second after the last: a step of the sample is
+    1/k s, the certification (which reads no clock here) 1 s."""
+    ticks = itertools.count()
+    monkeypatch.setattr(concurrent_trainer.time, "perf_counter", lambda: float(next(ticks)))
+    monkeypatch.setattr(concurrent_trainer, "certify", lambda *_: None)
+    cfg = get_config("concurrent-tiny")
+    est = concurrent_trainer.estimate_cycle(small_rules(), cfg, budgets=[0, None])
+    k = min(cfg.n_steps, pace.SAMPLE_STEPS)
+    assert est.sample_steps == k and est.step_s == 1.0 / k and est.check_s == 1.0
+    rollouts = -(-cfg.phase_steps // cfg.n_steps)
+    assert est.seconds == pytest.approx(2 * rollouts * cfg.n_steps / k + 1.0)
+    assert est.cycles == cfg.cycles and est.size.endswith(" workers")
+    text = est.text()
+    assert "a certification (exact best response)" in text and "\n" not in text
+
+
+def test_a_slow_concurrent_game_is_refused_before_the_folder_is_touched(tmp_path):
+    run = tmp_path / "run"
+    run.mkdir()
+    (run / "notes.txt").write_text("keep")
+    with pytest.raises(GameError, match="over --max-cycle-seconds 1e-06") as info:
+        train_concurrent(small_rules(), "concurrent-tiny", output=run, max_cycle_seconds=1e-6)
+    assert "\n" not in str(info.value) and "a cycle" in str(info.value)
+    assert sorted(p.name for p in run.iterdir()) == ["notes.txt"]
+
+
+@pytest.mark.slow
+def test_the_estimate_changes_no_result_and_the_heartbeat_says_each_step(monkeypatch):
+    rules = small_rules()
+    seen, lines = [], []
+    monkeypatch.setattr(pace, "HEARTBEAT_S", 0.001)
+    plain = train_concurrent(rules, "concurrent-tiny", seed=3, budgets=[0, None])
+    paced = train_concurrent(
+        rules,
+        "concurrent-tiny",
+        seed=3,
+        budgets=[0, None],
+        max_cycle_seconds=1e6,
+        on_estimate=seen.append,
+        heartbeat=lines.append,
+    )
+    assert len(seen) == 1 and seen[0].seconds > 0
+    assert without_times(paced.cycles) == without_times(plain.cycles)
+    assert lines and all(x.startswith("training: ") and x.endswith(" so far") for x in lines)
+    said = {x.split(", ")[0] for x in lines}
+    assert said <= {
+        "training: starting",
+        "training: estimating a cycle's time (a sample of steps",
+        *(f"training: cycle {c} of 2: the {s}'s phase" for c in (1, 2) for s in ("robot", "human")),
+        *(f"training: cycle {c} of 2: a certification (exact best response)" for c in (1, 2)),
+    }, said

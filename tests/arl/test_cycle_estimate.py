@@ -9,6 +9,7 @@ import threading
 
 import pytest
 
+import arl.pace as pace
 import arl.trainer as trainer
 from arl import get_config, train
 from asmplan.cli.app import main
@@ -46,7 +47,8 @@ def test_a_cycle_is_every_learner_s_phase_and_tabulations(clock, cfg, sample, ro
     assert est.sample_steps == sample and est.step_s == 1.0 / sample
     phase = rollouts * cfg.n_steps * cfg.n_envs * est.step_s
     assert est.seconds == pytest.approx(2 * (phase + opponent + 2.0))  # both sides learn
-    assert est.cycles == cfg.max_cycles and est.nodes == figure4().n_nodes
+    assert est.cycles == cfg.max_cycles
+    assert est.size == f"{figure4().n_nodes:,} nodes, {figure4().n_edges:,} edges"
     text = est.text()
     assert "a cycle" in text and f"for {cfg.max_cycles} cycles" in text and "\n" not in text
 
@@ -63,7 +65,7 @@ def test_a_cycle_is_every_learner_s_phase_and_tabulations(clock, cfg, sample, ro
     ],
 )
 def test_durations_read_as_a_person_says_them(seconds, text):
-    assert trainer._duration(seconds) == text
+    assert pace.duration(seconds) == text
 
 
 def test_a_slow_game_is_refused_before_the_run_folder_is_touched(tmp_path):
@@ -107,7 +109,7 @@ def test_cli_says_the_estimate_and_refuses_over_the_flag(tmp_path, capsys):
 
 def test_the_heartbeat_says_what_the_run_is_doing(monkeypatch):
     lines, doing, said = [], [], threading.Event()
-    monkeypatch.setattr(trainer, "HEARTBEAT_S", 0.001)
+    monkeypatch.setattr(pace, "HEARTBEAT_S", 0.001)
 
     def say(line):
         lines.append(line)

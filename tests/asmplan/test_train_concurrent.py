@@ -95,8 +95,11 @@ def test_train_config_concurrent_plays_the_rules_and_certifies(tmp_path, capsys)
     with pytest.raises(SystemExit) as exit_info:
         main([*argv.split(), "--output", str(run), "--no-progress"])
     assert exit_info.value.code == 0
-    out = capsys.readouterr().out
+    captured = capsys.readouterr()
+    out = captured.out
     assert "certified (exact best response) at k=0: " in out and "k=inf: " in out
+    estimate = [x for x in captured.err.splitlines() if x.startswith("training: about ")]
+    assert len(estimate) == 1 and "a certification (exact best response)" in estimate[0]
     log = json.loads((run / "log.json").read_text())
     assert len(log["cycles"]) == 1 and (run / "robot.zip").is_file()
     # evaluate certifies the saved robot again, without compiling the game.
@@ -119,3 +122,17 @@ def test_train_config_concurrent_needs_the_concurrent_game_of_an_assembly(tmp_pa
             main([*argv.split(), "--output", str(tmp_path / "run"), "--no-progress"])
         assert exit_info.value.code == 2
         assert message in capsys.readouterr().err
+
+
+def test_train_config_concurrent_refuses_a_cycle_over_the_flag(tmp_path, capsys):
+    """Issue 26 item 11: the concurrent trainer is estimated and limited as the alternating
+    one is (the same --max-cycle-seconds, the same line)."""
+    run = tmp_path / "run"
+    argv = f"train {PUMP} --turn-model concurrent --config concurrent-tiny --no-progress"
+    with pytest.raises(SystemExit) as exit_info:
+        main([*argv.split(), "--max-cycle-seconds", "0.001", "--output", str(run)])
+    assert exit_info.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "over --max-cycle-seconds 0.001" in err[0], err
+    assert "a certification (exact best response)" in err[0]
+    assert not run.exists() or not any(run.iterdir())
