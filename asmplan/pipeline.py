@@ -360,13 +360,17 @@ def load(
     ``penetration_tol`` (mm) replace the spec's tolerances when given; ``units`` and
     ``gravity`` replace the spec's (a given gravity is kept, not chosen). An assembly
     implausibly small or large for its unit gets a note (:func:`cad.unit_hints.size_hint`).
+
+    The source is read once (:func:`asp.fromcad.generate.read_source`: the spec and its
+    parts' meshes, one value); the relations and the decisions take that geometry, and no
+    step below reads a file again.
     """
-    from asp.fromcad.generate import decide_generated, spec_geometry
-    from asp.graph.feasibility import load_relations
+    from asp.fromcad.generate import decide_generated, read_source
+    from asp.graph.feasibility import spec_relations
     from cad.unit_hints import size_hint
 
-    spec = load_assembly(source, units=units, gravity=gravity)
-    spec = with_tolerances(spec, contact_tol, penetration_tol)
+    read = read_source(source, units=units, gravity=gravity)
+    spec = with_tolerances(read.spec, contact_tol, penetration_tol)
 
     def note(text: str) -> None:
         if on_step is not None:
@@ -388,12 +392,11 @@ def load(
     if spec.has_geometry:
         if on_step is not None:
             on_step(f"computing part relations of {len(spec.parts)} parts ...")
-        geometry = spec_geometry(spec)
-        if hint := size_hint(geometry):
+        if hint := size_hint(read.geometry):
             note(f"units: {hint}")
-        rel = load_relations(spec, progress=progress, geometry=geometry)
+        rel = spec_relations(spec, read.geometry, progress=progress)
         decided = decide_generated(
-            spec, rel, geometry, say=on_step, progress=progress, given_gravity=bool(gravity)
+            spec, rel, read.geometry, say=on_step, progress=progress, given_gravity=bool(gravity)
         )
         spec, rel = decided.spec, decided.relations
         for line in decided.notes():

@@ -163,11 +163,17 @@ def load_parts(
     distinct = sorted(set(used))
     combined = distinct[0] if len(distinct) == 1 else ("mixed" if distinct else units or "mm")
     assembly = Assembly(parts=tuple(parts), units=combined, source=str(base))
-    for k in range(len(parts) if len(parts) > 2 else 0):
+    warn_part_scales(assembly)
+    return rotated(assembly, frame)
+
+
+def warn_part_scales(assembly: Assembly) -> None:
+    """A warning for each part of three or more about 1000 times smaller or larger than
+    the others (its file in metres, read as millimetres: :func:`cad.unit_hints.part_scale_hint`)."""
+    for k in range(len(assembly.parts) if len(assembly.parts) > 2 else 0):
         hint = part_scale_hint(assembly, k, factors=METRES_ONLY)
         if hint:
-            warnings.warn(hint, stacklevel=2)
-    return rotated(assembly, frame)
+            warnings.warn(hint, stacklevel=3)
 
 
 def _record_mesh(row: PartRecord, base: Path, units: str | None):

@@ -10,6 +10,13 @@ from asp.lazy import lazy_exports
 __all__, __getattr__ = lazy_exports(
     __name__,
     {
-        "generate": ("decide_generated", "load_any", "spec_geometry", "spec_text"),
+        "generate": (
+            "Source",
+            "decide_generated",
+            "load_any",
+            "read_source",
+            "spec_geometry",
+            "spec_text",
+        ),
     },
 )

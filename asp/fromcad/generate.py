@@ -226,12 +226,17 @@ def cad_assembly(path: str | Path, units: str | None = None):
 
 def spec_data(
     path: str | Path,
+    geometry,
     spec_folder: str | Path | None = None,
     gravity: str | None = None,
     frame=None,
     units: str | None = None,
 ) -> tuple[dict, object]:
     """The generated spec of a CAD file or folder, as the YAML mapping, and its geometry.
+
+    ``geometry`` is the file's parts as :func:`cad_assembly` read them (in the file's
+    frame): the spec is made from it, along any gravity and in any frame, with no file
+    read again.
 
     Part files are written relative to ``spec_folder`` (default: the CAD file's folder,
     or the folder of meshes itself); ``gravity`` defaults to the format's own down
@@ -251,7 +256,7 @@ def spec_data(
 
     path = Path(path)
     gravity = gravity or default_down(path)
-    assembly = rotated(cad_assembly(path, units), frame)
+    assembly = rotated(geometry, frame)
     shapes = shape_classes(assembly.parts)
     counts = Counter(shapes)
     if spec_folder is None:
@@ -323,6 +328,48 @@ def is_cad_input(path: str | os.PathLike[str]) -> bool:
     return path.is_file() and path.suffix.lower() in MESH_SUFFIXES
 
 
+@dataclass(frozen=True, eq=False)
+class Source:
+    """An assembly's input, read once: its spec and the geometry of its parts.
+
+    Attributes
+    ----------
+    spec : AssemblySpec
+        Read (``assembly.yaml``, a Scholl ``.IN2``) or generated from a CAD file or a
+        folder of part meshes (``spec.generated``).
+    geometry : cad.Assembly or None
+        The meshes of the spec's parts in its build frame (None: the spec places no part
+        with a mesh). Of a CAD file: its parts as read (the file's frame, a ``bom``
+        applied, ``groups`` the file's hierarchy), the value the spec was generated from
+        and, along another gravity or in another frame, is generated again from
+        (:func:`decide_generated`); nothing below reads the file again.
+    """
+
+    spec: AssemblySpec
+    geometry: object | None = None
+
+
+def read_source(
+    path: str | os.PathLike[str], *, units: str | None = None, gravity: str | None = None
+) -> Source:
+    """The spec of ``path`` (as :func:`load_any` reads it) and its parts' geometry.
+
+    A CAD file or folder of meshes is read once (:func:`cad_assembly`) and the spec
+    generated from that geometry; a spec's part files are read once
+    (:func:`spec_geometry`).
+    """
+    check_overrides(units, gravity)
+    if not is_cad_input(path):
+        spec = _read_spec(path, units, gravity)
+        return Source(spec, spec_geometry(spec) if spec.has_geometry else None)
+    geometry = cad_assembly(path, units)
+    if Path(path).is_file():  # what reading a scene's parts as part files warns of
+        from cad.loading import warn_part_scales
+
+        warn_part_scales(geometry)
+    return Source(spec_from_geometry(path, geometry, gravity=gravity, units=units), geometry)
+
+
 def load_any(
     path: str | os.PathLike[str], *, units: str | None = None, gravity: str | None = None
 ) -> AssemblySpec:
@@ -336,6 +383,11 @@ def load_any(
     check_overrides(units, gravity)
     if is_cad_input(path):
         return generated_spec(path, gravity=gravity, units=units)
+    return _read_spec(path, units, gravity)
+
+
+def _read_spec(path, units: str | None, gravity: str | None) -> AssemblySpec:
+    """The spec file of ``path`` with ``--units`` and ``--gravity`` in place of its own."""
     spec = load_spec(path)
     changes = {"units": units, "gravity": gravity}
     return replace(spec, **{k: v for k, v in changes.items() if v is not None})
@@ -355,14 +407,22 @@ def check_overrides(units: str | None, gravity: str | None) -> None:
 def generated_spec(
     path: str | Path, gravity: str | None = None, frame=None, units: str | None = None
 ) -> AssemblySpec:
-    """The spec generated from a CAD file or a folder of part meshes (``generated=True``).
+    """The spec generated from a CAD file or a folder of part meshes (``generated=True``):
+    :func:`spec_from_geometry` of the file read (:func:`cad_assembly`)."""
+    return spec_from_geometry(path, cad_assembly(path, units), gravity, frame, units)
+
+
+def spec_from_geometry(
+    path: str | Path, geometry, gravity: str | None = None, frame=None, units: str | None = None
+) -> AssemblySpec:
+    """The spec generated from the parts of a CAD file or folder as read (``geometry``).
 
     Its ``source`` is the spec file it stands for (``assembly.yaml`` beside the CAD file,
     which need not exist), so that part files resolve as in the written spec. ``gravity``,
     ``frame`` and ``units``: as :func:`spec_data` takes them.
     """
     path = Path(path)
-    data, _ = spec_data(path, gravity=gravity, frame=frame, units=units)
+    data, _ = spec_data(path, geometry, gravity=gravity, frame=frame, units=units)
     folder = path if path.is_dir() else path.parent
     spec = spec_from_dict(data, source=str(folder / SPEC_FILE))
     return replace(spec, generated=True, source=str(path))
@@ -401,16 +461,17 @@ def orient_generated(spec: AssemblySpec, relations, geometry, turn=None, given: 
         return spec, choice
     with warnings.catch_warnings():  # the same files again: their warnings were given
         warnings.simplefilter("ignore")
-        turned = (turn or _regenerate(spec))(choice.gravity, spec.frame)
+        turned = (turn or _regenerate(spec, geometry))(choice.gravity, spec.frame)
     tolerances = {"contact_tol": spec.contact_tol, "penetration_tol": spec.penetration_tol}
     return replace(turned, **tolerances), choice
 
 
-def _regenerate(spec: AssemblySpec):
+def _regenerate(spec: AssemblySpec, geometry):
     """``turn(gravity, frame)``: ``spec``'s source generated again along another gravity
-    or in another build frame (tolerances are kept by the callers)."""
-    return lambda gravity, frame: generated_spec(
-        spec.source, gravity=gravity, frame=frame, units=spec.units
+    or in another build frame from ``geometry`` (its parts as read, in the file's frame;
+    tolerances are kept by the callers)."""
+    return lambda gravity, frame: spec_from_geometry(
+        spec.source, geometry, gravity=gravity, frame=frame, units=spec.units
     )
 
 
@@ -480,32 +541,27 @@ def decide_generated(
 
     ``asmplan plan`` (:func:`asmplan.pipeline.load`) and ``asmplan init``
     (:func:`spec_text`) both take them here, so the file written plans as the file read.
-    A user's spec comes back unchanged. ``turn(gravity, frame)``: the spec generated again
-    along another gravity or in another frame (default: from the spec's source). Use the
+    A user's spec comes back unchanged. ``geometry``: the parts as read (:class:`Source`).
+    ``turn(gravity, frame)``: the spec generated again along another gravity or in another
+    frame (default: from ``geometry``, no file read again). Use the
     returned ``relations`` (in the chosen frame) from then on. ``say`` is called with a line
     before each candidate frame's relations are computed (``progress``: their bars).
     ``given_gravity``: the spec's gravity was given (``--gravity``) and is kept.
     """
     from asp.fromcad.framing import choose_frame
 
-    turn = turn or _regenerate(spec)
+    turn = turn or _regenerate(spec, geometry)
     decided = _decide_in_frame(spec, relations, geometry, turn, given_gravity)
 
     def in_frame(rotation) -> Decisions:
         """The decisions in another build frame (its relations computed afresh)."""
-        import cad
+        from asp.graph.feasibility import spec_relations
         from cad.frame import frame_text, rotated
 
         geo = rotated(geometry, rotation)
         if say is not None:
             say(f"trying another build frame ({frame_text(rotation)}): part relations ...")
-        rel = cad.compute_relations(
-            geo,
-            contact_tol=spec.contact_tol,
-            penetration_tol=spec.penetration_tol,
-            progress=progress,
-            overlap_ok=spec.overlap_ok,
-        )
+        rel = spec_relations(spec, geo, progress=progress)
         tolerances = {"contact_tol": spec.contact_tol, "penetration_tol": spec.penetration_tol}
         framed = replace(turn(spec.gravity if given_gravity else None, rotation), **tolerances)
         return _decide_in_frame(framed, rel, geo, turn, given_gravity)
@@ -553,7 +609,8 @@ def spec_text(
     from cad.unit_hints import size_hint
 
     check_overrides(units, gravity)
-    data, assembly = spec_data(path, spec_folder, gravity=gravity, units=units)
+    read = cad_assembly(path, units)  # the file, read once: every turn below starts from it
+    data, assembly = spec_data(path, read, spec_folder, gravity=gravity, units=units)
     size_note = size_hint(assembly)
     if size_note and on_note is not None:
         on_note(f"units: {size_note}")
@@ -582,7 +639,7 @@ def spec_text(
 
     def turn(gravity: str | None, frame) -> AssemblySpec:
         """The spec along another gravity or in another frame, keeping its records."""
-        records = spec_data(path, spec_folder, gravity=gravity, frame=frame, units=units)
+        records = spec_data(path, read, spec_folder, gravity=gravity, frame=frame, units=units)
         turned[(records[0]["gravity"], frame)] = records
         return replace(spec_from_dict(records[0], source=str(path)), generated=True)
 

@@ -15,7 +15,7 @@ __all__, __getattr__ = lazy_exports(
     __name__,
     {
         "checker": ("check_line", "plan_operations"),
-        "feasibility": ("insertion_oracle", "load_relations", "operation_model"),
+        "feasibility": ("insertion_oracle", "load_relations", "operation_model", "spec_relations"),
         "game_dag": ("game_dag",),
         "state_graph": ("StateGraph", "build_state_graph"),
         "symmetry": ("Refutation", "reduced_state_graph", "refutation"),

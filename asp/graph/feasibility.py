@@ -830,25 +830,28 @@ def operation_model(
     )
 
 
-def load_relations(spec: AssemblySpec, *, progress: bool = False, geometry=None):
-    """Compute the cad relations of ``spec``'s parts (``None`` when it has no geometry).
-
-    Reads the meshes of the spec's parts (:func:`asp.fromcad.generate.spec_geometry`: in the
-    spec's build frame) unless ``geometry`` (that ``cad.Assembly``, already read) is given,
-    with the spec's
-    ``contact_tol`` and ``penetration_tol`` (None: the per-part rule), its ``overlap_ok``
-    pairs and its ``flex`` parts (:func:`asp.cad_keys.with_flex`).
-    """
+def load_relations(spec: AssemblySpec, *, progress: bool = False):
+    """Read the meshes of ``spec``'s parts (in its build frame) and compute their cad
+    relations (:func:`spec_relations`; ``None`` when the spec has no geometry)."""
     if not spec.has_geometry:
         return None
-    import cad
-    from asp.cad_keys import with_flex
     from cad.loading import load_parts
 
+    geometry = load_parts(spec.parts, spec.folder, spec.units, frame=spec.frame)
+    return spec_relations(spec, geometry, progress=progress)
+
+
+def spec_relations(spec: AssemblySpec, geometry, *, progress: bool = False):
+    """The cad relations of ``geometry``, the meshes of ``spec``'s parts already read.
+
+    With the spec's ``contact_tol`` and ``penetration_tol`` (None: the per-part rule), its
+    ``overlap_ok`` pairs and its ``flex`` parts (:func:`asp.cad_keys.with_flex`).
+    """
+    import cad
+    from asp.cad_keys import with_flex
+
     relations = cad.compute_relations(
-        load_parts(spec.parts, spec.folder, spec.units, frame=spec.frame)
-        if geometry is None
-        else geometry,
+        geometry,
         contact_tol=spec.contact_tol,
         penetration_tol=spec.penetration_tol,
         progress=progress,

@@ -218,3 +218,29 @@ def test_init_comments_each_class_of_generically_named_parts(tmp_path):
     text = out.read_text()
     assert "# alike_a: 2 part(s), each 40 x 40 x 5 mm (the file names Body, Body001)" in text
     assert "# alike_b: 1 part(s), each 3 x 3 x 10 mm (the file names Body002)" in text
+
+
+@pytest.mark.parametrize("kind", ["folder", "glb", "3mf"])
+def test_load_reads_a_cad_file_once(tmp_path, kind, monkeypatch):
+    """The source is read once at the top (``asp.fromcad.generate.read_source``): the spec is
+    generated from that geometry, the relations and the decisions take it, nothing below
+    reads the file again."""
+    import warnings
+
+    import cad.loading
+    from asmplan import pipeline
+
+    reads = []
+    for name in ("load_assembly", "load_parts"):
+        real = getattr(cad.loading, name)
+        monkeypatch.setattr(
+            cad.loading,
+            name,
+            lambda *a, _real=real, _name=name, **k: reads.append(_name) or _real(*a, **k),
+        )
+    source = inputs(tmp_path)[kind]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assembly = pipeline.load(source, on_step=lambda _: None)
+    assert assembly.spec.generated and assembly.relations is not None
+    assert reads == ["load_assembly"] + (["load_parts"] if kind == "folder" else [])
