@@ -11,16 +11,19 @@ class                  raised for
 ``InfeasibleAssembly`` (a ``SpecError``) an assembly with no complete sequence
 ``StateLimit``         (a ``SpecError``) a state graph over ``max_states`` or its memory
 ``GameLimit``          (a ``GameError``) a game over its node limit
+``Interpenetration``   (a ``GeometryError``, :mod:`cad.errors`) parts overlapping deeper
+                       than their tolerance; ``pairs`` names them
 =====================  ====================================================================
 
-The three limits and failures are typed so that a caller decides by type (build
-subassemblies, stop a curve early), never by reading the message; each keeps its parent, so
-the command line still answers with the same one line and exit code 2.
+The limits and failures are typed so that a caller decides by type (build subassemblies,
+stop a curve early, write the overlapping pairs commented), never by reading the message;
+each keeps its parent, so the command line still answers with the same one line and exit
+code 2.
 """
 
 from __future__ import annotations
 
-from cad.errors import AsmplanError, GeometryError
+from cad.errors import AsmplanError, GeometryError, Interpenetration
 
 
 class SpecError(AsmplanError):
@@ -64,6 +67,7 @@ __all__ = [
     "GameLimit",
     "GraphError",
     "InfeasibleAssembly",
+    "Interpenetration",
     "ScheduleError",
     "SpecError",
     "StateLimit",

@@ -18,3 +18,18 @@ class AsmplanError(ValueError):
 
 class GeometryError(AsmplanError):
     """Part geometry that cannot be used: unreadable mesh, deep interpenetration, bad units."""
+
+
+class Interpenetration(GeometryError):
+    """Parts that overlap deeper than their tolerance.
+
+    ``pairs`` holds their part ids, the pairs a spec's ``overlap_ok:`` accepts, so that a
+    caller (``asmplan init``) decides by type and reads the pairs, never the message.
+    """
+
+    def __init__(self, message: str, pairs=()) -> None:
+        super().__init__(message)
+        self.pairs = tuple(tuple(pair) for pair in pairs)
+
+    def __reduce__(self):
+        return type(self), (str(self), self.pairs)

@@ -43,7 +43,7 @@ import numpy as np
 import trimesh
 
 from cad.assembly import Assembly
-from cad.errors import GeometryError
+from cad.errors import Interpenetration
 from cad.faces import FaceSet, axis_face_sets, bounds_overlap, crop_pair, unit_normals
 from cad.offset import offset_vertices
 from cad.progress import progress_bar
@@ -359,10 +359,10 @@ def _centred(a: trimesh.Trimesh, b: trimesh.Trimesh) -> tuple[trimesh.Trimesh, t
     )
 
 
-def interpenetration_error(assembly: Assembly, tols, found: list[Overlap]) -> GeometryError:
+def interpenetration_error(assembly: Assembly, tols, found: list[Overlap]) -> Interpenetration:
     """The one-line error for every pair in ``found`` (the first :data:`MAX_NAMED` named),
     ending with the one spec line that accepts them all (:func:`overlap_line`) unless the
-    unit is wrong; its ``pairs`` attribute holds the pairs' part ids."""
+    unit is wrong; its ``pairs`` hold the pairs' part ids."""
     parts = assembly.parts
     first = found[0]
     pairs = [(parts[o.a].id, parts[o.b].id) for o in found]
@@ -377,7 +377,7 @@ def interpenetration_error(assembly: Assembly, tols, found: list[Overlap]) -> Ge
             + " (`asmplan init` writes the spec)"
         )
     if len(found) == 1:
-        error = GeometryError(
+        message = (
             f"parts {parts[first.a].id!r} and {parts[first.b].id!r} interpenetrate by "
             f"{first.text()} (penetration tolerance of this pair {tols.pair(first.a, first.b):.3g}"
             f" mm); {hint}"
@@ -389,12 +389,11 @@ def interpenetration_error(assembly: Assembly, tols, found: list[Overlap]) -> Ge
             for o in found[:MAX_NAMED]
         )
         more = f"; and {len(found) - MAX_NAMED} more" if len(found) > MAX_NAMED else ""
-        error = GeometryError(
+        message = (
             f"{len(found)} pairs of parts interpenetrate deeper than their tolerance: "
             f"{named}{more}; {hint}"
         )
-    error.pairs = tuple(pairs)
-    return error
+    return Interpenetration(message, pairs)
 
 
 def overlap_line(pairs) -> str:

@@ -605,7 +605,7 @@ def spec_text(
     from dataclasses import replace
 
     import cad
-    from cad.errors import GeometryError
+    from cad.errors import Interpenetration
     from cad.unit_hints import size_hint
 
     check_overrides(units, gravity)
@@ -619,10 +619,8 @@ def spec_text(
         relations = cad.compute_relations(
             assembly, contact_tol=contact_tol, penetration_tol=penetration_tol
         )
-    except GeometryError as exc:
-        overlapping = getattr(exc, "pairs", ())
-        if not overlapping:
-            raise
+    except Interpenetration as exc:
+        overlapping = exc.pairs
         relations = cad.compute_relations(
             assembly,
             contact_tol=contact_tol,

@@ -88,7 +88,7 @@ class FixedOrder:
     def of_graph(cls, graph) -> FixedOrder | None:
         """The fixed order of a state graph's model (None when it has none)."""
         model = graph.model
-        return cls.of(model.n_ops, getattr(model, "fixed", ()))
+        return cls.of(model.n_ops, model.fixed)
 
     def chain_pairs(self) -> set[tuple[int, int]]:
         """The precedences ``(a, b)`` the chains add to the spec (consecutive in a chain)."""

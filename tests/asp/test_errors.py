@@ -13,7 +13,9 @@ from asp.errors import (
     AsmplanError,
     GameError,
     GameLimit,
+    GeometryError,
     InfeasibleAssembly,
+    Interpenetration,
     SpecError,
     StateLimit,
 )
@@ -48,11 +50,25 @@ def _two_jobs():
 
 @pytest.mark.parametrize(
     ("kind", "parent"),
-    [(InfeasibleAssembly, SpecError), (StateLimit, SpecError), (GameLimit, GameError)],
+    [
+        (InfeasibleAssembly, SpecError),
+        (StateLimit, SpecError),
+        (GameLimit, GameError),
+        (Interpenetration, GeometryError),
+    ],
 )
 def test_each_kind_keeps_its_family(kind, parent):
     assert issubclass(kind, parent) and issubclass(kind, AsmplanError)
     assert issubclass(kind, ValueError)
+
+
+def test_interpenetration_carries_its_pairs_through_a_pickle():
+    import pickle
+
+    error = Interpenetration("parts 'a' and 'b' interpenetrate", [("a", "b")])
+    again = pickle.loads(pickle.dumps(error))
+    assert type(again) is Interpenetration and again.pairs == (("a", "b"),)
+    assert str(again) == str(error)
 
 
 def test_no_complete_sequence_is_infeasible_assembly():
