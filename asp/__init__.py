@@ -1,8 +1,15 @@
 """asp: assembly sequence planning as a robot-vs-human game.
 
-The game DAG (:mod:`asp.game.dag`), the rules of play on it (:mod:`asp.game.rules`), its
-file formats (:mod:`asp.game.io`), the synthetic generator (:mod:`asp.game.synth`), the exact
-solver (:mod:`asp.game.solve`) and the metrics (:mod:`asp.game.metrics`).
+Rooms, from the ground up (each imports its own and lower floors only): the ground modules
+(:mod:`asp.errors`, :mod:`asp.numbers`, :mod:`asp.atomic`, :mod:`asp.heap`,
+:mod:`asp.cad_keys`, :mod:`asp.lazy`); :mod:`asp.game` (the game DAG with no assembly spec);
+:mod:`asp.salbp` and :mod:`asp.spec`; :mod:`asp.graph` (the assembly state graph);
+:mod:`asp.schedule` (CP-SAT) and :mod:`asp.fromcad` (a spec from a CAD file);
+:mod:`asp.concurrent` and :mod:`asp.subassemblies`. Each room names what other packages may
+use in its ``__all__`` (a sub-package's ``__init__``, a module's own).
+
+Here: the game DAG's API for a notebook (:mod:`asp.game.dag`, :mod:`asp.game.io`,
+:mod:`asp.game.solve`, :mod:`asp.game.synth`, :mod:`asp.game.metrics`).
 This package never imports torch.
 """
 

@@ -280,3 +280,14 @@ def check_output_folder(
             f"{folder}: holds {others[0]!r}{more}, not written by asmplan; choose an empty "
             "or new folder, or pass --force to write beside them (they are never deleted)"
         )
+
+
+__all__ = [
+    "ForeignFilesError",
+    "OutputSet",
+    "check_output_folder",
+    "remove_stale_temps",
+    "write_bytes",
+    "write_text",
+]
+"""What other modules may use (asmplan and arl among them)."""

@@ -117,3 +117,12 @@ def parse_overlap_ok(value, part_ids, source: str) -> tuple[tuple[str, str], ...
             raise ValueError(f"{source}: {OVERLAP_KEY}: a pair of one part {a!r}")
         pairs.append((a, b))
     return tuple(pairs)
+
+
+__all__ = [
+    "flex_hint",
+    "parse_flex",
+    "parse_overlap_ok",
+    "with_flex",
+]
+"""What other modules may use (asmplan and arl among them)."""

@@ -116,3 +116,12 @@ def memory_budget(cap: int | None = None) -> int:
     most ``cap`` bytes when given."""
     share = int(MEMORY_SHARE * available_memory())
     return share if cap is None else min(int(cap), share)
+
+
+__all__ = [
+    "available_memory",
+    "map_large_blocks",
+    "memory_budget",
+    "release_memory",
+]
+"""What other modules may use (asmplan and arl among them)."""

@@ -40,3 +40,9 @@ def lazy_exports(
         return getattr(importlib.import_module(f"{package}.{module}"), name)
 
     return sorted(home), __getattr__
+
+
+__all__ = [
+    "lazy_exports",
+]
+"""What other modules may use (asmplan and arl among them)."""

@@ -30,3 +30,12 @@ def cost_text(x, spec: str = "g") -> str:
 def cost_unit(cost_model: str) -> str:
     """The unit suffix of a cost in text: ``""`` under ``steps``, ``" s"`` under ``time``."""
     return "" if cost_model == "steps" else " s"
+
+
+__all__ = [
+    "cost_text",
+    "cost_unit",
+    "json_number",
+    "plain",
+]
+"""What other modules may use (asmplan and arl among them)."""

@@ -131,3 +131,11 @@ def in2_assembly(path: str | os.PathLike[str]) -> dict:
         ],
         "credit": CREDIT,
     }
+
+
+__all__ = [
+    "SalbpInstance",
+    "in2_assembly",
+    "read_in2",
+]
+"""What other modules may use (asmplan and arl among them)."""

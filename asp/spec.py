@@ -721,3 +721,22 @@ def tool_values(spec: AssemblySpec) -> dict[str, tuple[str, ...]]:
             if v not in out[t]:
                 out[t].append(v)
     return {k: tuple(v) for k, v in out.items()}
+
+
+__all__ = [
+    "DIRECTIONS",
+    "SPEC_FILE",
+    "TURN_MODELS",
+    "Agent",
+    "AssemblySpec",
+    "Constraints",
+    "Operation",
+    "Part",
+    "Tool",
+    "load_spec",
+    "resolve_spec_path",
+    "spec_from_dict",
+    "tool_values",
+    "with_subassemblies",
+]
+"""What other modules may use (asmplan and arl among them)."""

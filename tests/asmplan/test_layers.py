@@ -196,11 +196,47 @@ def test_every_package_names_its_public_api(package):
     assert not missing, f"{package}.__all__ names what it does not have: {missing}"
 
 
-def test_asmplan_and_arl_use_the_public_names_of_asp():
-    """What asmplan and arl import from ``asp.<room>.<module>`` is in ``asp.<room>.__all__``
-    (or is a module of the room): add a new name to the room's ``__init__``."""
+def test_every_asp_module_room_names_its_public_api():
+    """A room that is one module (``asp/spec.py``) names what others may use in its own
+    ``__all__``, as a sub-package does in its ``__init__``."""
     import importlib
 
+    wrong = []
+    for path in sorted((REPO / "asp").glob("*.py")):
+        if path.name == "__init__.py":
+            continue
+        module = importlib.import_module(f"asp.{path.stem}")
+        names = getattr(module, "__all__", None)
+        if not isinstance(names, list):
+            wrong.append(f"asp.{path.stem}: no __all__")
+            continue
+        wrong += [f"asp.{path.stem}.{n}: not defined" for n in names if not hasattr(module, n)]
+    assert not wrong, f"each module room names its public API: {wrong}"
+
+
+def public_names(module: str) -> tuple[set[str], set[str]] | None:
+    """The names others may import from ``module`` and the modules beside them: of an asp
+    room (``asp.<room>.<module>``: the room's ``__all__``; ``asp.<module>``: the module's own)
+    or of cad (``cad.<module>``: ``cad.__all__``); None for any other module."""
+    import importlib
+
+    parts = module.split(".")
+    if parts[0] == "asp" and len(parts) == 3:
+        room = importlib.import_module(".".join(parts[:2]))
+        return set(room.__all__), {p.stem for p in (REPO / "asp" / parts[1]).glob("*.py")}
+    if parts[0] == "asp" and len(parts) == 2 and (REPO / "asp" / f"{parts[1]}.py").is_file():
+        return set(importlib.import_module(module).__all__), set()
+    if parts[0] == "cad" and len(parts) == 2:
+        import cad
+
+        return set(cad.__all__), {p.stem for p in (REPO / "cad").glob("*.py")}
+    return None
+
+
+def test_asmplan_and_arl_use_the_public_names_of_asp_and_cad():
+    """What asmplan and arl import from ``asp.<room>.<module>`` is in ``asp.<room>.__all__``
+    (or is a module of the room), from ``asp.<module>`` in that module's ``__all__``, and from
+    ``cad.<module>`` in ``cad.__all__``: add a new name to the room's face."""
     wrong = []
     for pkg in ("arl", "asmplan"):
         for path in sources(pkg):
@@ -208,15 +244,13 @@ def test_asmplan_and_arl_use_the_public_names_of_asp():
             for node in ast.walk(tree):
                 if not isinstance(node, ast.ImportFrom) or node.level or not node.module:
                     continue
-                parts = node.module.split(".")
-                if parts[0] != "asp" or len(parts) != 3:
+                face = public_names(node.module)
+                if face is None:
                     continue
-                room = importlib.import_module(".".join(parts[:2]))
-                public = set(room.__all__)
-                modules = {p.stem for p in (REPO / "asp" / parts[1]).glob("*.py")}
+                public, modules = face
                 wrong += [
                     f"{path.relative_to(REPO)}:{node.lineno} {node.module}.{a.name}"
                     for a in node.names
                     if a.name not in public and a.name not in modules
                 ]
-    assert not wrong, f"not in the room's __all__ (asp/<room>/__init__.py): {wrong}"
+    assert not wrong, f"not in the room's __all__ (its __init__.py, or the module's): {wrong}"
