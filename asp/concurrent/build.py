@@ -234,7 +234,9 @@ def game_of(
     :data:`LABEL_LIMIT`), the start of ``levels[-1]`` its start. ``t0``: when the build
     began (``seconds``)."""
     src, dst, cost, side = edges
-    labels = len(actions) <= LABEL_LIMIT
+    ops_labels, agent_labels = (
+        _edge_labels(model, actions) if len(actions) <= LABEL_LIMIT else (None, None)
+    )
     dag = from_arrays(
         list(range(len(nodes))),
         src,
@@ -243,8 +245,8 @@ def game_of(
         np.asarray(side, dtype=np.int8),
         start=starts[levels[-1]],
         end=end,
-        operations=tuple(_edge_ops(model, a) for a in actions) if labels else None,
-        agents=tuple(_edge_agents(model, a) for a in actions) if labels else None,
+        operations=ops_labels,
+        agents=agent_labels,
         cost_model="time",
         metadata={
             "generator": generator,
@@ -380,16 +382,30 @@ def _build_python(model: ConcurrentModel, levels, max_nodes, too_big, progress, 
     )
 
 
-def _edge_ops(model: ConcurrentModel, action) -> str:
+def _edge_labels(model: ConcurrentModel, actions) -> tuple[tuple[str, ...], tuple[str, ...]]:
+    """Each edge's operations (``"a,b"``, ``"wait"`` for none) and agents (``"R1,H"``): the
+    ids of the operations started, in worker order, and their workers' names. Computed once
+    per distinct row of started operations (few) when ``actions`` is :class:`ActionRows`."""
     ids = model.spec.op_ids
-    parts = [ids[o] for o in action.ops if o is not None and o != WAIT]
-    return ",".join(parts) if parts else "wait"
+    names = [w.name for w in model.workers]
 
+    def labels(ops) -> tuple[str, str]:
+        started = [(w, o) for w, o in enumerate(ops) if o is not None and o >= 0]
+        return (
+            ",".join(ids[o] for _, o in started) or "wait",
+            ",".join(names[w] for w, _ in started),
+        )
 
-def _edge_agents(model: ConcurrentModel, action) -> str:
-    return ",".join(
-        model.workers[w].name for w, o in enumerate(action.ops) if o is not None and o != WAIT
-    )
+    if isinstance(actions, ActionRows):
+        if len(actions) == 0:
+            return (), ()
+        uniq, inverse = np.unique(actions.ops, axis=0, return_inverse=True)
+        texts = [labels(row) for row in uniq.tolist()]
+        ops_of = np.array([t[0] for t in texts], dtype=object)[inverse.ravel()]
+        agents_of = np.array([t[1] for t in texts], dtype=object)[inverse.ravel()]
+        return tuple(ops_of.tolist()), tuple(agents_of.tolist())
+    pairs = [labels(a.ops) for a in actions]
+    return tuple(p[0] for p in pairs), tuple(p[1] for p in pairs)
 
 
 def _assignments(model: ConcurrentModel, state: int, deciders: list[int], busy: tuple[int, ...]):

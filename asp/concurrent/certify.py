@@ -31,7 +31,9 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
+import numba
 import numpy as np
+from numba.typed import List
 
 from asp.concurrent.build import Commit, ConcurrentGame
 from asp.concurrent.model import UNBOUNDED
@@ -44,7 +46,15 @@ from asp.concurrent.rules import (
     key_of,
     reply_rows,
 )
-from asp.concurrent.search import as_policy_game, node_row
+from asp.concurrent.search import (  # the search's compiled policies and table
+    ABORT,
+    _choose,
+    _find,
+    _rehash,
+    _slot,
+    as_policy_game,
+    node_row,
+)
 
 Choose = Callable[[Position, list[Commit]], int]
 """A robot policy: the index of the commitment it takes at a position."""
@@ -187,3 +197,326 @@ def certify(
         (None if b == UNBOUNDED else b): float(solution.value[s, 0]) for b, s in game.starts.items()
     }
     return Certificate(worst=worst, game=game, solution=solution, seconds=time.perf_counter() - t0)
+
+
+# --------------------------------------------------------------------------- values only
+
+FIRST_POSITIONS = 1 << 16
+"""Positions the memo of :func:`best_response_values` holds at first (it grows four-fold)."""
+TICK_MASK = (1 << 15) - 1
+"""The clock is looked at every ``TICK_MASK + 1`` positions valued."""
+OK, FULL, STOPPED = 0, 1, 2
+"""What :func:`_values` ended with: every start valued, the memo full, a limit reached."""
+ENTRIES, CAPACITY, VALUED, DEADLINE_MS = range(4)
+"""The counters of :func:`_values` (an int64 array): positions in the memo, the most it
+may hold, positions valued in all, the deadline (ms of ``time.perf_counter``, 0: none)."""
+
+
+@numba.njit(cache=True)
+def _values(T, H, P, starts, kind, prefs, n_prefs, st, cnt, out):  # pragma: no cover
+    """The exact best response of the human side to the fixed policy ``kind`` from each row
+    of ``starts`` (scaled makespans into ``out``), values only (:func:`best_response_values`).
+
+    Depth-first over positions with an explicit stack (as :func:`asp.concurrent.search._search`:
+    numba caches no recursive function); a position's value, the max over the replies to
+    the policy's one commitment of the reply's cost plus the value after it, is memoised in
+    ``P`` (``P.lo``) once all its replies are valued, and nothing else is kept. The game is
+    a DAG (every event completes an operation), so no position is met again below itself.
+    Returns :data:`OK`, :data:`FULL` (``P`` holds ``cnt[CAPACITY]`` positions: what is
+    memoised stays valid, call again with a larger ``P``) or :data:`STOPPED` (the deadline,
+    or the policy stopped: ``st[ABORT]``)."""
+    width = starts.shape[1]
+    D = T.label.shape[0] + 3
+    rows = np.empty((D, width), np.int64)
+    jr = np.zeros(D, np.int64)
+    v = np.zeros(D, np.int64)
+    rrows_l = List()
+    rdelta_l = List()
+    for _ in range(D):  # (made as the rules' kernels make them: the same array types)
+        rrows_l.append(np.empty((1, width), np.int64)[:0])
+        rdelta_l.append(np.empty((1, 2), np.int64)[:0, 1])
+    for b in range(starts.shape[0]):
+        if starts[b, 0] < 0:
+            out[b] = 0
+            continue
+        j = _find(P, key_of(T, starts[b]))
+        if j >= 0:
+            out[b] = P.lo[j]
+            continue
+        d = 0
+        rows[0] = starts[b]
+        enter = True
+        while d >= 0:
+            if enter:  # the policy's commitment and every reply to it
+                enter = False
+                commits = commit_rows(T, rows[d])
+                i = _choose(T, H, rows[d], commits, kind, prefs, n_prefs, st)
+                if i < 0 or st[ABORT]:
+                    return STOPPED
+                _, _, _, delta, rws = reply_rows(T, rows[d], commits[i])
+                rrows_l[d] = rws
+                rdelta_l[d] = delta
+                jr[d] = 0
+                v[d] = 0 if delta.shape[0] == 0 else -1
+                cnt[VALUED] += 1
+                if (cnt[VALUED] & TICK_MASK) == 0 and cnt[DEADLINE_MS] > 0:
+                    with numba.objmode(now="float64"):
+                        now = time.perf_counter()
+                    if np.int64(now * 1000) >= cnt[DEADLINE_MS]:
+                        return STOPPED
+            delta = rdelta_l[d]
+            rws = rrows_l[d]
+            pushed = False
+            while jr[d] < delta.shape[0]:
+                r = jr[d]
+                if rws[r, 0] < 0:  # the end
+                    val = delta[r]
+                else:
+                    j = _find(P, key_of(T, rws[r]))
+                    if j < 0:  # not valued yet: below it first, this reply again after
+                        rows[d + 1] = rws[r]
+                        d += 1
+                        enter = True
+                        pushed = True
+                        break
+                    val = delta[r] + P.lo[j]
+                if val > v[d]:
+                    v[d] = val
+                jr[d] += 1
+            if pushed:
+                continue
+            if cnt[ENTRIES] >= cnt[CAPACITY]:
+                return FULL
+            key = key_of(T, rows[d])
+            s = _slot(P, key)
+            P.keys[s] = key
+            P.lo[s] = v[d]
+            cnt[ENTRIES] += 1
+            d -= 1
+        out[b] = P.lo[_find(P, key_of(T, starts[b]))]
+    return OK
+
+
+def best_response_values(
+    search,
+    kind: int,
+    budgets: list[int | None],
+    *,
+    schedule: list[dict] | None = None,
+    memory: int | None = None,
+    time_limit: float | None = None,
+) -> dict | None:
+    """The certified worst case of a fixed robot policy per budget, without its policy game.
+
+    The exact best response of the human side (module docstring), as :func:`certify` and
+    the policy games of :class:`asp.concurrent.search.Search` give it, but only values are
+    kept: each position the policy reaches is memoised with its value (its key and one
+    integer; the policy game's nodes, edges and solution are never stored), so a policy
+    whose game is over the memory allowed is still certified. Exactness: the value of a
+    position is the max over the human side's replies to the policy's commitment of the
+    reply's cost plus the value after it, which is what :func:`asp.game.solve.solve` computes
+    on the policy game at its robot node; positions are the same canonical keys.
+
+    Parameters
+    ----------
+    search : asp.concurrent.search.Search
+        Its rules, its table (the hybrid policy's moves) and its CP-SAT lists.
+    kind : int
+        :data:`~asp.concurrent.search.GREEDY`, :data:`~asp.concurrent.search.SCHEDULE` or
+        :data:`~asp.concurrent.search.HYBRID` (policies that choose by the state alone).
+    budgets : list of int or None
+        The budgets to certify (``None``: ``k = inf``), all in one memo.
+    schedule : list of dict, optional
+        The CP-SAT rows for ``SCHEDULE`` (default: the search's).
+    memory : int, optional
+        Bytes of the memo at most (default: half the search's memory limit).
+    time_limit : float, optional
+        Seconds at most.
+
+    Returns
+    -------
+    dict or None
+        Budget -> the policy's worst-case makespan (spec units); None when the memory or
+        the time ran out first.
+    """
+    from asp.concurrent.search import LOAD, new_table, schedule_lists
+
+    t0 = time.perf_counter()
+    rules = search.rules
+    kw = rules.key_words
+    starts = np.array([rules.start(b).row() for b in budgets], dtype=np.int64)
+    prefs, n_prefs = (
+        (search.prefs, search.n_prefs) if not schedule else schedule_lists(rules, schedule)
+    )
+    memory = search.limits.memory // 2 if memory is None else int(memory)
+    most = int(memory // ((8 * kw + 8) / LOAD))  # only the keys and values are resident
+    cnt = np.zeros(4, dtype=np.int64)
+    if time_limit is not None:
+        cnt[DEADLINE_MS] = int((t0 + time_limit) * 1000)
+    st = search.stats.copy()
+    st[0:3] = 0  # NODES, NODE_LIMIT, ABORT of the search: the policies never search
+    out = np.zeros(len(budgets), dtype=np.int64)
+    size = min(most, FIRST_POSITIONS)
+    if size < 16:
+        return None
+    memo = new_table(size, kw)
+    while True:
+        cnt[CAPACITY] = min(size, int(memo.keys.shape[0] * LOAD))
+        status = _values(
+            rules.tables, search.table, memo, starts, kind, prefs, n_prefs, st, cnt, out
+        )
+        if status == OK:
+            break
+        if status == STOPPED or size >= most:
+            return None
+        size = min(most, 4 * size)
+        bigger = new_table(size, kw)
+        _rehash(memo, bigger)
+        memo = bigger
+    return {(None if b is None else b): float(out[i]) / rules.scale for i, b in enumerate(budgets)}
+
+
+# --------------------------------------------------------------------------- the curve's U
+
+
+def certified_curve(
+    search,
+    exact: dict,
+    budgets: list[int],
+    *,
+    finished: bool,
+    flat: bool,
+    floor: int,
+    schedule: list[dict] | None,
+    t0: float,
+    say,
+):
+    """The :class:`~asp.concurrent.search.Curve` of a search that has found the values
+    ``exact`` (budget, None for ``k = inf`` -> scaled ``W*``) for the plan's ``budgets``
+    (``0..K``).
+
+    ``U(k)`` is the least certified worst case, at ``k`` or at a larger budget (``W*`` never
+    falls), of the policies certified here: the robust policy when every value is known
+    (its policy game, which the plan file needs anyway), else the hybrid and greedy policies,
+    and the CP-SAT schedule run as a plan, each by :func:`best_response_values` (values only:
+    a policy whose game is over the memory allowed is still certified). ``L(k)`` is the exact
+    value, else the best bound the search proved (never below ``floor``, the CP-SAT bound,
+    nor below ``L(k - 1)``). Only the policy handed to the cell, the one certified at
+    ``U(K)``, gets its policy game: with every budget's start, else with ``0..K`` only (its
+    bound at ``inf`` is then its certified value); if neither fits, the next policy in order
+    of certified worst case whose game fits.
+
+    Raises
+    ------
+    asp.errors.GameError
+        No policy could be certified, or none of those certified has a policy game that fits
+        the memory allowed (the message names ``--max-memory``).
+    """
+    from asp.concurrent.search import GREEDY, HYBRID, ROBUST, SCHEDULE, Curve
+    from asp.errors import GameError
+    from asp.game.solve import solve
+
+    rules = search.rules
+    scale = rules.scale
+    K = budgets[-1]
+    ks: list = [*budgets, None]
+    everything = [None, *budgets]
+    kinds = {"hybrid": HYBRID, "greedy": GREEDY, "schedule": SCHEDULE}
+    certified: dict[str, dict] = {}  # name -> budget -> certified worst case (spec units)
+    games: dict[str, tuple] = {}  # name -> (policy game, its solution)
+    if finished:
+        game = search.policy_game(budgets, ROBUST)
+        if game is not None:
+            sol = solve(game.dag)
+            games["robust"] = (game, sol)
+            certified["robust"] = _start_values(game, sol)
+    schedule_worst: list = []
+    names = ["schedule"] if "robust" in certified else ["hybrid", "greedy", "schedule"]
+    for name in names:
+        if name == "schedule" and not schedule:
+            continue
+        values = best_response_values(search, kinds[name], everything, schedule=schedule)
+        if values is None:
+            say(f"the {name} policy: its best response is over the memory allowed")
+            continue
+        say(f"the {name} policy certified at {_fmt_values(values, budgets)}")
+        if name == "schedule":
+            schedule_worst = [{"k": b, "bound": values[b]} for b in ks]
+        if "robust" not in certified:
+            certified[name] = values
+    if not certified:
+        raise GameError(
+            f"--max-memory: {search.limits.memory:,} bytes certify no policy of this game "
+            "(each best response was over the limit); allow more memory"
+        )
+    # U(k): the least certified worst case at k or at a larger budget (W* never falls);
+    # L(k): exact, else the best proven bound, never below L(k - 1).
+    upper, lows = [], []
+    for i, b in enumerate(ks):
+        later = ks[i:]
+        u = min(
+            (vals[c] for vals in certified.values() for c in later if c in vals), default=np.inf
+        )
+        if b in exact:
+            u = min(u, exact[b] / scale)
+        upper.append(u)
+        lo = exact[b] if b in exact else max(search.proven(b)[0], floor)
+        lows.append(lo / scale)
+    lower_k = list(np.maximum.accumulate(lows))
+    upper_k = list(np.minimum.accumulate(upper[::-1])[::-1])
+    # The policy handed over: least certified worst case at K (the robust one on ties).
+    order = sorted(certified, key=lambda n: (certified[n][K], n != "robust"))
+    name = None
+    for name in order:
+        if name in games:
+            break
+        kind = kinds[name]
+        sched = schedule if name == "schedule" else None
+        game = search.policy_game(everything, kind, sched) or search.policy_game(
+            budgets, kind, sched
+        )
+        if game is not None:
+            games[name] = (game, solve(game.dag))
+            break
+        say(f"the {name} policy's game is over the memory allowed")
+    if name not in games:
+        raise GameError(
+            f"--max-memory: {search.limits.memory:,} bytes hold the policy game of no "
+            f"certified policy ({', '.join(order)}); allow more memory"
+        )
+    game, solution = games[name]
+    values = certified[name]
+    bounds = [values.get(b, upper_k[i]) for i, b in enumerate(ks)]
+    if search.stopped:
+        worst = max(range(len(ks)), key=lambda i: upper_k[i] - lower_k[i])
+        gap = 100 * (upper_k[worst] - lower_k[worst]) / upper_k[worst] if upper_k[worst] else 0
+        say(
+            f"{search.stopped} reached: W*({K}) in [{lower_k[K]:g}, {upper_k[K]:g}], "
+            f"the largest gap {gap:.1f} %"
+        )
+    return Curve(
+        lower=tuple(float(x) for x in lower_k),
+        upper=tuple(float(x) for x in upper_k),
+        bounds=tuple(float(x) for x in bounds),
+        flat=bool(flat),
+        game=game,
+        solution=solution,
+        policy=name,
+        schedule_worst=schedule_worst,
+        stopped=search.stopped,
+        nodes=search.nodes,
+        positions=search.positions,
+        seconds=time.perf_counter() - t0,
+    )
+
+
+def _start_values(game: ConcurrentGame, solution) -> dict:
+    """Budget (None: ``k = inf``) -> the solved value at that budget's start."""
+    return {
+        (None if b == UNBOUNDED else b): float(solution.value[v, 0]) for b, v in game.starts.items()
+    }
+
+
+def _fmt_values(values: dict, budgets: list[int]) -> str:
+    finite = " ".join(f"{values[b]:g}" for b in budgets)
+    return f"k = 0..{budgets[-1]}: {finite}, k = inf: {values[None]:g}"

@@ -1172,7 +1172,6 @@ def solve_curve(
     asp.errors.GameError
         The memory allowed holds no search table, or no policy could be certified in it.
     """
-    from asp.game.solve import solve
 
     t0 = time.perf_counter()
     search = Search(rules, limits, progress=progress, schedule=schedule)
@@ -1208,78 +1207,18 @@ def solve_curve(
     flat = None in exact and exact.get(k) == exact[None]
     K = k if finished else min(max_k, max(min_k, k))  # stopped: the budgets reached so far
     budgets = list(range(K + 1))
-    ks: list = [*budgets, None]
-    # The certified policies: the exact one when every value is known, else the others.
-    candidates = []
-    if finished:
-        game = search.policy_game(budgets, ROBUST)
-        if game is not None:
-            candidates.append(("robust", game))
-    if not candidates:
-        for name, kind in (("hybrid", HYBRID), ("greedy", GREEDY)):
-            game = search.policy_game([None, *budgets], kind)
-            if game is not None:
-                candidates.append((name, game))
-    sched_game = None
-    if schedule:
-        sched_game = search.policy_game([None, *budgets], SCHEDULE, schedule)
-        if sched_game is not None and candidates and candidates[0][0] != "robust":
-            candidates.append(("schedule", sched_game))
-    if not candidates:
-        from asp.errors import GameError
+    from asp.concurrent.certify import certified_curve
 
-        raise GameError(
-            f"--max-memory: {search.limits.memory:,} bytes certify no policy of this game "
-            "(each policy game was over the limit); allow more memory"
-        )
-    solved = []
-    for name, game in candidates:
-        sol = solve(game.dag)
-        values = {
-            (None if b == UNBOUNDED else b): float(sol.value[v, 0]) for b, v in game.starts.items()
-        }
-        solved.append((name, game, sol, values))
-    # U(k): the least certified worst case at k or at a larger budget (W* never falls);
-    # L(k): exact, else the best proven bound, never below L(k - 1).
-    upper, lows = [], []
-    for i, b in enumerate(ks):
-        later = ks[i:]
-        u = min((vals[c] for *_, vals in solved for c in later if c in vals), default=np.inf)
-        if b in exact:
-            u = min(u, exact[b] / scale)
-        upper.append(u)
-        lo = exact[b] if b in exact else max(search.proven(b)[0], floor)
-        lows.append(lo / scale)
-    lower_k = list(np.maximum.accumulate(lows))
-    upper_k = list(np.minimum.accumulate(upper[::-1])[::-1])
-    name, game, solution, values = min(solved, key=lambda x: (x[3][K], x[0] != "robust"))
-    bounds = [values.get(b, upper_k[i]) for i, b in enumerate(ks)]
-    schedule_worst = []
-    if sched_game is not None:
-        sol = solve(sched_game.dag)
-        schedule_worst = [
-            {"k": None if b == UNBOUNDED else b, "bound": float(sol.value[v, 0])}
-            for b, v in sorted(sched_game.starts.items(), key=lambda x: (x[0] == UNBOUNDED, x[0]))
-        ]
-    if progress and search.stopped:
-        worst = max(range(len(ks)), key=lambda i: upper_k[i] - lower_k[i])
-        say(
-            f"{search.stopped} reached: W*({K}) in [{lower_k[K]:g}, {upper_k[K]:g}], "
-            f"the largest gap {100 * (upper_k[worst] - lower_k[worst]) / upper_k[worst]:.1f} %"
-        )
-    return Curve(
-        lower=tuple(float(x) for x in lower_k),
-        upper=tuple(float(x) for x in upper_k),
-        bounds=tuple(float(x) for x in bounds),
-        flat=bool(flat),
-        game=game,
-        solution=solution,
-        policy=name,
-        schedule_worst=schedule_worst,
-        stopped=search.stopped,
-        nodes=search.nodes,
-        positions=search.positions,
-        seconds=time.perf_counter() - t0,
+    return certified_curve(
+        search,
+        exact,
+        budgets,
+        finished=finished,
+        flat=flat,
+        floor=floor,
+        schedule=schedule,
+        t0=t0,
+        say=say,
     )
 
 

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from unittest.mock import patch
+
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -112,3 +114,35 @@ def test_bad_choice_and_limits_are_errors():
     cert = certify(rules, lambda pos, commits: 0, [0, None])
     assert [row["k"] for row in cert.to_list()] == [0, None]
     assert cert.nodes == cert.game.dag.n_nodes
+
+
+@SETTINGS
+@given(random_jobs(humans=(1, 2), ranges=True), st.sampled_from(["greedy", "schedule", "hybrid"]))
+def test_value_only_best_response_is_the_compiled_one(data, policy):
+    """The best response that keeps values only gives every budget's value of the policy
+    game solved in full, for each fixed policy (the hybrid one after a search stopped
+    early, so its table has moves at some positions only)."""
+    from asp.concurrent.certify import best_response_values
+    from asp.concurrent.search import HYBRID, SCHEDULE, Limits
+    from asp.game.solve import solve
+    from asp.schedule.assembly_makespan import assembly_makespan
+
+    ops, agents = data
+    spec, graph = job(ops, agents=agents)
+    rules = concurrent_rules(spec, graph)
+    kind = {"greedy": GREEDY, "schedule": SCHEDULE, "hybrid": HYBRID}[policy]
+    rows = None
+    if kind == SCHEDULE:
+        rows = assembly_makespan(spec, graph, time_limit=5)[1].detail["schedule"]
+    search = Search(rules, Limits(max_nodes=5), schedule=rows)
+    search.value(0)
+    budgets = [None, 0, 1, 2]
+    game = search.policy_game(budgets, kind, rows)
+    sol = solve(game.dag)
+    want = {None if b < 0 else b: float(sol.value[s, 0]) for b, s in game.starts.items()}
+    got = best_response_values(search, kind, budgets, schedule=rows)
+    assert got == want
+    # a memo that grows many times gives the same values; one too small gives none
+    with patch("asp.concurrent.certify.FIRST_POSITIONS", 16):
+        assert best_response_values(search, kind, budgets, schedule=rows) == want
+    assert best_response_values(search, kind, budgets, schedule=rows, memory=400) in (None, want)
