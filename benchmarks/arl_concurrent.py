@@ -4,7 +4,7 @@ Issue 23 item 3: on a product, alternating PPO played from the game's rules
 (:func:`arl.concurrent_trainer.train_concurrent`, config ``concurrent``) gives a robot
 policy; its certified worst case (the exact best response of the human side,
 :func:`asp.concurrent.certify.certify`) per budget ``k`` is printed beside the exact value
-``W*(k)`` (:func:`asp.concurrent.search.solve_curve`, where it fits), the greedy adaptive
+``W*(k)`` (:func:`asp.concurrent.curve.solve_curve`, where it fits), the greedy adaptive
 policy's and the CP-SAT schedule run as a plan (both certified the same way), with the
 training cost (environment steps, seconds). Lower is better; every figure is exact.
 
@@ -58,8 +58,9 @@ def row(name: str, values: dict) -> str:
 def main() -> None:
     from arl.concurrent_trainer import train_concurrent
     from asmplan import pipeline
+    from asp.concurrent.curve import solve_curve
     from asp.concurrent.rules import concurrent_rules
-    from asp.concurrent.search import GREEDY, SCHEDULE, Limits, Search, solve_curve
+    from asp.concurrent.search import GREEDY, SCHEDULE, Limits, Search
     from asp.schedule.assembly_makespan import assembly_makespan
 
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])

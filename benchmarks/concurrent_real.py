@@ -8,7 +8,7 @@ steps ``asmplan plan --turn-model concurrent`` takes: the state graph (alike par
 fixed order, which the rules undo exactly, :mod:`asp.concurrent.rules`; ``--loose``: the
 graph reduced in a loose order, larger), the CP-SAT schedule (its bound is ``L`` at
 ``k = 0``, its rows the search's first guesses and a certified policy), then
-:func:`asp.concurrent.search.solve_curve` with its default limits (``--time-limit`` here:
+:func:`asp.concurrent.curve.solve_curve` with its default limits (``--time-limit`` here:
 seconds for the search, default none).
 
 Each file runs in a child process; one row per file: operations, states, the graph's and
@@ -36,8 +36,9 @@ FILES = ("asm_shear_mold.step", "as1-oc-214.stp", "rod.3DXML", "cycloidal.3DXML"
 def one(path: Path, time_limit: float | None, loose: bool = False, memory: float = 0) -> dict:
     """The figures of one file (in this process)."""
     from asmplan import pipeline
+    from asp.concurrent.curve import solve_curve
     from asp.concurrent.rules import concurrent_rules
-    from asp.concurrent.search import Limits, solve_curve
+    from asp.concurrent.search import Limits
 
     warnings.simplefilter("ignore")
     t0 = time.perf_counter()

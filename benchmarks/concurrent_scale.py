@@ -5,7 +5,7 @@ before it in its chain, the last operation of every chain before a final check),
 ``H`` and ``R1..Rr``; every third operation is the person's (a duration range of
 ``spread`` seconds on the grid of 1 s), the others a robot's or either side's; ``R1``
 screws with a bit the person changes twice (tool changes). Prints the on-the-fly search's
-curve W*(0..k) and W*(inf) (:func:`asp.concurrent.search.solve_curve`, the CP-SAT schedule
+curve W*(0..k) and W*(inf) (:func:`asp.concurrent.curve.solve_curve`, the CP-SAT schedule
 as its first guesses and its bound as ``L``), its positions, seconds and the peak memory;
 with ``--enumerate`` also the full enumeration's (:func:`asp.concurrent.robustness`, the
 oracle: game nodes and edges, the same values).
@@ -20,10 +20,10 @@ import argparse
 import resource
 import time
 
+from asp.concurrent.curve import solve_curve
 from asp.concurrent.model import concurrent_model
 from asp.concurrent.robustness import robustness
 from asp.concurrent.rules import concurrent_rules
-from asp.concurrent.search import solve_curve
 from asp.graph.state_graph import build_state_graph
 from asp.schedule.assembly_makespan import assembly_makespan
 from asp.spec import Agent, AssemblySpec, Operation, Tool

@@ -58,7 +58,8 @@ __all__, __getattr__ = lazy_exports(
             "timeline_text",
         ),
         "robustness": ("DEFAULT_MAX_K", "certified_worst_case", "policy_array", "schedule_rule"),
-        "search": ("Curve", "Limits", "solve_curve"),
+        "curve": ("Curve", "solve_curve"),
+        "search": ("Limits",),
         "rules": (
             "NONE",
             "Position",

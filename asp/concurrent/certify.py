@@ -48,12 +48,12 @@ from asp.concurrent.rules import (
 )
 from asp.concurrent.search import (  # the search's compiled policies and table
     ABORT,
-    _choose,
-    _find,
-    _rehash,
-    _slot,
     as_policy_game,
     node_row,
+    policy_choice,
+    table_find,
+    table_rehash,
+    table_slot,
 )
 
 Choose = Callable[[Position, list[Commit]], int]
@@ -217,7 +217,7 @@ def _values(T, H, P, starts, kind, prefs, n_prefs, st, cnt, out):  # pragma: no 
     """The exact best response of the human side to the fixed policy ``kind`` from each row
     of ``starts`` (scaled makespans into ``out``), values only (:func:`best_response_values`).
 
-    Depth-first over positions with an explicit stack (as :func:`asp.concurrent.search._search`:
+    Depth-first over positions with an explicit stack (as :mod:`asp.concurrent.search`'s search:
     numba caches no recursive function); a position's value, the max over the replies to
     the policy's one commitment of the reply's cost plus the value after it, is memoised in
     ``P`` (``P.lo``) once all its replies are valued, and nothing else is kept. The game is
@@ -239,7 +239,7 @@ def _values(T, H, P, starts, kind, prefs, n_prefs, st, cnt, out):  # pragma: no 
         if starts[b, 0] < 0:
             out[b] = 0
             continue
-        j = _find(P, key_of(T, starts[b]))
+        j = table_find(P, key_of(T, starts[b]))
         if j >= 0:
             out[b] = P.lo[j]
             continue
@@ -250,7 +250,7 @@ def _values(T, H, P, starts, kind, prefs, n_prefs, st, cnt, out):  # pragma: no 
             if enter:  # the policy's commitment and every reply to it
                 enter = False
                 commits = commit_rows(T, rows[d])
-                i = _choose(T, H, rows[d], commits, kind, prefs, n_prefs, st)
+                i = policy_choice(T, H, rows[d], commits, kind, prefs, n_prefs, st)
                 if i < 0 or st[ABORT]:
                     return STOPPED
                 _, _, _, delta, rws = reply_rows(T, rows[d], commits[i])
@@ -272,7 +272,7 @@ def _values(T, H, P, starts, kind, prefs, n_prefs, st, cnt, out):  # pragma: no 
                 if rws[r, 0] < 0:  # the end
                     val = delta[r]
                 else:
-                    j = _find(P, key_of(T, rws[r]))
+                    j = table_find(P, key_of(T, rws[r]))
                     if j < 0:  # not valued yet: below it first, this reply again after
                         rows[d + 1] = rws[r]
                         d += 1
@@ -288,12 +288,12 @@ def _values(T, H, P, starts, kind, prefs, n_prefs, st, cnt, out):  # pragma: no 
             if cnt[ENTRIES] >= cnt[CAPACITY]:
                 return FULL
             key = key_of(T, rows[d])
-            s = _slot(P, key)
+            s = table_slot(P, key)
             P.keys[s] = key
             P.lo[s] = v[d]
             cnt[ENTRIES] += 1
             d -= 1
-        out[b] = P.lo[_find(P, key_of(T, starts[b]))]
+        out[b] = P.lo[table_find(P, key_of(T, starts[b]))]
     return OK
 
 
@@ -371,152 +371,6 @@ def best_response_values(
             return None
         size = min(most, 4 * size)
         bigger = new_table(size, kw)
-        _rehash(memo, bigger)
+        table_rehash(memo, bigger)
         memo = bigger
     return {(None if b is None else b): float(out[i]) / rules.scale for i, b in enumerate(budgets)}
-
-
-# --------------------------------------------------------------------------- the curve's U
-
-
-def certified_curve(
-    search,
-    exact: dict,
-    budgets: list[int],
-    *,
-    finished: bool,
-    flat: bool,
-    floor: int,
-    schedule: list[dict] | None,
-    t0: float,
-    say,
-):
-    """The :class:`~asp.concurrent.search.Curve` of a search that has found the values
-    ``exact`` (budget, None for ``k = inf`` -> scaled ``W*``) for the plan's ``budgets``
-    (``0..K``).
-
-    ``U(k)`` is the least certified worst case, at ``k`` or at a larger budget (``W*`` never
-    falls), of the policies certified here: the robust policy when every value is known
-    (its policy game, which the plan file needs anyway), else the hybrid and greedy policies,
-    and the CP-SAT schedule run as a plan, each by :func:`best_response_values` (values only:
-    a policy whose game is over the memory allowed is still certified). ``L(k)`` is the exact
-    value, else the best bound the search proved (never below ``floor``, the CP-SAT bound,
-    nor below ``L(k - 1)``). Only the policy handed to the cell, the one certified at
-    ``U(K)``, gets its policy game: with every budget's start, else with ``0..K`` only (its
-    bound at ``inf`` is then its certified value); if neither fits, the next policy in order
-    of certified worst case whose game fits.
-
-    Raises
-    ------
-    asp.errors.GameError
-        No policy could be certified, or none of those certified has a policy game that fits
-        the memory allowed (the message names ``--max-memory``).
-    """
-    from asp.concurrent.search import GREEDY, HYBRID, ROBUST, SCHEDULE, Curve
-    from asp.errors import GameError
-    from asp.game.solve import solve
-
-    rules = search.rules
-    scale = rules.scale
-    K = budgets[-1]
-    ks: list = [*budgets, None]
-    everything = [None, *budgets]
-    kinds = {"hybrid": HYBRID, "greedy": GREEDY, "schedule": SCHEDULE}
-    certified: dict[str, dict] = {}  # name -> budget -> certified worst case (spec units)
-    games: dict[str, tuple] = {}  # name -> (policy game, its solution)
-    if finished:
-        game = search.policy_game(budgets, ROBUST)
-        if game is not None:
-            sol = solve(game.dag)
-            games["robust"] = (game, sol)
-            certified["robust"] = _start_values(game, sol)
-    schedule_worst: list = []
-    names = ["schedule"] if "robust" in certified else ["hybrid", "greedy", "schedule"]
-    for name in names:
-        if name == "schedule" and not schedule:
-            continue
-        values = best_response_values(search, kinds[name], everything, schedule=schedule)
-        if values is None:
-            say(f"the {name} policy: its best response is over the memory allowed")
-            continue
-        say(f"the {name} policy certified at {_fmt_values(values, budgets)}")
-        if name == "schedule":
-            schedule_worst = [{"k": b, "bound": values[b]} for b in ks]
-        if "robust" not in certified:
-            certified[name] = values
-    if not certified:
-        raise GameError(
-            f"--max-memory: {search.limits.memory:,} bytes certify no policy of this game "
-            "(each best response was over the limit); allow more memory"
-        )
-    # U(k): the least certified worst case at k or at a larger budget (W* never falls);
-    # L(k): exact, else the best proven bound, never below L(k - 1).
-    upper, lows = [], []
-    for i, b in enumerate(ks):
-        later = ks[i:]
-        u = min(
-            (vals[c] for vals in certified.values() for c in later if c in vals), default=np.inf
-        )
-        if b in exact:
-            u = min(u, exact[b] / scale)
-        upper.append(u)
-        lo = exact[b] if b in exact else max(search.proven(b)[0], floor)
-        lows.append(lo / scale)
-    lower_k = list(np.maximum.accumulate(lows))
-    upper_k = list(np.minimum.accumulate(upper[::-1])[::-1])
-    # The policy handed over: least certified worst case at K (the robust one on ties).
-    order = sorted(certified, key=lambda n: (certified[n][K], n != "robust"))
-    name = None
-    for name in order:
-        if name in games:
-            break
-        kind = kinds[name]
-        sched = schedule if name == "schedule" else None
-        game = search.policy_game(everything, kind, sched) or search.policy_game(
-            budgets, kind, sched
-        )
-        if game is not None:
-            games[name] = (game, solve(game.dag))
-            break
-        say(f"the {name} policy's game is over the memory allowed")
-    if name not in games:
-        raise GameError(
-            f"--max-memory: {search.limits.memory:,} bytes hold the policy game of no "
-            f"certified policy ({', '.join(order)}); allow more memory"
-        )
-    game, solution = games[name]
-    values = certified[name]
-    bounds = [values.get(b, upper_k[i]) for i, b in enumerate(ks)]
-    if search.stopped:
-        worst = max(range(len(ks)), key=lambda i: upper_k[i] - lower_k[i])
-        gap = 100 * (upper_k[worst] - lower_k[worst]) / upper_k[worst] if upper_k[worst] else 0
-        say(
-            f"{search.stopped} reached: W*({K}) in [{lower_k[K]:g}, {upper_k[K]:g}], "
-            f"the largest gap {gap:.1f} %"
-        )
-    return Curve(
-        lower=tuple(float(x) for x in lower_k),
-        upper=tuple(float(x) for x in upper_k),
-        bounds=tuple(float(x) for x in bounds),
-        flat=bool(flat),
-        game=game,
-        solution=solution,
-        policy=name,
-        schedule_worst=schedule_worst,
-        stopped=search.stopped,
-        nodes=search.nodes,
-        positions=search.positions,
-        seconds=time.perf_counter() - t0,
-    )
-
-
-def _start_values(game: ConcurrentGame, solution) -> dict:
-    """Budget (None: ``k = inf``) -> the solved value at that budget's start."""
-    return {
-        (None if b == UNBOUNDED else b): float(solution.value[v, 0]) for b, v in game.starts.items()
-    }
-
-
-def _fmt_values(values: dict, budgets: list[int]) -> str:
-    finite = " ".join(f"{values[b]:g}" for b in budgets)
-    return f"k = 0..{budgets[-1]}: {finite}, k = inf: {values[None]:g}"

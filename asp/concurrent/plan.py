@@ -5,7 +5,7 @@
 - the CP-SAT makespan schedule, replayed through the state graph
   (:func:`asp.schedule.assembly_makespan.assembly_makespan`);
 - ``W*(k)`` for ``k = 0, 1, ...`` until it reaches ``W*(inf)``, by the on-the-fly search
-  (:func:`asp.concurrent.search.solve_curve`): exact where the search finishes within its
+  (:func:`asp.concurrent.curve.solve_curve`): exact where the search finishes within its
   limits, else a certified interval ``[L(k), U(k)]``, the policy given to the cell being
   the one certified at ``U``;
 - the CP-SAT schedule run as a plan that ignores the person and its certified worst case
@@ -25,11 +25,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from asp.concurrent.build import DEFAULT_MAX_NODES
+from asp.concurrent.curve import Curve, solve_curve
 from asp.concurrent.describe import Bar, timeline
 from asp.concurrent.model import concurrent_model
 from asp.concurrent.robustness import DEFAULT_MAX_K, Robustness, robustness
 from asp.concurrent.rules import concurrent_rules
-from asp.concurrent.search import Curve, Limits, solve_curve
+from asp.concurrent.search import Limits
 from asp.numbers import json_number
 from asp.schedule.assembly_makespan import assembly_makespan
 
@@ -42,7 +43,7 @@ class ConcurrentPlan:
     ----------
     spec, graph, step
         What the game was made of (:meth:`compiled` makes it again).
-    curve : asp.concurrent.search.Curve
+    curve : asp.concurrent.curve.Curve
         ``W*(k)`` exact or as certified intervals, the policy game of the plan's policy
         and its solution (each state's bound is that policy's certified worst case).
     schedule : BaselineResult
@@ -168,7 +169,7 @@ def _fmt(x) -> str:
 
 def exact_curve(compiled: Robustness) -> Curve:
     """The curve of a compiled, exactly solved game (:meth:`ConcurrentPlan.compiled`) as a
-    :class:`~asp.concurrent.search.Curve`: every value exact, the robust policy's game."""
+    :class:`~asp.concurrent.curve.Curve`: every value exact, the robust policy's game."""
     values = (*compiled.bounds, compiled.unbounded)
     return Curve(
         lower=values,

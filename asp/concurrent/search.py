@@ -87,7 +87,8 @@ The table is sized before the search from the memory allowed (only its key array
 before a slot is written, so only the slots in use are resident) (``memory``: its bytes per
 entry are known, :func:`table_entries`); it never grows. The search stops when the table is
 full, at ``max_nodes`` positions expanded, or at ``time_limit``; the policy games stop at
-their own node limit (from the same memory). Stopped, :func:`solve_curve` still answers:
+their own node limit (from the same memory). Stopped,
+:func:`asp.concurrent.curve.solve_curve` still answers:
 for each ``k`` a proven lower bound ``L(k)`` (the CP-SAT bound, the start's bound, what the
 search proved, and ``L(k - 1)``: the curve never falls) and the least certified worst case
 ``U(k)`` of the policies above (and of larger budgets: ``U(k) <= U(k + 1)``), the policy
@@ -1055,174 +1056,11 @@ def _as_game(rules, budgets, rows, start_ids, edges, t0):
     return game_of(model, levels, nodes, actions, starts, 0, edges, t0, GENERATOR)
 
 
-# --------------------------------------------------------------------------- the curve
-
-
-@dataclass(frozen=True, eq=False)
-class Curve:
-    """``W*(k)`` for ``k = 0..K`` and ``k = inf``, each exact or as a certified interval.
-
-    Attributes
-    ----------
-    lower, upper : tuple of float
-        ``L(k)`` and ``U(k)`` for ``k = 0..K`` then ``k = inf`` (spec units):
-        ``L(k) <= W*(k) <= U(k)``, equal where exact; both never fall as ``k`` grows.
-    bounds : tuple of float
-        The certified worst case of the plan's policy for the same budgets (``upper`` at
-        ``K``; ``W*(k)`` where exact). At ``inf``: the policy's own when its game has that
-        start, else ``upper``.
-    flat : bool
-        ``W*(K) = W*(inf)`` is proven (the curve stops there), else ``max_k`` or a limit
-        stopped it.
-    game : asp.concurrent.build.ConcurrentGame
-        The policy game of the plan's policy (its starts: budgets ``0..K``, and ``inf``
-        unless the policy is the exact one; the plan's ``K`` is the DAG's start), and
-        ``solution`` its exact solution: each state's bound is the policy's certified worst
-        case from it.
-    policy : str
-        ``"robust"`` (exact), ``"hybrid"``, ``"greedy"`` or ``"schedule"``: the certified
-        policy of least worst case at ``K``.
-    schedule_worst : list of {"k", "bound"}
-        The CP-SAT schedule's certified worst case per ``k`` (``None`` for ``inf``), empty
-        without a schedule or when its policy game was over the limits.
-    stopped : str or None
-        The limit that stopped the search (``"time limit"``, ...), None when exact.
-    nodes, positions : int
-        Positions the search expanded, and the table's entries.
-    seconds : float
-    """
-
-    lower: tuple[float, ...]
-    upper: tuple[float, ...]
-    bounds: tuple[float, ...]
-    flat: bool
-    game: ConcurrentGame
-    solution: object
-    policy: str
-    schedule_worst: list
-    stopped: str | None
-    nodes: int
-    positions: int
-    seconds: float
-
-    @property
-    def k(self) -> int:
-        """The plan's budget ``K``."""
-        return len(self.lower) - 2
-
-    @property
-    def exact(self) -> tuple[bool, ...]:
-        return tuple(lo == hi for lo, hi in zip(self.lower, self.upper, strict=True))
-
-    def gap(self, i: int) -> float:
-        """The gap of entry ``i`` in per cent of the upper bound."""
-        lo, hi = self.lower[i], self.upper[i]
-        return 0.0 if hi <= lo or hi <= 0 else 100.0 * (hi - lo) / hi
-
-    def to_list(self) -> list[dict]:
-        """``[{"k", "bound", "lower", "upper", "exact"}, ..., {"k": None, ...}]``: ``bound``
-        is the certified worst case of the plan's policy (``W*(k)`` where exact)."""
-        from asp.numbers import json_number
-
-        out = []
-        n = len(self.lower)
-        for i in range(n):
-            out.append(
-                {
-                    "k": None if i == n - 1 else i,
-                    "bound": json_number(self.bounds[i], 6),
-                    "lower": json_number(self.lower[i], 6),
-                    "upper": json_number(self.upper[i], 6),
-                    "exact": self.lower[i] == self.upper[i],
-                }
-            )
-        return out
-
-
-def solve_curve(
-    rules: Rules,
-    *,
-    max_k: int = 12,
-    min_k: int = 2,
-    limits: Limits | None = None,
-    schedule: list[dict] | None = None,
-    lower: float | None = None,
-    progress: bool = False,
-) -> Curve:
-    """``W*(k)`` for ``k = 0, 1, ...`` until it reaches ``W*(inf)`` (module docstring).
-
-    Parameters
-    ----------
-    max_k : int
-        The largest finite budget of the curve.
-    min_k : int
-        The curve goes at least this far (while ``<= max_k``), flat or not.
-    limits : Limits, optional
-        Memory, positions and seconds for the search (default :class:`Limits`).
-    schedule : list of dict, optional
-        A CP-SAT schedule (``{"task", "agent", "start"}`` rows), run as a plan: certified for
-        every ``k``, and one more policy for ``U`` when the search stops.
-    lower : float, optional
-        A proven lower bound of ``W*(0)`` (the CP-SAT bound), spec units.
-    progress : bool
-        A line on stderr per value found and every second of search.
-
-    Raises
-    ------
-    asp.errors.GameError
-        The memory allowed holds no search table, or no policy could be certified in it.
-    """
-
-    t0 = time.perf_counter()
-    search = Search(rules, limits, progress=progress, schedule=schedule)
-    scale = rules.scale
-    floor = int(np.ceil((lower or 0) * scale - 1e-9))
-    floor = max(floor, int(lower_bound_of(rules.tables, rules.start(0).row())))
-
-    def say(text: str) -> None:
-        if progress:
-            print(f"  {text} ({time.perf_counter() - t0:.1f} s)", file=sys.stderr, flush=True)
-
-    exact: dict = {}  # budget (None: inf) -> W* (scaled)
-    v0 = search.value(0, floor)
-    if v0 is not None:
-        exact[0] = v0
-        say(f"W*(0) = {v0 / scale:g}")
-        top = search.value(None, v0)
-        if top is not None:
-            exact[None] = top
-            say(f"W*(inf) = {top / scale:g}")
-    k = 0
-    while None in exact and k < max_k and not (exact[k] == exact[None] and k >= min_k):
-        if exact[k] == exact[None]:
-            v = exact[None]  # flat from k on (the curve never falls, never passes W*(inf))
-        else:
-            v = search.value(k + 1, exact[k], exact[None] + 1)
-            if v is None:
-                break
-            say(f"W*({k + 1}) = {v / scale:g}")
-        exact[k + 1] = v
-        k += 1
-    finished = None in exact and (k == max_k or exact[k] == exact[None])
-    flat = None in exact and exact.get(k) == exact[None]
-    K = k if finished else min(max_k, max(min_k, k))  # stopped: the budgets reached so far
-    budgets = list(range(K + 1))
-    from asp.concurrent.certify import certified_curve
-
-    return certified_curve(
-        search,
-        exact,
-        budgets,
-        finished=finished,
-        flat=flat,
-        floor=floor,
-        schedule=schedule,
-        t0=t0,
-        say=say,
-    )
-
-
 # Public names for the certificate of any robot policy (asp.concurrent.certify).
 node_row = _node_row
 as_policy_game = _as_game
 commit_bound = _estimate
+policy_choice = _choose
+table_find = _find
+table_slot = _slot
+table_rehash = _rehash

@@ -6,6 +6,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from asp.concurrent.curve import solve_curve
 from asp.concurrent.model import UNBOUNDED
 from asp.concurrent.rules import concurrent_rules
 from asp.concurrent.search import (
@@ -14,7 +15,6 @@ from asp.concurrent.search import (
     SCHEDULE,
     Limits,
     Search,
-    solve_curve,
 )
 from asp.errors import SpecError
 from asp.game.solve import solve
