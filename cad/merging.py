@@ -1,15 +1,30 @@
-"""Parts of one sub-assembly of the file that overlap each other: one rigid part.
+"""Parts of one sub-assembly of the file that overlap or lock each other: one rigid part.
 
 Scene files of purchased parts and visualisation assets model a component in pieces that
 overlap for real (Khronos' ``2CylinderEngine.glb``: each valve spring is ten coil links;
-an XBee module's pins inside its chip). Those pieces are never assembled one by one.
+an XBee module's pins inside its chip) or that lock each other (a patch cable's plug
+moulded round its boot: each blocks the other along every direction). Those pieces are
+never assembled one by one.
 
-Rule (:func:`merge_overlapping`): two parts that overlap deeper than their tolerance
-(:func:`cad.freedom.overlaps`, the check the relations make) and lie in one group of the
-file's hierarchy (:attr:`cad.assembly.Assembly.groups`) are one rigid part; parts joined
-so, transitively, make one part. Its id is the innermost group's when the part is that
-whole group, else its first member's; its mesh is the members' meshes together, its
-source ``file#a+b+c`` (how a spec names such a part: :mod:`cad.loading`).
+Rule (:func:`merge_overlapping`): two parts that lie in one group of the file's hierarchy
+(:attr:`cad.assembly.Assembly.groups`) and either overlap deeper than their tolerance
+(:func:`cad.freedom.overlaps`, the check the relations make) or, clear of each other,
+*lock* each other (each blocked by the other along all six directions,
+:func:`cad.freedom.translational_freedom` of the pair alone) are one rigid part; parts
+joined so, transitively, make one part, and the joined parts are checked again (a part
+joined of pieces may lock the next piece).
+
+Why locking pieces are one part: blocking is a relation of the pair alone (a third part
+never frees a direction), so of two parts locking each other whichever is placed second
+has no way in, whatever the order and whatever else is there: as rigid bodies the file
+cannot be assembled at all. A sub-assembly of the file that holds such a pair is therefore
+a component that came assembled (or is assembled by flexing, which the file's geometry
+cannot show). Planning it as one rigid part changes only files that had no plan (a file
+without such a pair is as before), and removes no way the rest can be assembled.
+
+Its id is the innermost group's when the part is that whole group, else its first
+member's; its mesh is the members' meshes together, its source ``file#a+b+c`` (how a spec
+names such a part: :mod:`cad.loading`).
 One warning names every part made so. Overlapping parts of no common group stay parts
 (the relations then report them, with the spec line that joins them).
 """
@@ -19,23 +34,64 @@ from __future__ import annotations
 import warnings
 from dataclasses import replace
 
+import numpy as np
 import trimesh
 
 from cad.assembly import Assembly, Part
+from cad.faces import bounds_overlap
+from cad.freedom import eroded_meshes, overlaps
+from cad.tolerances import Tolerances, resolve_tolerances
 
 
 def merge_overlapping(assembly: Assembly, file_name: str) -> Assembly:
     """``assembly`` with the overlapping parts of each file group joined (module rule)."""
     if not assembly.groups or len(assembly.parts) < 2:
         return assembly
-    from cad.freedom import overlaps
-    from cad.tolerances import resolve_tolerances
-
-    ids = [p.id for p in assembly.parts]
-    grouped = _group_pairs(ids, assembly.groups)
+    grouped = _group_pairs([p.id for p in assembly.parts], assembly.groups)
     if not grouped:
         return assembly
-    root = list(range(len(ids)))
+    tols = resolve_tolerances(assembly)
+    eroded = eroded_meshes(assembly, tols.shrink)
+    overlapping = {(o.a, o.b) for o in overlaps(assembly, tols, eroded)}
+    why, joined = "overlap", _classes(len(assembly.parts), overlapping & grouped)
+    for _ in range(len(assembly.parts)):  # each round joins parts: it ends
+        if joined:
+            assembly = _joined(assembly, joined, file_name, why)
+            tols = resolve_tolerances(assembly)
+            eroded = eroded_meshes(assembly, tols.shrink)
+            overlapping = {(o.a, o.b) for o in overlaps(assembly, tols, eroded)}
+        grouped = _group_pairs([p.id for p in assembly.parts], assembly.groups)
+        locked = _locked(assembly, tols, eroded, sorted(grouped - overlapping))
+        if not locked:
+            break
+        why, joined = "lock", _classes(len(assembly.parts), locked)
+    return assembly
+
+
+def _locked(assembly: Assembly, tols, eroded, pairs) -> list[tuple[int, int]]:
+    """Of ``pairs`` (part indices), those whose parts block each other along all six
+    directions (module rule): the pair's translational freedom, computed for the two parts
+    alone (their boxes must meet, else neither can block the other both ways)."""
+    from cad.freedom import translational_freedom
+
+    found = []
+    for a, b in pairs:
+        if not bounds_overlap(eroded[a].bounds, eroded[b].bounds):
+            continue
+        pair = Assembly(parts=(assembly.parts[a], assembly.parts[b]), units=assembly.units)
+        reach = None if tols.reach is None else np.asarray(tols.reach)[[a, b]]
+        pair_tols = Tolerances(tols.contact, np.asarray(tols.shrink)[[a, b]], tols.explicit, reach)
+        tt = translational_freedom(
+            pair, penetration_tol=pair_tols, check=False, eroded=[eroded[a], eroded[b]]
+        )
+        if not tt[0, 1].any() and not tt[1, 0].any():
+            found.append((a, b))
+    return found
+
+
+def _classes(n: int, pairs) -> list[list[int]]:
+    """The classes of two or more of ``n`` indices joined, transitively, by ``pairs``."""
+    root = list(range(n))
 
     def find(k: int) -> int:
         while root[k] != k:
@@ -43,16 +99,12 @@ def merge_overlapping(assembly: Assembly, file_name: str) -> Assembly:
             k = root[k]
         return k
 
-    for found in overlaps(assembly, resolve_tolerances(assembly)):
-        if (found.a, found.b) in grouped:
-            root[find(found.b)] = find(found.a)
+    for a, b in pairs:
+        root[find(b)] = find(a)
     members: dict[int, list[int]] = {}
-    for k in range(len(ids)):
+    for k in range(n):
         members.setdefault(find(k), []).append(k)
-    joined = [m for m in members.values() if len(m) > 1]
-    if not joined:
-        return assembly
-    return _joined(assembly, joined, file_name)
+    return [m for m in members.values() if len(m) > 1]
 
 
 def _group_pairs(ids: list[str], groups) -> set[tuple[int, int]]:
@@ -65,8 +117,9 @@ def _group_pairs(ids: list[str], groups) -> set[tuple[int, int]]:
     return pairs
 
 
-def _joined(assembly: Assembly, joined: list[list[int]], file_name: str) -> Assembly:
-    """The assembly with each list of part indices in ``joined`` made one part."""
+def _joined(assembly: Assembly, joined: list[list[int]], file_name: str, why: str) -> Assembly:
+    """The assembly with each list of part indices in ``joined`` made one part (``why``:
+    ``"overlap"`` or ``"lock"``, for the warning)."""
     parts = list(assembly.parts)
     new_id: dict[str, str] = {}
     made: dict[int, Part] = {}
@@ -92,10 +145,15 @@ def _joined(assembly: Assembly, joined: list[list[int]], file_name: str) -> Asse
         if len(renamed) >= 2:
             groups.append((gid, renamed))
     shown = ", ".join(said[:10]) + (f" and {len(said) - 10} more" if len(said) > 10 else "")
+    how = (
+        "overlap each other"
+        if why == "overlap"
+        else "lock each other (each blocks the other along every direction)"
+    )
     warnings.warn(
-        f"{file_name}: parts of one sub-assembly of the file overlap each other, each set "
-        f"taken as one rigid part (a component modelled in pieces; cad/merging.py): {shown}",
-        stacklevel=3,
+        f"{file_name}: parts of one sub-assembly of the file {how}, each set taken as one "
+        f"rigid part (a component modelled in pieces; cad/merging.py): {shown}",
+        stacklevel=4,
     )
     return replace(assembly, parts=kept, groups=tuple(groups))
 

@@ -227,3 +227,27 @@ def test_the_bodies_of_one_part_fall_into_distinct_shape_classes(tmp_path):
     classes = shape_classes(assembly.parts)
     assert len(classes) == 5 and len(set(classes)) == 2
     assert classes[0] == classes[1] == classes[2] != classes[3] == classes[4]
+
+
+def linked_rings(centre=(0.0, 0.0, 0.0)) -> dict:
+    """Two chain links (tori of 10 mm radius, 2 mm tube) through each other, clear of each
+    other by 6 mm: as rigid bodies each blocks the other along every direction."""
+    c = np.asarray(centre, float)
+    a = trimesh.creation.torus(major_radius=10, minor_radius=2, major_sections=48)
+    b = a.copy().apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, (1, 0, 0)))
+    return {"link_a": a.apply_translation(c), "link_b": b.apply_translation(c + (10, 0, 0))}
+
+
+def test_locking_parts_of_one_sub_assembly_are_one_rigid_part(tmp_path):
+    """Linked links of one group (a patch cable's plug round its boot): no order can place
+    both, so they are one part; the same links in no common group stay two."""
+    loose = {"plate": box([60, 30, 2], [5, 0, -13])}
+    path = write_grouped_glb(tmp_path / "chain.glb", linked_rings(), loose)
+    with pytest.warns(UserWarning, match=r"lock each other .*: spring \(2 parts\)"):
+        assembly = load_assembly(path)  # the group's node is called spring
+    assert assembly.ids == ("plate", "spring")
+    assert assembly.parts[1].source.endswith("chain.glb#link_a+link_b")
+    apart = write_grouped_glb(tmp_path / "apart.glb", {}, {**linked_rings(), **loose})
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert load_assembly(apart).ids == ("link_a", "link_b", "plate")
