@@ -2,7 +2,7 @@
 
 A real product is not only rigid bodies. A snap fit's housing flexes over the axle it
 locks: as rigid meshes, the two block each other along every direction, and no sequence
-can assemble them (:func:`locking_pairs`). The spec says so in one line::
+can assemble them (:func:`cad.freedom.locking_pairs`). The spec says so in one line::
 
     flex: [lever_housing]      # flexes while it is inserted: its blocking by the parts
                                # it locks with is ignored then
@@ -49,16 +49,6 @@ def parse_flex(value, part_ids, source: str) -> tuple[str, ...]:
     if unknown:
         raise ValueError(f"{source}: flex: unknown part {unknown[0]!r}")
     return out
-
-
-def locking_pairs(tt: np.ndarray, ids) -> list[tuple[str, str]]:
-    """Pairs ``(i, j)`` of parts that block each other along all six directions (``tt``
-    false both ways): whichever goes in second has no way in."""
-    stuck = ~np.asarray(tt, dtype=bool).any(axis=2)
-    np.fill_diagonal(stuck, False)
-    i, j = np.nonzero(np.triu(stuck & stuck.T))
-    names = [str(p) for p in ids]
-    return [(names[a], names[b]) for a, b in zip(i.tolist(), j.tolist(), strict=True)]
 
 
 def with_flex(relations, flex: tuple[str, ...]):

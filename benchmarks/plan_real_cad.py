@@ -7,7 +7,9 @@ line against relations loaded afresh from the same file. Prints one row per asse
 parts, parts ``held``, subassemblies, length unit and size, the generated spec's gravity and
 why (``asp/fromcad/gravity.py``), the exit code, seconds, peak memory of the plan command,
 states, TCT, W*, the CP-SAT status and the checker's verdict, or the error (the command's
-last stderr line, cut; below the table, whole).
+last stderr line, cut; below the table, whole). A file whose error names the spec lines
+that accept its overlaps gets a second row: ``asmplan init`` writes the spec with those
+lines commented, they are uncommented (``overlap_ok:``, ``flex:``) and the spec is planned.
 
 Assemblies, by default: the Fabrica assemblies in ``../shared/data/cad/fabrica/`` (or
 ``$ASMPLAN_FABRICA``), the built
@@ -139,6 +141,24 @@ def check_plan(path: str, doc: dict) -> str:
     return "ok"
 
 
+def follow_message(path: str, out: str, timeout: float) -> dict | None:
+    """The plan after the one message an overlapping file gets: ``asmplan init`` writes the
+    spec with the lines the message names commented (``overlap_ok:``, and ``flex:`` when
+    parts then lock); uncommented, the spec is planned as :func:`plan_one` plans a file.
+    None when init fails."""
+    folder = Path(out) / "spec"
+    folder.mkdir(parents=True, exist_ok=True)
+    spec = folder / "assembly.yaml"
+    cmd = [sys.executable, "-c", "from asmplan.cli import main; main()", "init", path]
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    made = subprocess.run([*cmd, "-o", str(spec)], capture_output=True, text=True, env=env)
+    if made.returncode != 0 or not spec.is_file():
+        return None
+    text = spec.read_text()
+    spec.write_text(re.sub(r"(?m)^# ((overlap_ok|flex): \[)", r"\1", text))
+    return plan_one(str(spec), str(Path(out) / "followed"), timeout)
+
+
 def plan_one(path: str, out: str, timeout: float) -> dict:
     """Run ``asmplan plan path -o out`` in a child and check its plan (this process is a
     child of :func:`main`, so its children's peak memory is the plan command's)."""
@@ -214,6 +234,9 @@ def main(argv: list[str]) -> None:
     if argv[:1] == ["--one"]:
         print(json.dumps(plan_one(argv[1], argv[2], float(argv[3]))))
         return
+    if argv[:1] == ["--follow"]:
+        print(json.dumps(follow_message(argv[1], argv[2], float(argv[3]))))
+        return
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("paths", nargs="*", help="assemblies, or folders to search for them")
     parser.add_argument("--timeout", type=float, default=300.0, help="seconds per assembly")
@@ -252,6 +275,20 @@ def main(argv: list[str]) -> None:
             print_row(row)
             if "error" in row:
                 errors.append(f"{row['assembly']}: {row['error']}")
+            if "`overlap_ok: [" in row.get("error", ""):  # the one message, followed
+                run = subprocess.run(
+                    [sys.executable, __file__, "--follow", str(path), str(out), str(args.timeout)],
+                    capture_output=True,
+                    text=True,
+                )
+                try:
+                    row = json.loads(run.stdout.strip().splitlines()[-1]) or {}
+                except (IndexError, json.JSONDecodeError):
+                    row = {"error": run.stderr.strip()[-300:]}
+                row["assembly"] = f"{path} (its message's lines added)"
+                print_row(row)
+                if "error" in row:
+                    errors.append(f"{row['assembly']}: {row['error']}")
         if errors:
             print("\nThe messages of the assemblies that do not plan, whole:\n")
             print("\n".join(f"- {e}" for e in errors))

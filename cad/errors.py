@@ -25,11 +25,24 @@ class Interpenetration(GeometryError):
 
     ``pairs`` holds their part ids, the pairs a spec's ``overlap_ok:`` accepts, so that a
     caller (``asmplan init``) decides by type and reads the pairs, never the message.
+    ``flex``: the parts a ``flex:`` line names for the pairs that lock each other once those
+    are accepted; ``relations``: the relations computed with them accepted (None when not
+    computed); ``unit_wrong``: the message blames the length unit instead.
     """
 
-    def __init__(self, message: str, pairs=()) -> None:
+    def __init__(
+        self, message: str, pairs=(), *, flex=(), relations=None, unit_wrong: bool = False
+    ) -> None:
         super().__init__(message)
         self.pairs = tuple(tuple(pair) for pair in pairs)
+        self.flex = tuple(flex)
+        self.relations = relations
+        self.unit_wrong = unit_wrong
 
     def __reduce__(self):
-        return type(self), (str(self), self.pairs)
+        return _interpenetration, (str(self), self.pairs, self.flex, self.unit_wrong)
+
+
+def _interpenetration(message: str, pairs, flex, unit_wrong) -> Interpenetration:
+    """An :class:`Interpenetration` rebuilt from its pickled fields (its relations left)."""
+    return Interpenetration(message, pairs, flex=flex, unit_wrong=unit_wrong)

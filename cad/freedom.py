@@ -362,11 +362,12 @@ def _centred(a: trimesh.Trimesh, b: trimesh.Trimesh) -> tuple[trimesh.Trimesh, t
 def interpenetration_error(assembly: Assembly, tols, found: list[Overlap]) -> Interpenetration:
     """The one-line error for every pair in ``found`` (the first :data:`MAX_NAMED` named),
     ending with the one spec line that accepts them all (:func:`overlap_line`) unless the
-    unit is wrong; its ``pairs`` hold the pairs' part ids."""
+    unit is wrong (``unit_wrong``); its ``pairs`` hold the pairs' part ids."""
     parts = assembly.parts
     first = found[0]
     pairs = [(parts[o.a].id, parts[o.b].id) for o in found]
     hint = unit_hint(assembly, first.a, first.b)
+    unit_wrong = bool(hint)
     if not hint:
         join = joining_line(parts[first.a], parts[first.b]) if len(found) == 1 else ""
         hint = (
@@ -393,7 +394,52 @@ def interpenetration_error(assembly: Assembly, tols, found: list[Overlap]) -> In
             f"{len(found)} pairs of parts interpenetrate deeper than their tolerance: "
             f"{named}{more}; {hint}"
         )
-    return Interpenetration(message, pairs)
+    return Interpenetration(message, pairs, unit_wrong=unit_wrong)
+
+
+def locking_pairs(tt: np.ndarray, ids) -> list[tuple[str, str]]:
+    """Pairs ``(i, j)`` of parts that block each other along all six directions (``tt``
+    false both ways): whichever goes in second has no way in."""
+    stuck = ~np.asarray(tt, dtype=bool).any(axis=2)
+    np.fill_diagonal(stuck, False)
+    i, j = np.nonzero(np.triu(stuck & stuck.T))
+    names = [str(p) for p in ids]
+    return [(names[a], names[b]) for a, b in zip(i.tolist(), j.tolist(), strict=True)]
+
+
+def flexing_parts(assembly: Assembly, pairs) -> tuple[str, ...]:
+    """The parts a ``flex:`` line names to let each locking pair in (``pairs`` of part ids):
+    of each pair the smaller part (by bounding-box diagonal; a snap fit's clip, a
+    connector in its panel), each once, in the assembly's order."""
+    size = {p.id: float(np.linalg.norm(np.ptp(p.bounds, axis=0))) for p in assembly.parts}
+    chosen = {a if size[a] <= size[b] else b for a, b in pairs}
+    return tuple(p.id for p in assembly.parts if p.id in chosen)
+
+
+def flex_line(parts) -> str:
+    """The ``flex:`` spec line naming ``parts``."""
+    return "flex: [" + ", ".join(parts) + "]"
+
+
+def with_locking(error: Interpenetration, assembly: Assembly, relations) -> Interpenetration:
+    """``error`` (of :func:`interpenetration_error`) told what else the file needs once its
+    overlaps are accepted (``relations``, computed so): the pairs that then lock each other
+    and the ``flex:`` line that lets each in, so that one message names every line to add;
+    its ``flex`` holds those parts (empty: none lock), its ``relations`` the relations."""
+    locked = locking_pairs(relations.tt, assembly.ids)
+    flex = flexing_parts(assembly, locked)
+    text = str(error)
+    if locked:
+        shown = "; ".join(f"{a} and {b}" for a, b in locked[:MAX_NAMED])
+        more = f" and {len(locked) - MAX_NAMED} more pair(s)" if len(locked) > MAX_NAMED else ""
+        text = (
+            f"{text.replace(' (`asmplan init` writes the spec)', '')}; with the overlaps so "
+            f"accepted, {shown}{more} block each other along every direction (whichever goes "
+            "in second has no way in): if the smaller of each pair flexes in (a snap fit, a "
+            f"clip, a connector), the line `{flex_line(flex)}` lets it in after the other "
+            "(`asmplan init` writes the spec, both lines commented)"
+        )
+    return Interpenetration(text, error.pairs, flex=flex, relations=relations)
 
 
 def overlap_line(pairs) -> str:

@@ -2,17 +2,18 @@
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
 
 from cad.assembly import Assembly
-from cad.contact import contact_relation, distance_contacts
+from cad.contact import contact_relation, distance_contacts, nearest_contacts
 from cad.directions import DIRECTIONS
-from cad.errors import GeometryError
+from cad.errors import GeometryError, Interpenetration
 from cad.fits import find_fits
-from cad.freedom import eroded_meshes
+from cad.freedom import eroded_meshes, with_locking
 from cad.freedom import translational_freedom as _freedom
 from cad.offset import FREE_EDGE_PULL
 from cad.support import SUPPORT_RULES, SUPPORT_TRAVEL_FACTOR, support_relation
@@ -59,6 +60,11 @@ class Relations:
         Pairs the spec accepts as overlapping (``overlap_ok:``) that are nested too deep to
         part: they touch and rest on each other along every direction, neither blocks the
         other (:func:`cad.fits.accepted_overlap`).
+    nearest : tuple of (str, str, int, float)
+        Parts that touch no other part while others touch, each with the part nearest to
+        it: (part, nearest part, direction index of the nearest part's side, gap in mm)
+        (:func:`cad.contact.nearest_contacts`); not in ``tc``: :func:`with_nearest` adds
+        them, as the planner reads a file.
     """
 
     parts: tuple[str, ...]
@@ -74,6 +80,7 @@ class Relations:
     sp: np.ndarray | None = None
     fits: tuple[tuple[str, str, float], ...] = ()
     through: tuple[tuple[str, str], ...] = ()
+    nearest: tuple[tuple[str, str, int, float], ...] = ()
 
     def __post_init__(self) -> None:
         n = len(self.parts)
@@ -152,11 +159,27 @@ def compute_relations(
     ------
     ValueError
         Two parts interpenetrate deeper than the penetration tolerance and are not a fit
-        (a screw or pin in a hole, :mod:`cad.fits`).
+        (a screw or pin in a hole, :mod:`cad.fits`): a GeometryError naming every such
+        pair and the ``overlap_ok:`` line that accepts them, and, computed with them
+        accepted (its ``relations`` attribute), the pairs that then lock each other and the
+        ``flex:`` line that lets each in (:func:`cad.freedom.with_locking`): every line the
+        file needs in one message.
     """
     tols = resolve_tolerances(assembly, contact_tol, penetration_tol)
     eroded = eroded_meshes(assembly, tols.shrink)
-    fits = find_fits(assembly, tols, eroded, overlap_ok)
+    try:
+        fits = find_fits(assembly, tols, eroded, overlap_ok)
+    except Interpenetration as exc:
+        if exc.unit_wrong:
+            raise
+        accepted = compute_relations(  # what else the file needs once they are accepted
+            assembly,
+            contact_tol=contact_tol,
+            penetration_tol=penetration_tol,
+            progress=progress,
+            overlap_ok=(*overlap_ok, *exc.pairs),
+        )
+        raise with_locking(exc, assembly, accepted) from None
     tc = contact_relation(assembly, penetration_tol=tols, progress=progress)
     tt = _freedom(assembly, penetration_tol=tols, progress=progress, check=False, eroded=eroded)
     sp = support_relation(assembly, tols, eroded, tc, tt, progress=progress)
@@ -181,7 +204,38 @@ def compute_relations(
             (ids[f.inner], ids[f.outer], _up(float(f.extra))) for f in fits if not f.through
         ),
         through=tuple((ids[f.inner], ids[f.outer]) for f in fits if f.through),
+        nearest=tuple(
+            (ids[a], ids[b], d, round(gap, 6)) for a, b, d, gap in nearest_contacts(assembly, tc)
+        ),
     )
+
+
+def with_nearest(relations: Relations) -> Relations:
+    """``relations`` with each part that touches no other part taken as touching its
+    nearest part (``relations.nearest``, :func:`cad.contact.nearest_contacts`: contact and
+    support across the gap, both ways), as the planner reads a file; one warning names
+    them. Unchanged when there are none."""
+    if not relations.nearest:
+        return relations
+    from dataclasses import replace
+
+    tc, sp = np.array(relations.tc, dtype=bool), relations.sp
+    sp = None if sp is None else np.array(sp, dtype=bool)
+    ids = list(relations.parts)
+    for part, near, d, _ in relations.nearest:
+        a, b = ids.index(part), ids.index(near)
+        tc[a, b, d] = tc[b, a, d ^ 1] = True
+        if sp is not None:
+            sp[a, b, d] = sp[b, a, d ^ 1] = True
+    found = relations.nearest
+    shown = ", ".join(f"{a} to {b} ({gap:.3g} mm)" for a, b, _, gap in found[:10])
+    more = f" and {len(found) - 10} more" if len(found) > 10 else ""
+    warnings.warn(
+        f"{len(found)} part(s) touch no other part, each taken as touching the part nearest "
+        f"to it across the model's gap (cad/contact.py): {shown}{more}",
+        stacklevel=2,
+    )
+    return replace(relations, tc=tc, sp=sp)
 
 
 def replay_rules(relations: Relations) -> dict:

@@ -606,6 +606,7 @@ def spec_text(
 
     import cad
     from cad.errors import Interpenetration
+    from cad.relations import with_nearest
     from cad.unit_hints import size_hint
 
     check_overrides(units, gravity)
@@ -615,24 +616,30 @@ def spec_text(
     if size_note and on_note is not None:
         on_note(f"units: {size_note}")
     overlapping: tuple = ()  # pairs the file overlaps: the spec names them, commented
+    flexing: tuple = ()  # parts that lock another once those are accepted: named likewise
     try:
         relations = cad.compute_relations(
             assembly, contact_tol=contact_tol, penetration_tol=penetration_tol
         )
     except Interpenetration as exc:
         overlapping = exc.pairs
-        relations = cad.compute_relations(
-            assembly,
-            contact_tol=contact_tol,
-            penetration_tol=penetration_tol,
-            overlap_ok=overlapping,
-        )
+        relations = exc.relations  # computed with the pairs accepted
+        if relations is None:  # the message blames the unit: accepted all the same
+            relations = cad.compute_relations(
+                assembly,
+                contact_tol=contact_tol,
+                penetration_tol=penetration_tol,
+                overlap_ok=overlapping,
+            )
+        flexing = exc.flex
         if on_note is not None:
             on_note(
                 f"overlaps: {len(overlapping)} pair(s) overlap deeper than their tolerance; "
                 "the spec's `overlap_ok:` line is written commented: uncomment it if they "
                 "overlap as modelled"
+                + (" (and the `flex:` line after it: parts that then lock)" if flexing else "")
             )
+    relations = with_nearest(relations)  # as the plan reads them
     turned: dict = {(data["gravity"], None): (data, assembly)}
 
     def turn(gravity: str | None, frame) -> AssemblySpec:
@@ -711,7 +718,7 @@ def spec_text(
         "cost: time                 # or steps (1 per operation)",
         _tolerance_line("contact_tol", contact_tol, "largest gap that counts as touching"),
         _tolerance_line("penetration_tol", penetration_tol, "largest overlap that still touches"),
-        *_overlap_lines(overlapping),
+        *_overlap_lines(overlapping, flexing),
         "",
         "operations:   # one placement per part: base first, then from the lowest part up",
     ]
@@ -727,17 +734,25 @@ def spec_text(
     return "\n".join(lines) + "\n"
 
 
-def _overlap_lines(pairs) -> list[str]:
-    """The commented ``overlap_ok:`` line of the pairs the file overlaps (none: no lines)."""
+def _overlap_lines(pairs, flexing=()) -> list[str]:
+    """The commented ``overlap_ok:`` line of the pairs the file overlaps and the ``flex:``
+    line of the parts that lock another once they are accepted (none: no lines)."""
     if not pairs:
         return []
-    from cad.freedom import overlap_line
+    from cad.freedom import flex_line, overlap_line
 
-    return [
+    lines = [
         f"# {len(pairs)} pair(s) overlap deeper than their tolerance in the file: uncomment if",
         "# as modelled (a press fit, a thread, a visual asset's pieces): each pair touches",
         f"# {overlap_line(pairs)}",
     ]
+    if flexing:
+        lines += [
+            "# with them accepted, these parts lock another (each blocks the other along",
+            "# every direction): uncomment if each flexes in (a snap fit, a clip, a connector)",
+            f"# {flex_line(flexing)}",
+        ]
+    return lines
 
 
 def _alike_lines(assembly) -> list[str]:

@@ -845,10 +845,12 @@ def spec_relations(spec: AssemblySpec, geometry, *, progress: bool = False):
     """The cad relations of ``geometry``, the meshes of ``spec``'s parts already read.
 
     With the spec's ``contact_tol`` and ``penetration_tol`` (None: the per-part rule), its
-    ``overlap_ok`` pairs and its ``flex`` parts (:func:`asp.cad_keys.with_flex`).
+    ``overlap_ok`` pairs and its ``flex`` parts (:func:`asp.cad_keys.with_flex`); a part
+    that touches no other part touches its nearest (:func:`cad.relations.with_nearest`).
     """
     import cad
     from asp.cad_keys import with_flex
+    from cad.relations import with_nearest
 
     relations = cad.compute_relations(
         geometry,
@@ -857,4 +859,4 @@ def spec_relations(spec: AssemblySpec, geometry, *, progress: bool = False):
         progress=progress,
         overlap_ok=spec.overlap_ok,
     )
-    return with_flex(relations, spec.flex)
+    return with_flex(with_nearest(relations), spec.flex)

@@ -102,3 +102,45 @@ def test_overlap_ok_refuses_what_is_not_pairs_of_parts(tmp_path):
     ):
         with pytest.raises(ValueError, match=why):
             parse_overlap_ok(bad, {"a", "b"}, "s.yaml")
+
+
+def caged_cube() -> dict:
+    """A block sunk 1 mm into a base (an overlap), and a cage on the base with a cube shut
+    in its closed cavity, resting on its floor (a pair that locks once placed)."""
+    import trimesh
+
+    cavity = shapes.box_between((34, 6, 12), (46, 14, 22))
+    cavity.invert()
+    cage = trimesh.util.concatenate([shapes.box_between((30, 2, 10), (50, 18, 26)), cavity])
+    return {
+        "base": shapes.box_between((0, 0, 0), (60, 20, 10)),
+        "block": shapes.box_between((5, 5, 9), (15, 15, 19)),
+        "cage": cage,
+        "cube": shapes.box_between((37, 8, 12), (43, 12, 16)),
+    }
+
+
+def test_one_message_names_every_line_the_file_needs_and_with_them_it_plans(tmp_path):
+    """The overlap error is computed on with its pairs accepted: the pairs that then lock
+    each other and the ``flex:`` line (the smaller of each pair) are in the same message,
+    ``init`` writes both lines commented, and with both uncommented the product plans."""
+    source = tmp_path / "caged"
+    source.mkdir()
+    for name, mesh in caged_cube().items():
+        mesh.export(source / f"{name}.stl")
+    with pytest.raises(GeometryError) as info:
+        cad.compute_relations(cad.load_assembly(source))
+    message = str(info.value)
+    assert "`overlap_ok: [[base, block]]`" in message and "\n" not in message
+    assert "cage and cube block each other along every direction" in message
+    assert "`flex: [cube]`" in message and info.value.flex == ("cube",)
+    refused = CliRunner().invoke(app, ["plan", str(source), "-o", str(tmp_path / "no")])
+    assert refused.exit_code == 2 and "`flex: [cube]`" in refused.stderr
+    spec_file = source / "assembly.yaml"
+    made = CliRunner().invoke(app, ["init", str(source), "-o", str(spec_file)])
+    assert made.exit_code == 0, made.output
+    text = spec_file.read_text()
+    assert "# overlap_ok: [[base, block]]" in text and "# flex: [cube]" in text
+    spec_file.write_text(text.replace("# overlap_ok:", "overlap_ok:").replace("# flex:", "flex:"))
+    planned = CliRunner().invoke(app, ["plan", str(spec_file), "-o", str(tmp_path / "out")])
+    assert planned.exit_code == 0, planned.output

@@ -5,9 +5,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from asp.cad_keys import locking_pairs, parse_flex, with_flex
+from asp.cad_keys import parse_flex, with_flex
 from asp.graph.state_graph import build_state_graph
 from asp.spec import spec_from_dict
+from cad.freedom import locking_pairs
 from tests.asp.graph.test_explain import tower
 from tests.asp.helpers_assembly import LATERAL
 

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from cad import DIRECTIONS, Assembly, compute_relations, rtc, rtt, tt_set
+from cad.relations import with_nearest
 from tests.cad import shapes
 
 
@@ -254,3 +255,29 @@ def test_open_disc_springs_touching_along_free_edges_are_not_interpenetrating():
 def test_open_disc_springs_sunk_into_each_other_are_an_error():
     with pytest.raises(ValueError, match="'lower' and 'upper' interpenetrate"):
         compute_relations(shapes.open_disc_springs(sink=1.5))
+
+
+def test_a_part_touching_nothing_touches_its_nearest_part():
+    """A lid floating 1 mm over a box on its foot (a visual model's gap) could never be
+    inserted: it is taken as touching the box, its nearest part, from above; a block far
+    off, 30 mm from everything (over half its own diagonal), is left alone; one warning
+    names them. Where no two parts touch at all nothing is added (the gap tests above)."""
+    import warnings
+
+    meshes = {
+        "foot": shapes.box_between((10, 10, -5), (30, 30, 0)),
+        "box": shapes.box_between((0, 0, 0), (40, 40, 20)),
+        "lid": shapes.box_between((0, 0, 21), (40, 40, 25)),
+        "far": shapes.box_between((70, 0, 0), (80, 10, 10)),
+    }
+    raw = compute_relations(Assembly.from_meshes(meshes))
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        rel = with_nearest(raw)
+    box, lid, far = (rel.parts.index(p) for p in ("box", "lid", "far"))
+    assert raw.nearest == (("lid", "box", 5, 1.0),) and not raw.tc[lid].any()
+    assert rel.tc[lid, box].tolist() == [False] * 5 + [True]  # the box is below it (-z)
+    assert rel.tc[box, lid, 4] and rel.sp[lid, box, 5]
+    assert not rel.tc[far].any() and not rel.tc[:, far].any()
+    told = [str(w.message) for w in said if "touch no other part" in str(w.message)]
+    assert len(told) == 1 and "lid to box (1 mm)" in told[0]
