@@ -107,7 +107,7 @@ def build_with_units(
     rounds too), and the graph is built again (at most :data:`MAX_ROUNDS` rounds); if no
     new unit can be found, the file's remaining sub-assemblies are given up before the
     first error is raised. With ``reduce``, a round whose derived precedences already prove
-    that no complete sequence exists (:func:`asp.graph.symmetry.refutation`, milliseconds)
+    that no complete sequence exists (:func:`asp.graph.precedences.refutation`, milliseconds)
     builds no checked graph, and its graph for the stuck operations only up to
     :data:`PROVED_ROUND_STATES` states; beyond, the operation the proof names is the stuck
     one (a clutch's pressure plate blocked by its 13 pins: 15.7M states built twice before).
@@ -146,7 +146,8 @@ def build_with_units(
 
     def build(with_units: AssemblySpec):
         if reduce:
-            from asp.graph.symmetry import reduced_state_graph, refutation
+            from asp.graph.precedences import refutation
+            from asp.graph.symmetry import reduced_state_graph
 
             proof = refutation(with_units, relations)
             if proof is not None:  # no complete sequence: known without a graph
@@ -263,7 +264,7 @@ def refuted_units(
     on_unit: Callable[[str], None] | None = None,
 ) -> set[str]:
     """The CAD file's sub-assemblies to give up before any state graph is built: those the
-    derived precedences prove leave no complete sequence (:func:`asp.graph.symmetry.refutation`,
+    derived precedences prove leave no complete sequence (:func:`asp.graph.precedences.refutation`,
     milliseconds), with ``exclude``.
 
     While the file's units (:func:`with_cad_units`, without the ones given up) admit such a
@@ -276,7 +277,7 @@ def refuted_units(
     Sound: a proof holds for every order, so the state graph would give these units up as
     well, after building it.
     """
-    from asp.graph.symmetry import refutation
+    from asp.graph.precedences import refutation
 
     say = on_unit or (lambda _line: None)
     given_up = set(exclude)

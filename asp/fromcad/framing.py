@@ -13,7 +13,7 @@ nearest coordinate axis, the most shared first, of the axes that a part of an in
 pair has) are tried in order; in each the relations
 are computed afresh and the generated spec's decisions taken again (gravity, base part,
 ``held``). The first in which no pair is interlocked and the derived precedences do not
-refute every sequence (:func:`asp.graph.symmetry.infeasibility`) is taken; else the first in
+refute every sequence (:func:`asp.graph.precedences.infeasibility`) is taken; else the first in
 which no pair is interlocked; else the file's frame stays (nothing helps; the state graph
 then says which part can never be inserted). Each candidate costs one computation of the
 relations. A candidate whose relations cannot be computed (a pair overlaps there that is a
@@ -95,7 +95,7 @@ def choose_frame(decided, geometry, in_frame: Callable) -> tuple[FrameChoice | N
         relations, or no interlocked pair); else the choice and the decisions in the frame
         taken (None when the file's frame stays).
     """
-    from asp.graph.symmetry import infeasibility
+    from asp.graph.precedences import infeasibility
 
     spec, relations = decided.spec, decided.relations
     if not spec.generated or relations is None or spec.frame is not None:

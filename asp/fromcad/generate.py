@@ -122,7 +122,7 @@ def workable_base(spec: AssemblySpec, relations) -> tuple[AssemblySpec, str]:
     """A generated spec on a base part from which the assembly is not ruled out.
 
     The geometric rule (:func:`base_index`) looks at bounding boxes only; when the derived
-    precedences (:func:`asp.graph.symmetry.infeasibility`) prove that no complete sequence starts
+    precedences (:func:`asp.graph.precedences.infeasibility`) prove that no complete sequence starts
     from that base (with gravity as given, e.g. a drive drawn upside down whose lowest large
     part rests on parts that need the parts above it), the other parts are tried, those
     touching the most parts first (then in operation order), and the first not ruled out
@@ -136,7 +136,7 @@ def workable_base(spec: AssemblySpec, relations) -> tuple[AssemblySpec, str]:
     """
     from dataclasses import replace
 
-    from asp.graph.symmetry import infeasibility
+    from asp.graph.precedences import infeasibility
 
     held, _ = hold_unsupported(spec, relations)
     if not spec.generated or relations is None or not spec.base_part:

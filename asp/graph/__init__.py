@@ -2,8 +2,9 @@
 
 :mod:`~asp.graph.feasibility` (the insertion oracle and the state-key codec),
 :mod:`~asp.graph.enabled_kernel` (its numba inner loops), :mod:`~asp.graph.state_graph`
-(the graph, built layer by layer), :mod:`~asp.graph.symmetry` (derived precedences,
-infeasibility proofs and the interchangeable-part reduction), :mod:`~asp.graph.fixed_order`
+(the graph, built layer by layer), :mod:`~asp.graph.precedences` (derived
+precedences and infeasibility proofs), :mod:`~asp.graph.symmetry` (the interchangeable-part
+reduction), :mod:`~asp.graph.fixed_order`
 (that reduction undone for schedules), :mod:`~asp.graph.together` (which operations may run
 at once, one rule), :mod:`~asp.graph.game_dag` (from the state graph to the game DAG) and
 :mod:`~asp.graph.checker` (an independent plan checker that shares no code with the rest).
@@ -18,6 +19,7 @@ __all__, __getattr__ = lazy_exports(
         "feasibility": ("insertion_oracle", "load_relations", "operation_model", "spec_relations"),
         "game_dag": ("game_dag",),
         "state_graph": ("StateGraph", "build_state_graph"),
-        "symmetry": ("Refutation", "reduced_state_graph", "refutation"),
+        "precedences": ("Refutation", "infeasibility", "refutation", "with_derived_precedences"),
+        "symmetry": ("reduced_state_graph",),
     },
 )

@@ -16,7 +16,7 @@ import pytest
 from asmplan import pipeline
 from asp.fromcad.generate import spec_text, workable_base
 from asp.graph.checker import check_line, plan_operations
-from asp.graph.symmetry import infeasibility
+from asp.graph.precedences import infeasibility
 from tests.cad.real_shapes import box
 
 

@@ -107,7 +107,7 @@ def test_units_decide_by_type_not_by_text(monkeypatch):
     monkeypatch.setattr(
         "asp.graph.symmetry.reduced_state_graph", failing("no words", InfeasibleAssembly)
     )
-    monkeypatch.setattr("asp.graph.symmetry.refutation", lambda *a: None)
+    monkeypatch.setattr("asp.graph.precedences.refutation", lambda *a: None)
     with pytest.raises(InfeasibleAssembly):
         subassemblies.build_with_units(spec, rel, reduce=True)
     assert calls == [InfeasibleAssembly]  # given up after the rounds, the first error raised

@@ -15,9 +15,9 @@ from asp.errors import SpecError
 from asp.game.solve import solve
 from asp.graph.checker import check_line
 from asp.graph.game_dag import game_dag
+from asp.graph.precedences import infeasibility
 from asp.graph.state_graph import build_state_graph
 from asp.graph.symmetry import (
-    infeasibility,
     interchangeable_blocks,
     reduce_interchangeable,
     reduced_state_graph,

@@ -12,7 +12,8 @@ from asp.errors import SpecError
 from asp.game.solve import solve
 from asp.graph.checker import check_line
 from asp.graph.game_dag import game_dag
-from asp.graph.symmetry import infeasibility, interchangeable_blocks, reduced_state_graph
+from asp.graph.precedences import infeasibility
+from asp.graph.symmetry import interchangeable_blocks, reduced_state_graph
 from asp.spec import with_subassemblies
 from tests.asp.graph.test_symmetry_ring import (
     RING,
