@@ -1184,9 +1184,14 @@ def check_plan(doc: dict, where: str = "plan") -> None:
 
 
 TIMINGS_FORMAT = "asmplan-timings/1"
-TIMING_KEYS = {"schedule": ("wall_s", "stage_s", "improvements"), "concurrent": ("seconds",)}
+TIMING_KEYS = {
+    "schedule": ("wall_s", "stage_s", "improvements", "wall_stop"),
+    "concurrent": ("seconds",),
+}
 """The keys of a plan document's objects that measure time (``improvements``: ``[seconds,
-makespan]`` of each better CP-SAT schedule); they go to ``timings.json``, not ``plan.json``."""
+makespan]`` of each better CP-SAT schedule; ``wall_stop``: the wall-clock seconds at which
+the CP-SAT stage's safety net stopped it, only when it did, :mod:`asp.schedule.cpsat`); they
+go to ``timings.json``, not ``plan.json``."""
 
 
 def split_timings(doc: dict) -> tuple[dict, dict]:

@@ -3,10 +3,10 @@
 The stage is :func:`asp.schedule.assembly_makespan.assembly_makespan` (``asmplan plan``'s
 step 4: the precedences the state graph implies, the replay tables, the list schedules, then
 CP-SAT with lazy cuts from the replay). Each case runs with the default of ``asmplan plan``
-(``auto``: the whole stage within :data:`asp.schedule.assembly_makespan.AUTO_TIME_LIMIT`
-seconds, stopping once neither a better schedule nor a new cut has come for
-:data:`asp.schedule.assembly_makespan.AUTO_PATIENCE` seconds) and with each ``--limits``
-value (a CP-SAT time limit in seconds, as ``--time-limit`` gives). Printed per run: the
+(``auto``: :data:`asp.schedule.assembly_makespan.AUTO_TIME_LIMIT` search seconds of CP-SAT's
+deterministic time, stopping once neither a better schedule nor a new cut has come for
+:data:`asp.schedule.assembly_makespan.AUTO_PATIENCE` of them) and with each ``--limits``
+value (a CP-SAT time limit in search seconds, as ``--time-limit`` gives). Printed per run: the
 stage's wall time and the part of it spent before CP-SAT (the precedences, the replay
 tables, the list schedules), status, makespan, proven lower bound, cuts and solves, and who
 found the schedule; every schedule printed has passed the replay (checked again here).

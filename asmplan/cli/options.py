@@ -27,7 +27,12 @@ CostModel = choices("CostModel", COST_MODELS, "Cost of a move.")
 TurnModel = choices("TurnModel", TURN_MODELS, "Turn model of the game.")
 
 
-def time_limit_option(default: float | None, help: str = "CP-SAT time limit, seconds."):
+def time_limit_option(
+    default: float | None,
+    help: str = "CP-SAT time limit, search seconds: its deterministic time, about a second of "
+    "one core's search each, so the same answer at any load (the wall clock stops it only as "
+    "a safety net, at 3x + 30 s).",
+):
     """``--time-limit``: one definition for every command that runs CP-SAT (``help`` says
     what the default does when it is not a number)."""
     return typer.Option(default, "--time-limit", min=0.001, max=TIME_LIMIT_MAX, help=help)

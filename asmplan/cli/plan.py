@@ -34,10 +34,12 @@ from asp.atomic import check_output_folder
 from asp.schedule.assembly_makespan import AUTO_PATIENCE, AUTO_TIME_LIMIT
 
 AUTO_TIME_LIMIT_HELP = (
-    "Seconds for CP-SAT's minimum-makespan search. Default: automatic, the whole schedule "
-    f"stage within {AUTO_TIME_LIMIT:g} s, stopping once neither a better schedule nor a new cut "
-    f"has come for {AUTO_PATIENCE:g} s, or when proven optimal; give a number to let CP-SAT "
-    "search that long."
+    "Search seconds for CP-SAT's minimum-makespan search: its deterministic time, about a "
+    "second of one core's search each, so the same plan at any load (the wall clock stops it "
+    "only as a safety net, at 3x + 30 s). "
+    f"Default: automatic, {AUTO_TIME_LIMIT:g} s, stopping once neither a better schedule nor a "
+    f"new cut has come for {AUTO_PATIENCE:g} s, or when proven optimal; give a number to let "
+    "CP-SAT search that long."
 )
 
 

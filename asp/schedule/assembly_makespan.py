@@ -14,19 +14,16 @@ from asp.schedule.makespan import min_makespan
 from asp.schedule.replay import replay_model, schedule_violation
 
 AUTO_TIME_LIMIT = 10.0
-"""Seconds for the whole CP-SAT makespan stage by default (:func:`assembly_makespan` with
-``time_limit=None``), its preparation included. A small assembly is proven optimal in well
-under a second; on the 72-part cycloidal drive every better schedule came within the first
-7 s of the search and the cuts after them gave nothing better (20 s bought nothing)."""
+"""Search seconds (CP-SAT's deterministic time) for the makespan stage's search by default
+(:func:`assembly_makespan` with ``time_limit=None``; :mod:`asp.schedule.cpsat`: the same
+answer at any load). A small assembly is proven optimal in well under a second; on the
+72-part cycloidal drive every better schedule came within the first 7 s of the search and
+the cuts after them gave nothing better (20 s bought nothing)."""
 
 
 AUTO_PATIENCE = 2.0
 """By default the CP-SAT makespan stage stops once neither a better schedule nor a new cut
-has come for this many seconds (or when it is proven optimal)."""
-
-
-MIN_SOLVE_S = 0.5
-"""The least time the automatic budget leaves CP-SAT after a long preparation."""
+has come for this many search seconds (or when it is proven optimal)."""
 
 
 def assembly_makespan(
@@ -62,13 +59,13 @@ def assembly_makespan(
     Parameters
     ----------
     time_limit : float or None
-        Seconds for the CP-SAT loop (after the precedences, the replay tables and the list
-        schedules are built). ``None``: the automatic budget, :data:`AUTO_TIME_LIMIT` seconds
-        for the whole call, preparation included, with ``patience`` defaulting to
-        :data:`AUTO_PATIENCE`.
+        Search seconds (CP-SAT's deterministic time) for the CP-SAT loop (after the precedences,
+        the replay tables and the list schedules are built; the wall clock only as a safety
+        net, :func:`asp.schedule.cpsat.wall_safety`). ``None``: the automatic budget,
+        :data:`AUTO_TIME_LIMIT`, with ``patience`` defaulting to :data:`AUTO_PATIENCE`.
     patience : float, optional
-        Stop once neither a better schedule nor a new cut has come for this many seconds
-        (:func:`asp.schedule.makespan.min_makespan`).
+        Stop once neither a better schedule nor a new cut has come for this many search
+        seconds (:func:`asp.schedule.makespan.min_makespan`).
     fixed_order : bool
         On a graph whose alike operations are in a fixed order (the alternating game's
         reduction), undo it (:mod:`asp.graph.fixed_order`): the schedules of the full graph, alike
@@ -98,12 +95,9 @@ def assembly_makespan(
         starts.append(list_schedule(model, sched.problem, sequence))
     starts = [rows for rows in starts if rows]
     incumbent = min(starts, key=lambda rows: max(float(r["end"]) for r in rows), default=None)
-    limit = time_limit
-    if limit is None:  # the budget covers the preparation too (at least a moment for CP-SAT)
-        limit = max(AUTO_TIME_LIMIT - (time.perf_counter() - t0), MIN_SOLVE_S)
     result = min_makespan(
         sched.problem,
-        time_limit=limit,
+        time_limit=AUTO_TIME_LIMIT if time_limit is None else time_limit,
         workers=workers,
         seed=seed,
         replay=replay,

@@ -16,7 +16,14 @@ from dataclasses import dataclass
 
 from asp.errors import ScheduleError
 from asp.numbers import json_number
-from asp.schedule.cpsat import EXACT_HEADROOM, BaselineResult, integer_scale, new_solver
+from asp.schedule.cpsat import (
+    EXACT_HEADROOM,
+    BaselineResult,
+    integer_scale,
+    new_solver,
+    search_seconds,
+    wall_safety,
+)
 
 
 @dataclass(frozen=True)
@@ -96,6 +103,12 @@ def min_makespan(
     ``patience`` (optional, seconds): stop once neither a better schedule nor a new cut
     has come for that long (the status is then ``FEASIBLE`` unless proven); ``time_limit``
     still caps the whole loop. Without it the loop runs until proven or ``time_limit``.
+
+    Both are search seconds, CP-SAT's deterministic time (:mod:`asp.schedule.cpsat`), counted
+    over the loop's solves, so the result is the same on every run at any load (one
+    worker); the wall clock stops the loop only as a safety net
+    (:func:`asp.schedule.cpsat.wall_safety` of ``time_limit``), and then
+    ``detail["wall_stop"]`` says so.
 
     Tool states as sequence-dependent setups: for a tool ``T``, a *setter* is a task that
     sets ``T`` and a *user* a task that requires a value of ``T``. Every setter is ordered
@@ -270,9 +283,11 @@ class _ReplayLoop:
         self.prec: dict[tuple[int, int], object] = {}
         self.modes: list[int] | None = None  # the incumbent's mode per task
         self.t0 = time.perf_counter()
-        self.progress_at = 0.0  # seconds after t0 of the last better schedule or new cut
-        self.improvements: list[list[float]] = []  # [seconds, makespan] of each better one
+        self.work = 0.0  # search seconds of the solves so far (CP-SAT's deterministic clock)
+        self.progress_at = 0.0  # search seconds at the last better schedule or new cut
+        self.improvements: list[list[float]] = []  # [wall seconds, makespan] of each better one
         self.stalled = False  # stopped by the patience
+        self.wall_stop = False  # stopped by the wall-clock safety net
 
     def rows(self, value, boolean) -> tuple[list[dict], list[int]]:
         """The schedule rows of a solution (``value``/``boolean`` read it) and its modes."""
@@ -291,8 +306,11 @@ class _ReplayLoop:
         rows.sort(key=lambda r: (r["start"], r["end"], r["task"]))
         return rows, modes
 
-    def offer(self, rows: list[dict], *, source: str, modes=None) -> list | None:
-        """Replay ``rows``; keep them when they pass and beat the incumbent; the cut if not."""
+    def offer(
+        self, rows: list[dict], *, source: str, modes=None, work: float | None = None
+    ) -> list | None:
+        """Replay ``rows``; keep them when they pass and beat the incumbent; the cut if not
+        (``work``: the search seconds when they came, default the solves' so far)."""
         cut = self.replay(rows) if self.replay is not None else None
         if cut is not None:
             self.failed += 1
@@ -303,8 +321,8 @@ class _ReplayLoop:
                 agent = {r["task"]: r["agent"] for r in rows}
                 modes = [[a for a, _ in t.modes].index(agent[t.id]) for t in self.tasks]
             self.best, self.source, self.modes = (span, rows), source, list(modes)
-            self.progress_at = time.perf_counter() - self.t0
-            self.improvements.append([round(self.progress_at, 3), span / self.scale])
+            self.progress_at = self.work if work is None else work
+            self.improvements.append([round(time.perf_counter() - self.t0, 3), span / self.scale])
         return None
 
     def precedes(self, y: int, x: int):
@@ -321,7 +339,7 @@ class _ReplayLoop:
             return
         self.added.add(key)
         self.cuts += 1
-        self.progress_at = time.perf_counter() - self.t0
+        self.progress_at = self.work
         self.model.add_bool_or([self.precedes(y, x) for y, x in sorted(key)])
 
     def hint(self) -> None:
@@ -344,18 +362,23 @@ class _ReplayLoop:
 
         loop = self
         t0 = self.t0 = time.perf_counter()
-        self.progress_at = 0.0
+        wall_limit = wall_safety(time_limit)
+        self.work = self.progress_at = 0.0
         self.improvements = [[0.0, self.best[0] / self.scale]] if self.best else []
         proven = infeasible = False
         last = "UNKNOWN"
         while True:
-            elapsed = time.perf_counter() - t0
+            elapsed = self.work
             left = time_limit - elapsed
             if patience is not None and self.best is not None:
                 wait = self.progress_at + patience - elapsed
                 self.stalled = wait < left  # this solve stops by the patience, if it does
                 left = min(left, wait)
             if left <= 0:
+                break
+            wall_left = wall_limit - (time.perf_counter() - t0)
+            if wall_left <= 0:
+                self.wall_stop = True
                 break
             if self.solves and self.best is not None:
                 # After a cut: only a shorter schedule is of use now, and the best one so
@@ -373,17 +396,21 @@ class _ReplayLoop:
 
                 def on_solution_callback(self):
                     rows, modes = loop.rows(self.value, self.boolean_value)
-                    cut = loop.offer(rows, source="CP-SAT", modes=modes)
+                    work = loop.work + search_seconds(self.deterministic_time)
+                    cut = loop.offer(rows, source="CP-SAT", modes=modes, work=work)
                     if cut is not None:
                         self.cut, self.failed_rows = cut, rows
                         self.stop_search()
 
             callback = Replayed()
-            solver = new_solver(left, workers, seed)
-            began = time.perf_counter() - t0
+            solver = new_solver(left, workers, seed, wall_limit=wall_left)
+            began = self.work
             status = solver.solve(self.model, callback)
             self.solves += 1
+            self.work += search_seconds(solver.deterministic_time)
             last = solver.status_name(status)
+            if callback.cut is None and status not in (cp_model.OPTIMAL, cp_model.INFEASIBLE):
+                self.wall_stop = solver.wall_time >= 0.95 * wall_left  # the net, not the work
             if status in (cp_model.OPTIMAL, cp_model.FEASIBLE):
                 bound = int(round(solver.best_objective_bound))
                 if self.best is not None:
@@ -422,6 +449,8 @@ class _ReplayLoop:
             elif status_name == "UNKNOWN":
                 detail["replay"] = "no physically feasible schedule found within the time limit"
             detail["improvements"] = self.improvements
+        if self.wall_stop:
+            detail["wall_stop"] = round(wall_limit, 3)
         detail["status_note"] = self.note(status_name, time_limit, patience)
         return status_name, detail, wall
 
@@ -435,9 +464,8 @@ class _ReplayLoop:
             low = f"; the optimum is at least {self.bound / self.scale:g}" if self.bound else ""
             replayed = ", replayed through the state graph" if self.replay is not None else ""
             within = (
-                f"in {time.perf_counter() - self.t0:.1f} s (no better schedule nor cut for "
-                f"{patience:g} s)"
-                if self.stalled
+                f"in {self.work:.1f} s (no better schedule nor cut for {patience:g} s)"
+                if self.stalled and not self.wall_stop
                 else f"within {time_limit:g} s"
             )
             return (
