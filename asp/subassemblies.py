@@ -166,7 +166,7 @@ def build_with_units(
         that graph is built up to :data:`PROVED_ROUND_STATES` states only; beyond, the
         operation the proof names is the stuck one, and the whole graph is built only if
         that gives nothing new."""
-        from asp.graph.feasibility import operation_model
+        from asp.graph.state_keys import operation_model
 
         def units_of(graph, stuck: list[int]):
             drop.update(_stuck_units(graph.spec, stuck, optional))

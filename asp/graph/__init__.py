@@ -1,6 +1,7 @@
 """The assembly state graph: which operations are feasible from which states.
 
-:mod:`~asp.graph.feasibility` (the insertion oracle and the state-key codec),
+:mod:`~asp.graph.feasibility` (the insertion oracle), :mod:`~asp.graph.state_keys` (the
+state-key codec: which operations are enabled in which states),
 :mod:`~asp.graph.enabled_kernel` (its numba inner loops), :mod:`~asp.graph.state_graph`
 (the graph, built layer by layer), :mod:`~asp.graph.precedences` (derived
 precedences and infeasibility proofs), :mod:`~asp.graph.symmetry` (the interchangeable-part
@@ -16,10 +17,11 @@ __all__, __getattr__ = lazy_exports(
     __name__,
     {
         "checker": ("check_line", "plan_operations"),
-        "feasibility": ("insertion_oracle", "load_relations", "operation_model", "spec_relations"),
+        "feasibility": ("insertion_oracle", "load_relations", "spec_relations"),
         "game_dag": ("game_dag",),
         "state_graph": ("StateGraph", "build_state_graph"),
         "precedences": ("Refutation", "infeasibility", "refutation", "with_derived_precedences"),
+        "state_keys": ("OperationModel", "operation_model"),
         "symmetry": ("reduced_state_graph",),
     },
 )

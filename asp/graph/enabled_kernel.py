@@ -1,6 +1,6 @@
 """The state graph's inner loops compiled with numba.
 
-The enabled-operations test (:meth:`asp.graph.feasibility.OperationModel.enabled`), stuck states,
+The enabled-operations test (:meth:`asp.graph.state_keys.OperationModel.enabled`), stuck states,
 duplicate successor keys (:func:`asp.graph.state_graph.build_state_graph`) and the sequence count
 (:meth:`asp.graph.state_graph.StateGraph.count_sequences`).
 

@@ -3,7 +3,7 @@
 The state graph of the alternating game is reduced by symmetry (:mod:`asp.graph.symmetry`): of a
 class of interchangeable blocks of operations (a pin; a dowel with its roller), the
 ``i``-th operations of the blocks are chained in block order at every position ``i``
-(:attr:`asp.graph.feasibility.OperationModel.fixed`). The graph holds one state of every orbit:
+(:attr:`asp.graph.state_keys.OperationModel.fixed`). The graph holds one state of every orbit:
 the *sorted* state, whose blocks are done in block order by prefix length (longest first).
 TCT and W* stay exact, but a schedule replayed through it as it is could never run two
 alike operations at once (both orders must be transitions) and would keep the chain as a
@@ -47,7 +47,7 @@ class FixedOrder:
     ----------
     n_ops : int
     classes : tuple of classes of blocks of operation indices
-        :attr:`asp.graph.feasibility.OperationModel.fixed`.
+        :attr:`asp.graph.state_keys.OperationModel.fixed`.
     chains : tuple of tuple of int
         Per class and position, the chain of the blocks' operations there, in block order.
     label : (n_ops,) int64

@@ -1,7 +1,7 @@
 """The assembly state graph and the assembly sequence table (AST).
 
 A state is the set of operations done plus the tool values, packed into a key of
-``W = ceil(bits / 64)`` uint64 words (:class:`asp.graph.feasibility.OperationModel`;
+``W = ceil(bits / 64)`` uint64 words (:class:`asp.graph.state_keys.OperationModel`;
 ``W == 1``, up to 64 operations and tool bits, is the fast path). Starting from the empty
 assembly, the graph is built breadth-first, one layer (states with ``k`` operations done) at
 a time: every state of the layer x every operation is tested at once with bit operations,
@@ -29,13 +29,8 @@ import numpy as np
 from asp import heap
 from asp.cad_keys import flex_hint
 from asp.errors import InfeasibleAssembly, StateLimit
-from asp.graph.feasibility import (
-    OperationModel,
-    blocked_text,
-    operation_model,
-    pack_words,
-    unpack_words,
-)
+from asp.graph.feasibility import blocked_text, pack_words, unpack_words
+from asp.graph.state_keys import OperationModel, operation_model
 from asp.spec import DIRECTIONS, AssemblySpec
 
 DEFAULT_MAX_STATES = 20_000_000
@@ -93,7 +88,7 @@ class StateGraph:
     model : OperationModel
         The compiled spec (key layout, enabled operations).
     keys : (N, W) uint64
-        State keys (``W`` words each, see :class:`asp.graph.feasibility.OperationModel`), layer by
+        State keys (``W`` words each, see :class:`asp.graph.state_keys.OperationModel`), layer by
         layer; state 0 is the start.
     layer_ptr : (L + 2,) int64
         States of layer ``l`` (``l`` operations done) are ``layer_ptr[l]:layer_ptr[l + 1]``.
@@ -126,7 +121,7 @@ class StateGraph:
     def parts(self) -> np.ndarray:
         """(N, PW) uint64: assembled-part set of each state (``PW`` words, see
         :class:`asp.graph.feasibility.InsertionOracle`), computed from the keys on each call
-        (:meth:`asp.graph.feasibility.OperationModel.parts_of`): not stored, a state's parts are
+        (:meth:`asp.graph.state_keys.OperationModel.parts_of`): not stored, a state's parts are
         those of its done operations."""
         return self.model.parts_of(self.keys)
 
@@ -266,7 +261,7 @@ def build_state_graph(
         sequence exists.
     drop_stuck : bool
         Leave out the states in which some part still to come is blocked along every
-        direction (:meth:`asp.graph.feasibility.OperationModel.stuck`): dead ends, which the game
+        direction (:meth:`asp.graph.state_keys.OperationModel.stuck`): dead ends, which the game
         drops anyway (TCT and W* do not change), but not the states an infeasibility report
         or the automatic subassemblies look at.
     max_memory : int, optional

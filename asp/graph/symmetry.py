@@ -381,9 +381,9 @@ def reduce_interchangeable(spec: AssemblySpec, relations) -> AssemblySpec:
 def _reduced(spec: AssemblySpec, relations, concurrent: bool):
     """:func:`reduce_interchangeable` and, with ``concurrent``, the chains of the classes
     of blocks kept in a loose order instead, with their slack (``(m, ids)`` for
-    :func:`asp.graph.feasibility.operation_model`'s ``loose``), the classes of blocks ordered,
+    :func:`asp.graph.state_keys.operation_model`'s ``loose``), the classes of blocks ordered,
     and those put in a fixed order at every position (``fixed``, for
-    :attr:`asp.graph.feasibility.OperationModel.fixed`).
+    :attr:`asp.graph.state_keys.OperationModel.fixed`).
 
     The slack of position ``p`` of a class's blocks is ``s(p) = s(p - 1) + m(p)``, ``m(p)``
     the :func:`class_slack` of the operations at ``p`` (``s(-1) = 0``): the block to move,
@@ -447,7 +447,7 @@ def symmetry_reduction(
     Classes of blocks that are chains are put in a fixed order position by position
     (:func:`reduce_interchangeable`): the alternating game keeps its values. With
     ``concurrent`` (a graph for the concurrent game too) they keep a *loose* order
-    instead (``(m, ids)``, :meth:`asp.graph.feasibility.OperationModel._loose_order`, the slack
+    instead (``(m, ids)``, :meth:`asp.graph.state_keys.OperationModel._loose_order`, the slack
     of :func:`_reduced`), so that two of them may still run at once: a fixed order would
     forbid it and change the concurrent game's W* (the CP-SAT schedule undoes a fixed
     order instead, :mod:`asp.graph.fixed_order`).
@@ -456,7 +456,7 @@ def symmetry_reduction(
     three times around a drive) cannot be put in a fixed order by precedences; its first
     operations are chained when a block has one operation every other of it needs, and the
     state graph moves only the first of equal blocks
-    (:meth:`asp.graph.feasibility.OperationModel.enabled`, pass the classes as
+    (:meth:`asp.graph.state_keys.OperationModel.enabled`, pass the classes as
     ``operation_model(..., symmetric=...)``): the alternating game's values only.
     """
     model, why, _ = derive(spec, relations)
@@ -487,8 +487,8 @@ def reduced_state_graph(spec: AssemblySpec, relations, *, concurrent: bool = Fal
     file's ``interchangeable``: a runtime maps an alike physical operation onto the
     canonical one the graph keeps).
     """
-    from asp.graph.feasibility import operation_model
     from asp.graph.state_graph import build_state_graph
+    from asp.graph.state_keys import operation_model
 
     reduced, others, loose, classes, fixed = symmetry_reduction(
         spec, relations, concurrent=concurrent

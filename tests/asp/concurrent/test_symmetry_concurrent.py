@@ -4,7 +4,7 @@ A fixed order of alike parts would forbid placing two of them at once (the concu
 game runs two operations together only if both orders are transitions), so the graph for
 the concurrent game (``reduced_state_graph(..., concurrent=True)``) keeps alike operations
 that several workers may do in a loose order instead
-(:meth:`asp.graph.feasibility.OperationModel._loose_order`): W*(k) and W*(inf) on the reduced
+(:meth:`asp.graph.state_keys.OperationModel._loose_order`): W*(k) and W*(inf) on the reduced
 graph equal the full graph's, in the main assembly and in a unit's workspace.
 """
 

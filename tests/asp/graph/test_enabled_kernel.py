@@ -6,7 +6,8 @@ import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from asp.graph.feasibility import operation_model, pack_words, unpack_words
+from asp.graph.feasibility import pack_words, unpack_words
+from asp.graph.state_keys import operation_model
 from asp.spec import with_subassemblies
 from tests.asp.graph.test_symmetry_ring import _random_spec, _random_tables
 

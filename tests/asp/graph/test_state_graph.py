@@ -9,9 +9,10 @@ from hypothesis import strategies as st
 
 from asp.game.dag import ANY, HUMAN, ROBOT
 from asp.game.solve import solve
-from asp.graph.feasibility import insertion_oracle, operation_model
+from asp.graph.feasibility import insertion_oracle
 from asp.graph.game_dag import game_dag
 from asp.graph.state_graph import _projected, build_state_graph
+from asp.graph.state_keys import operation_model
 from asp.spec import spec_from_dict
 from tests.asp.helpers_assembly import (
     brute_force_downsets,

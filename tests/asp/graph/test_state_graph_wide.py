@@ -13,9 +13,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from asp.game.solve import solve
-from asp.graph.feasibility import operation_model
 from asp.graph.game_dag import game_dag
 from asp.graph.state_graph import build_state_graph
+from asp.graph.state_keys import operation_model
 from asp.spec import spec_from_dict
 from tests.asp.helpers_assembly import precedence_spec, stack_relations, stack_spec
 
