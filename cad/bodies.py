@@ -29,6 +29,20 @@ The rule, in this order:
    a body written inside out (the toy truck's mixer drum), and is turned.
 
 Bodies come in the order of their first face in the mesh.
+
+**Shells a STEP declares** (``shells``: the face count of each closed shell of the file's
+one solid, :func:`cad.step.solid_shells`). Shells resting face to face on each other at
+edges that do not meet end to end (T-junctions: the toy truck's cabin, chassis and drum
+supports) stay one piece by rule 1. A STEP says how many shells there are and how many
+B-rep faces each has, and OCCT tessellates each B-rep face as a patch of its own vertices,
+a shell's faces one after the other (the shells themselves in an order of OCCT's). So when
+the mesh's patches (faces joined by shared vertex indices) come in runs, as many as the
+file's faces, the mesh is cut into consecutive runs of patches, one block per shell, each
+block closed (rule 2's test) and connected (joined by positions), the blocks' sizes being
+the shells' face counts, every one used once (:func:`_declared_shells`; a depth-first
+search from the first patch, the smaller size first). A union of several shells, or an
+open part of one, fails one of the tests, so a block that passes is one shell. With no
+such cut, rule 1 applies as before.
 """
 
 from __future__ import annotations
@@ -49,13 +63,18 @@ FLUSH_RADIANS = 1e-3
 shells touching; the tessellations of one curved contact differ by about 2e-5 rad)."""
 
 
-def closed_bodies(mesh: trimesh.Trimesh) -> tuple[trimesh.Trimesh, ...] | None:
+def closed_bodies(
+    mesh: trimesh.Trimesh, shells: tuple[int, ...] | None = None
+) -> tuple[trimesh.Trimesh, ...] | None:
     """The closed bodies of ``mesh`` when it holds two or more, else None.
 
     Parameters
     ----------
     mesh : trimesh.Trimesh
         One part's mesh, in any unit and frame.
+    shells : tuple of int, optional
+        The face count of each shell of the STEP solid the mesh tessellates (the module's
+        "Shells a STEP declares"); None: the mesh alone decides.
 
     Returns
     -------
@@ -67,7 +86,8 @@ def closed_bodies(mesh: trimesh.Trimesh) -> tuple[trimesh.Trimesh, ...] | None:
     faces = np.asarray(mesh.faces)
     if len(faces) < 8:
         return None
-    labels = _pieces(mesh)
+    labels = _declared_shells(mesh, shells) if shells and len(shells) > 1 else None
+    labels = _pieces(mesh) if labels is None else labels
     count = int(labels.max()) + 1
     if count < 2:
         return None
@@ -87,6 +107,91 @@ def closed_bodies(mesh: trimesh.Trimesh) -> tuple[trimesh.Trimesh, ...] | None:
         pieces = [_piece_mesh(mesh, labels, k, turn=volume[k] < 0 and k == body) for k in members]
         bodies.append(pieces[0] if len(pieces) == 1 else trimesh.util.concatenate(pieces))
     return tuple(bodies) if len(bodies) >= 2 else None
+
+
+SEARCH_STEPS = 200_000
+"""Most blocks tried by :func:`_declared_shells` before it gives up (rule 1 then applies)."""
+
+
+def _declared_shells(mesh: trimesh.Trimesh, shells: tuple[int, ...]) -> np.ndarray | None:
+    """A shell label per face: the mesh's patches (faces joined by vertex index) cut into
+    consecutive blocks, one per declared shell (module docstring), or None when the
+    patches do not come in one run each, their count is not the faces declared, or no cut
+    passes the tests within :data:`SEARCH_STEPS` blocks tried."""
+    faces = np.asarray(mesh.faces)
+    n_vertices = len(mesh.vertices)
+    rows = np.concatenate([faces[:, 0], faces[:, 1]])
+    cols = np.concatenate([faces[:, 1], faces[:, 2]])
+    graph = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(n_vertices, n_vertices))
+    n_patches, vertex_patch = connected_components(graph, directed=False)
+    patch = vertex_patch[faces[:, 0]]
+    starts = np.r_[True, patch[1:] != patch[:-1]]
+    if n_patches != sum(shells) or int(starts.sum()) != n_patches:
+        return None
+    run = np.cumsum(starts) - 1  # the patch of each face, numbered in face order
+    areas = np.asarray(mesh.area_faces)
+    vector = np.zeros((n_patches, 3))
+    np.add.at(vector, run, np.asarray(mesh.face_normals) * areas[:, None])
+    cum_vector = np.vstack([np.zeros(3), np.cumsum(vector, axis=0)])
+    cum_area = np.r_[0.0, np.cumsum(np.bincount(run, weights=areas, minlength=n_patches))]
+    vertices = np.asarray(mesh.vertices, dtype=float)
+    size = float(np.linalg.norm(np.ptp(vertices, axis=0))) or 1.0
+    grid = np.round(vertices / (size * 10.0**-MERGE_DIGITS)).astype(np.int64)
+    position = np.unique(grid, axis=0, return_inverse=True)[1].reshape(-1)[faces]
+    first_face = np.r_[np.flatnonzero(starts), len(faces)]
+    tested: dict[tuple[int, int], bool] = {}
+
+    def one_shell(i: int, j: int) -> bool:
+        """Patches ``i .. j-1``: closed (rule 2) and connected by positions."""
+        if (i, j) not in tested:
+            area = cum_area[j] - cum_area[i]
+            ok = bool(np.linalg.norm(cum_vector[j] - cum_vector[i]) <= CLOSED_VECTOR_AREA * area)
+            if ok:
+                block = position[first_face[i] : first_face[j]]
+                used, local = np.unique(block, return_inverse=True)
+                k = len(block)
+                link = coo_matrix(
+                    (np.ones(3 * k), (np.repeat(np.arange(k), 3), k + local.reshape(-1))),
+                    shape=(k + len(used),) * 2,
+                )
+                ok = connected_components(link, directed=False)[0] == 1
+            tested[(i, j)] = ok
+        return tested[(i, j)]
+
+    left: dict[int, int] = {}
+    for count in shells:
+        left[count] = left.get(count, 0) + 1
+    cut: list[int] = []
+    steps = [0]
+
+    def search(i: int) -> bool:
+        if i == n_patches:
+            return True
+        for count in sorted(left):
+            if not left[count] or i + count > n_patches or steps[0] > SEARCH_STEPS:
+                continue
+            steps[0] += 1
+            if one_shell(i, i + count):
+                left[count] -= 1
+                cut.append(count)
+                if search(i + count):
+                    return True
+                left[count] += 1
+                cut.pop()
+        return False
+
+    import sys
+
+    depth = sys.getrecursionlimit()
+    sys.setrecursionlimit(max(depth, len(shells) + 100))
+    try:
+        found = search(0)
+    finally:
+        sys.setrecursionlimit(depth)
+    if not found:
+        return None
+    block_of_patch = np.repeat(np.arange(len(cut)), cut)
+    return block_of_patch[run]
 
 
 def _pieces(mesh: trimesh.Trimesh) -> np.ndarray:

@@ -41,7 +41,7 @@ from cad.readers import (  # noqa: F401  (re-exported: cad.scene is where caller
     is_step,
     reader_for,
 )
-from cad.step import document_files
+from cad.step import document_files, solid_shells
 from cad.units import canonical_unit, unit_scale
 
 MAX_ID_LENGTH = 32
@@ -346,7 +346,8 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
     bases = _alike_bases(bases, generic, meshes)
     ids = unique_ids(bases)
     split = ()
-    if len(meshes) == 1 and (bodies := closed_bodies(meshes[0])) is not None:
+    shells = solid_shells(file) if len(meshes) == 1 and is_format(file, "STEP") else None
+    if len(meshes) == 1 and (bodies := closed_bodies(meshes[0], shells)) is not None:
         split = ((ids[0], tuple(f"{ids[0]}_body_{n}" for n in range(1, len(bodies) + 1))),)
         meshes, names = list(bodies), [f"{names[0]} body {n}" for n in range(1, len(bodies) + 1)]
         part_nodes, ids = part_nodes * len(bodies), list(split[0][1])

@@ -134,6 +134,39 @@ def solid_count(body: bytes) -> int:
     return len(re.findall(rb"#\d+\s*=\s*(?:" + names + rb")\s*\(", body))
 
 
+def solid_shells(path: Path) -> tuple[int, ...] | None:
+    """The face count of each closed shell of a STEP file's one solid, outer shell first,
+    when that solid is a ``BREP_WITH_VOIDS`` (FreeCAD writes a product fused into one solid
+    so, each body a shell: the APLAN toy truck's 61); None for any other file (several
+    solids, no voids, unreadable text). :func:`cad.bodies.closed_bodies` cuts the mesh by
+    these counts."""
+    try:
+        body = _STRING.sub(b"''", path.read_bytes())
+    except OSError:
+        return None
+    if solid_count(body) != 1:
+        return None
+    solid = re.search(rb"#\d+\s*=\s*BREP_WITH_VOIDS\s*\((.*?)\)\s*;", body, flags=re.S)
+    if solid is None:
+        return None
+    shells = {
+        int(k): (kind, args)
+        for k, kind, args in re.findall(
+            rb"#(\d+)\s*=\s*((?:ORIENTED_)?CLOSED_SHELL)\s*\((.*?)\)\s*;", body, flags=re.S
+        )
+    }
+    counts = []
+    for ref in (int(k) for k in re.findall(rb"#(\d+)", solid.group(1))):
+        kind, args = shells.get(ref, (b"", b""))
+        if kind == b"ORIENTED_CLOSED_SHELL":
+            inner = re.findall(rb"#(\d+)", args)
+            kind, args = shells.get(int(inner[0]), (b"", b"")) if inner else (b"", b"")
+        if kind != b"CLOSED_SHELL":
+            return None
+        counts.append(len(re.findall(rb"#\d+", args)))
+    return tuple(counts) if len(counts) > 1 else None
+
+
 def undefined_references(body: bytes) -> list[int]:
     """Entity ids a file's text (string literals emptied) refers to (``#n`` in an entity)
     but never defines, ascending."""

@@ -35,6 +35,20 @@ def test_the_toy_truck_is_its_bodies():
     assert all(pid.startswith("cement_mixer_truck_body_") for pid in scene.ids)
 
 
+def test_the_toy_truck_is_its_61_declared_shells():
+    """The APLAN toy truck (one BREP_WITH_VOIDS of 61 shells, 542 faces): every shell a
+    closed body, when the file is at hand."""
+    from cad.step import solid_shells
+
+    path = public("toy_truck.stp")
+    shells = solid_shells(path)
+    assert len(shells) == 61 and sum(shells) == 542
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        scene = read_scene(path)
+    assert len(scene.ids) == 61 and all(m.is_watertight for m in scene.meshes)
+
+
 def test_a_single_shell_part_stays_one_part():
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

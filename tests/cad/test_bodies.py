@@ -251,3 +251,33 @@ def test_locking_parts_of_one_sub_assembly_are_one_rigid_part(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         assert load_assembly(apart).ids == ("link_a", "link_b", "plate")
+
+
+def brep_patches(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
+    """``mesh`` as OCCT tessellates a B-rep: each planar face (facet) a patch of its own
+    vertices, the patches one after the other."""
+    pieces = []
+    for facet in mesh.facets:
+        tri = np.asarray(mesh.faces)[facet]
+        used, local = np.unique(tri, return_inverse=True)
+        pieces.append(trimesh.Trimesh(mesh.vertices[used], local.reshape(-1, 3), process=False))
+    return trimesh.util.concatenate(pieces)
+
+
+def slab_on_block():
+    """A 20 x 20 x 5 slab on a 10 mm cube, one corner and two edges flush: the cube's top
+    edges end halfway along the slab's (T-junctions), so by positions the two are one
+    piece that cannot be cut at their contact."""
+    cube = brep_patches(box([10, 10, 10], [5, 5, 5]))
+    slab = brep_patches(box([20, 20, 5], [10, 10, 12.5]))
+    return fused(cube, slab)
+
+
+def test_the_shells_a_step_declares_cut_a_fused_mesh_into_its_bodies():
+    mesh = slab_on_block()
+    assert closed_bodies(mesh) is None  # the mesh alone: one piece
+    bodies = closed_bodies(mesh, shells=(6, 6))
+    assert volumes(bodies) == [1000.0, 2000.0]
+    assert all(b.is_watertight for b in (trimesh.Trimesh(b.vertices, b.faces) for b in bodies))
+    assert closed_bodies(mesh, shells=(5, 7)) is None  # no cut closes both: as before
+    assert closed_bodies(mesh, shells=(6, 5)) is None  # not the faces declared
