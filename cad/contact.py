@@ -41,6 +41,7 @@ open part having no face to rest on, as support along it.
 from __future__ import annotations
 
 import numpy as np
+from scipy.sparse.csgraph import connected_components
 
 from cad.assembly import Assembly
 from cad.faces import FaceSet, axis_face_sets, bounds_overlap, crop_pair, unit_normals
@@ -202,46 +203,62 @@ def distance_contacts(assembly: Assembly, tols, tc: np.ndarray) -> list[tuple[in
 
 
 NEAREST_SHARE = 0.5
-"""A part touching no other part is taken as touching its nearest part when the gap is at
-most this share of the smaller part's bounding-box diagonal (:func:`nearest_contacts`)."""
+"""Pieces of the contact graph are joined across a gap of at most this share of the
+smaller part's bounding-box diagonal (:func:`nearest_contacts`)."""
 
 
 def nearest_contacts(assembly: Assembly, tc: np.ndarray) -> list[tuple[int, int, int, float]]:
-    """``(a, b, d, gap)``: each part ``a`` that touches no other part (``tc``) while other
-    parts touch, with the part ``b`` nearest to it, on its ``d`` side (the axis of the
-    centroids' offset), when the gap is at most :data:`NEAREST_SHARE` of the smaller part's
-    diagonal (none when no two parts touch at all: then the contact tolerance or the unit
-    is the question, not a part off the product).
+    """``(a, b, d, gap)``: the pairs across a model's gaps that join the parts' contact graph
+    (``tc``, either way) into one piece: the pair of parts of two different pieces with the
+    smallest gap first, then the next, as a minimum spanning forest of the pieces; a pair
+    is taken only when its gap is at most :data:`NEAREST_SHARE` of the smaller part's
+    diagonal, ``b`` on the ``d`` side of ``a`` (the axis of the centroids' offset). None
+    when no two parts touch at all (then the contact tolerance or the unit is the question,
+    not parts off the product).
 
-    Why: a part may only be inserted touching the parts already there, so a part that
-    touches nothing in the finished product can never be inserted, and the file has no
-    plan. A visual model floats such parts a little off the part they are fixed to (a
-    mounting plate 2.3 mm off a satellite's front, the fasteners not modelled); taking the
-    nearest as touching changes only such files, and only for that pair."""
+    Why: a part may only be inserted touching the parts already there, so the parts
+    placed always form one piece of the contact graph, and a product whose graph is in
+    pieces has no plan. A visual model floats parts a little off the part they are fixed
+    to (a satellite's mounting plate 2.3 mm off its front, a board on stand-offs short of
+    it, the fasteners not modelled); joining the pieces by their nearest parts changes only
+    such files, and only those pairs."""
     import fcl
 
     parts = assembly.parts
     n = len(parts)
     touches = np.asarray(tc, bool).any(axis=2)
-    lonely = [a for a in range(n) if not (touches[a].any() or touches[:, a].any())]
-    if not touches.any() or not lonely:  # nothing touches: a tolerance, not a model's gap
+    touches = touches | touches.T
+    if not touches.any():  # nothing touches: a tolerance, not a model's gap
+        return []
+    piece = connected_components(touches, directed=False)[1]
+    if piece.max() == 0:
         return []
     objects = [_fcl_object(p.mesh) for p in parts]
     diagonal = [float(np.linalg.norm(np.ptp(p.bounds, axis=0))) for p in parts]
+    pairs = []
+    for a in range(n):
+        for b in range(a + 1, n):
+            if piece[a] == piece[b]:
+                continue
+            gap = fcl.distance(objects[a], objects[b], fcl.DistanceRequest(), fcl.DistanceResult())
+            if gap <= NEAREST_SHARE * min(diagonal[a], diagonal[b]):
+                pairs.append((float(gap), a, b))
+    root = list(range(int(piece.max()) + 1))
+
+    def find(k: int) -> int:
+        while root[k] != k:
+            root[k] = root[root[k]]
+            k = root[k]
+        return k
+
     found = []
-    for a in lonely:
-        gaps = [
-            fcl.distance(objects[a], objects[b], fcl.DistanceRequest(), fcl.DistanceResult())
-            if b != a
-            else np.inf
-            for b in range(n)
-        ]
-        b = int(np.argmin(gaps))
-        if gaps[b] > NEAREST_SHARE * min(diagonal[a], diagonal[b]):
+    for gap, a, b in sorted(pairs):
+        if find(piece[a]) == find(piece[b]):
             continue
+        root[find(piece[b])] = find(piece[a])
         delta = _surface_centroid(parts[b].mesh) - _surface_centroid(parts[a].mesh)
         axis = int(np.argmax(np.abs(delta)))
-        found.append((a, b, 2 * axis + (0 if delta[axis] >= 0 else 1), float(gaps[b])))
+        found.append((a, b, 2 * axis + (0 if delta[axis] >= 0 else 1), gap))
     return found
 
 

@@ -61,10 +61,10 @@ class Relations:
         part: they touch and rest on each other along every direction, neither blocks the
         other (:func:`cad.fits.accepted_overlap`).
     nearest : tuple of (str, str, int, float)
-        Parts that touch no other part while others touch, each with the part nearest to
-        it: (part, nearest part, direction index of the nearest part's side, gap in mm)
-        (:func:`cad.contact.nearest_contacts`); not in ``tc``: :func:`with_nearest` adds
-        them, as the planner reads a file.
+        Pairs across the model's gaps that join the contact graph's pieces into one (a
+        plate floating off the part it is fixed to): (part, part, direction index of the
+        second's side, gap in mm) (:func:`cad.contact.nearest_contacts`); not in ``tc``:
+        :func:`with_nearest` adds them, as the planner reads a file.
     """
 
     parts: tuple[str, ...]
@@ -211,10 +211,10 @@ def compute_relations(
 
 
 def with_nearest(relations: Relations) -> Relations:
-    """``relations`` with each part that touches no other part taken as touching its
-    nearest part (``relations.nearest``, :func:`cad.contact.nearest_contacts`: contact and
-    support across the gap, both ways), as the planner reads a file; one warning names
-    them. Unchanged when there are none."""
+    """``relations`` with the pieces of its contact graph joined by their nearest parts
+    (``relations.nearest``, :func:`cad.contact.nearest_contacts`: contact and support
+    across the gap, both ways), as the planner reads a file; one warning names them.
+    Unchanged when there are none."""
     if not relations.nearest:
         return relations
     from dataclasses import replace
@@ -231,8 +231,8 @@ def with_nearest(relations: Relations) -> Relations:
     shown = ", ".join(f"{a} to {b} ({gap:.3g} mm)" for a, b, _, gap in found[:10])
     more = f" and {len(found) - 10} more" if len(found) > 10 else ""
     warnings.warn(
-        f"{len(found)} part(s) touch no other part, each taken as touching the part nearest "
-        f"to it across the model's gap (cad/contact.py): {shown}{more}",
+        f"the parts touch in {len(found) + 1} or more pieces, joined by the nearest parts "
+        f"across the model's gaps, each pair taken as touching (cad/contact.py): {shown}{more}",
         stacklevel=2,
     )
     return replace(relations, tc=tc, sp=sp)

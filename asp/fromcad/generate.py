@@ -183,7 +183,8 @@ def spec_geometry(spec: AssemblySpec):
 def spec_hierarchy(spec: AssemblySpec) -> tuple[tuple[str, tuple[str, ...]], ...]:
     """The CAD file's hierarchy over ``spec``'s parts: group id -> the spec's part ids.
 
-    Parts named ``scene#node`` are looked up in their scene's tree (:mod:`cad.scene`);
+    Parts named ``scene#node`` are looked up in their scene's tree (:mod:`cad.scene`), a
+    part joined of nodes (``scene#a+b+c``, :mod:`cad.merging`) standing for each of them;
     groups keep the spec's parts among their members and count when two or more remain.
     Outermost groups first; empty when no part comes from a scene with a hierarchy.
     """
@@ -194,13 +195,15 @@ def spec_hierarchy(spec: AssemblySpec) -> tuple[tuple[str, tuple[str, ...]], ...
         name, _, node = str(part.file or "").partition("#")
         if node:
             scene = read_scene(spec.folder / name)
-            k = scene.find(node)
-            if k is not None:
+            found = [scene.find(node)] if scene.find(node) is not None else []
+            if not found and "+" in node:
+                found = [k for k in map(scene.find, node.split("+")) if k is not None]
+            for k in found:
                 by_file.setdefault(name, {})[scene.ids[k]] = part.id
     out = []
     for name, spec_id in by_file.items():
         for gid, members in read_scene(spec.folder / name).groups:
-            mapped = tuple(spec_id[m] for m in members if m in spec_id)
+            mapped = tuple(dict.fromkeys(spec_id[m] for m in members if m in spec_id))
             if len(mapped) >= 2:
                 out.append((gid, mapped))
     return tuple(out)

@@ -324,8 +324,8 @@ def spec_relations(spec: AssemblySpec, geometry, *, progress: bool = False):
     """The cad relations of ``geometry``, the meshes of ``spec``'s parts already read.
 
     With the spec's ``contact_tol`` and ``penetration_tol`` (None: the per-part rule), its
-    ``overlap_ok`` pairs and its ``flex`` parts (:func:`asp.cad_keys.with_flex`); a part
-    that touches no other part touches its nearest (:func:`cad.relations.with_nearest`).
+    ``overlap_ok`` pairs and its ``flex`` parts (:func:`asp.cad_keys.with_flex`); a contact
+    graph in pieces has them joined by its nearest parts (:func:`cad.relations.with_nearest`).
     """
     import cad
     from asp.cad_keys import with_flex

@@ -257,11 +257,12 @@ def test_open_disc_springs_sunk_into_each_other_are_an_error():
         compute_relations(shapes.open_disc_springs(sink=1.5))
 
 
-def test_a_part_touching_nothing_touches_its_nearest_part():
+def test_pieces_of_the_contact_graph_are_joined_by_their_nearest_parts():
     """A lid floating 1 mm over a box on its foot (a visual model's gap) could never be
-    inserted: it is taken as touching the box, its nearest part, from above; a block far
-    off, 30 mm from everything (over half its own diagonal), is left alone; one warning
-    names them. Where no two parts touch at all nothing is added (the gap tests above)."""
+    inserted: the contact graph's pieces are joined by their nearest parts, the lid
+    touching the box from above; a block far off, 30 mm from everything (over half its
+    own diagonal), is left alone; one warning names them. Where no two parts touch at all
+    nothing is added (the gap tests above)."""
     import warnings
 
     meshes = {
@@ -275,9 +276,9 @@ def test_a_part_touching_nothing_touches_its_nearest_part():
         warnings.simplefilter("always")
         rel = with_nearest(raw)
     box, lid, far = (rel.parts.index(p) for p in ("box", "lid", "far"))
-    assert raw.nearest == (("lid", "box", 5, 1.0),) and not raw.tc[lid].any()
+    assert raw.nearest == (("box", "lid", 4, 1.0),) and not raw.tc[lid].any()
     assert rel.tc[lid, box].tolist() == [False] * 5 + [True]  # the box is below it (-z)
     assert rel.tc[box, lid, 4] and rel.sp[lid, box, 5]
     assert not rel.tc[far].any() and not rel.tc[:, far].any()
-    told = [str(w.message) for w in said if "touch no other part" in str(w.message)]
-    assert len(told) == 1 and "lid to box (1 mm)" in told[0]
+    told = [str(w.message) for w in said if "joined by the nearest parts" in str(w.message)]
+    assert len(told) == 1 and "box to lid (1 mm)" in told[0]
