@@ -82,6 +82,7 @@ from cad.bom import PartRecord, part_records, refuse_unknown_keys
 from cad.directions import DIRECTIONS
 from cad.frame import parse_frame
 from cad.numbers import WRITTEN_PLAINLY, plain_number
+from cad.texts import MAX_NAME, MAX_TEXT, bounded
 from cad.tolerances import checked_tolerance
 from cad.units import unit_scale
 from cad.yamlfile import read_yaml
@@ -351,10 +352,18 @@ class _Parser:
     def text(self, value, key: str) -> str:
         if value is None or isinstance(value, dict | list):
             raise self.fail(key, f"expected a name, got {value!r}")
-        out = str(value).strip()
+        out = self.bounded(str(value).strip(), key)
         if not out:
             raise self.fail(key, "expected a non-empty name")
         return out
+
+    def bounded(self, text: str, key: str, limit: int = MAX_NAME) -> str:
+        """``text`` within :func:`cad.texts.bounded`'s limit (a name's by default)."""
+        return bounded(text, f"{self.source}: {key}", limit)
+
+    def prose(self, value, key: str) -> str:
+        """A free description (empty when absent), at most :data:`cad.texts.MAX_TEXT`."""
+        return self.bounded("" if value is None else str(value), key, MAX_TEXT)
 
     def mapping(self, value, key: str, known: tuple[str, ...] = ()) -> dict:
         """A mapping (None: empty); with ``known``, any other key is refused."""
@@ -434,7 +443,9 @@ class _Parser:
         except ValueError as exc:
             raise self.fail("frame", str(exc)) from None
         spec = AssemblySpec(
-            name=str(data.get("name") or Path(self.source).parent.name or "assembly"),
+            name=self.bounded(
+                str(data.get("name") or Path(self.source).parent.name or "assembly"), "name"
+            ),
             operations=ops,
             agents=agents,
             parts=parts,
@@ -447,7 +458,7 @@ class _Parser:
             cost=cost,
             source=self.source,
             units=None if units is None else str(units),
-            credit=str(data.get("credit", "")),
+            credit=self.prose(data.get("credit", ""), "credit"),
             max_states=max_states,
             frame=frame,
             flex=parse_flex(data.get("flex"), part_ids, self.source),
@@ -509,7 +520,8 @@ class _Parser:
                 raise self.fail(
                     f"agents.{name}.side", f"expected human, robot or any, got {item.get('side')!r}"
                 )
-            out.append(Agent(name=name, side=side, description=str(item.get("description", ""))))
+            description = self.prose(item.get("description", ""), f"agents.{name}.description")
+            out.append(Agent(name=name, side=side, description=description))
         return tuple(out)
 
     def tools(self, raw) -> tuple[Tool, ...]:
@@ -602,7 +614,7 @@ class _Parser:
             ops.append(
                 Operation(
                     id=oid,
-                    description=str(item.get("description") or ""),
+                    description=self.prose(item.get("description") or "", f"{where}.description"),
                     durations=tuple(durations),
                     parts=placed,
                     requires=tool_pairs["requires"],

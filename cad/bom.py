@@ -22,6 +22,7 @@ from typing import Any
 
 from cad.errors import AsmplanError
 from cad.numbers import WRITTEN_PLAINLY, plain_integer
+from cad.texts import MAX_TEXT, bounded
 from cad.yamlfile import read_yaml
 
 PART_KEYS = ("id", "name", "file", "quantity", "type", "shape")
@@ -95,15 +96,17 @@ def part_record(row: Any, where: str) -> PartRecord:
     refuse_unknown_keys(row, PART_KEYS, where)
     raw_id = row.get("id")
     pid = "" if raw_id is None or isinstance(raw_id, dict | list) else str(raw_id).strip()
+    pid = bounded(pid, f"{where}: id")
     if not pid:
         raise AsmplanError(f"{where}: part has no id")
+    at = f"{where} (part {pid!r})"
     return PartRecord(
         id=pid,
-        name=_text(row.get("name")) or pid,
-        file=_text(row.get("file")) or None,
-        quantity=_quantity(row.get("quantity"), f"{where} (part {pid!r})"),
-        type=_text(row.get("type")),
-        shape=_text(row.get("shape")),
+        name=bounded(_text(row.get("name")), f"{at}: name") or pid,
+        file=bounded(_text(row.get("file")), f"{at}: file", MAX_TEXT) or None,
+        quantity=_quantity(row.get("quantity"), at),
+        type=bounded(_text(row.get("type")), f"{at}: type"),
+        shape=bounded(_text(row.get("shape")), f"{at}: shape"),
     )
 
 

@@ -34,6 +34,7 @@ from asp.atomic import write_bytes, write_text
 from asp.errors import FormatError, GraphError
 from asp.game.dag import MAX_COST, SIDE_NAMES, GameDAG, from_edges, from_networkx, side_from_name
 from asp.numbers import json_number, plain
+from cad.texts import bounded
 
 FORMAT = "asmplan-dag/1"
 JSON_SUFFIXES = (".json",)
@@ -98,6 +99,9 @@ def dag_from_dict(data: dict, source: str = "<dict>") -> GameDAG:
         _check_ids(
             source, "start/end", [data[k] for k in ("start", "end") if data.get(k) is not None]
         )
+        _check_texts(source, "node label", labels)
+        _check_texts(source, "edge operation", [e.get("operation") for e in edges])
+        _check_texts(source, "edge agent", [e.get("agent") for e in edges])
         costs = [float(e.get("cost", 1)) for e in edges]
         sides = [side_from_name(e.get("side", "any")) for e in edges]
         has_ops = any("operation" in e for e in edges)
@@ -131,6 +135,14 @@ def _check_ids(source: str, what: str, values: list) -> None:
             raise FormatError(
                 f"{source}: {what} {json.dumps(value)}: expected a string or an integer"
             )
+    _check_texts(source, what, values)
+
+
+def _check_texts(source: str, what: str, values: list) -> None:
+    """Every text at most a name long (:func:`cad.texts.bounded`)."""
+    for k, value in enumerate(values):
+        if isinstance(value, str):
+            bounded(value, f"{source}: {what} {k + 1}")
 
 
 def load_dag(path: str | os.PathLike[str]) -> GameDAG:

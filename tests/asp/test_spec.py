@@ -215,3 +215,36 @@ def test_a_self_referencing_yaml_is_refused(tmp_path):
     path.write_text("name: &x [*x]\n")
     with pytest.raises(ValueError, match="expands to more than"):
         load_spec(path)
+
+
+LONG_NAME, LONG_TEXT = "n" * 201, "t" * 2001
+
+
+@pytest.mark.parametrize(
+    ("path", "value", "where"),
+    [
+        (("name",), LONG_NAME, "toy.yaml: name: 201 characters"),
+        (("credit",), LONG_TEXT, "toy.yaml: credit: 2,001 characters"),
+        (("operations", 0, "id"), LONG_NAME, "operations[0].id: 201 characters"),
+        (("operations", 0, "description"), LONG_TEXT, "operations[1].description: 2,001"),
+        (("operations", 1, "after"), [LONG_NAME], "operations[2].after: 201"),
+        (("agents", "H", "description"), LONG_TEXT, "agents.H.description: 2,001"),
+        (("tools", "R1.bit", "initial"), LONG_NAME, "tools.R1.bit.initial: 201"),
+        (("parts", 1, "name"), LONG_NAME, "(part 'B'): name: 201 characters"),
+        (("parts", 1, "id"), LONG_NAME, "id: 201 characters"),
+        (("parts", 1, "file"), LONG_TEXT, "(part 'B'): file: 2,001 characters"),
+    ],
+)
+def test_every_free_text_is_bounded(path, value, where):
+    """Issue 26 item 13: a 5 MB name kept `plan` drawing its figures for minutes; every
+    name is at most 200 characters and every description 2,000 (cad.texts), refused in one
+    line naming the file, the key and the length."""
+    with pytest.raises(ValueError, match="over the limit of") as info:
+        spec_from_dict(variant(path, value), source="toy.yaml")
+    message = str(info.value)
+    assert where in message and "\n" not in message and len(message) < 300, message
+    at_limit = (
+        value[:200] if len(value) == 201 else value[:2000] if isinstance(value, str) else None
+    )
+    if at_limit is not None and path[-1] not in ("id", "initial"):  # ids must stay consistent
+        spec_from_dict(variant(path, at_limit), source="toy.yaml")  # the bound itself is fine

@@ -158,3 +158,28 @@ def test_numbers_past_the_limit_and_deep_nesting_are_refused(tmp_path, content, 
     with pytest.raises(ValueError, match=message) as info:
         load_dag(path)
     assert "bad.json" in str(info.value)
+
+
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        (lambda d: d["nodes"].__setitem__(0, {"id": "s" * 201}), "node id 1: 201 characters"),
+        (lambda d: d["edges"][0].__setitem__("operation", "o" * 201), "edge operation 1: 201"),
+        (lambda d: d["edges"][0].__setitem__("agent", "a" * 201), "edge agent 1: 201"),
+    ],
+)
+def test_texts_of_a_dag_file_are_bounded(tmp_path, change, message):
+    """Issue 26 item 13: every id and label at most a name long (cad.texts.bounded)."""
+    data = {
+        "format": "asmplan-dag/1",
+        "nodes": ["s", "t"],
+        "edges": [{"source": "s", "target": "t", "cost": 1, "side": "robot"}],
+        "start": "s",
+        "end": "t",
+    }
+    change(data)
+    path = tmp_path / "g.json"
+    path.write_text(json.dumps(data))
+    with pytest.raises(ValueError, match="over the limit of 200") as info:
+        load_dag(path)
+    assert message in str(info.value) and "\n" not in str(info.value)
