@@ -135,6 +135,7 @@ def test_an_infeasible_assembly_graph_is_built_once(monkeypatch, proved):
     holders' units) is reduced once and its graph built once checked, once unchecked at
     most, never again by a first round of the pipeline's own; ``proved=False``: the
     derived precedences prove nothing, the state graph finds the stuck parts itself."""
+    import asp.graph.precedences
     import asp.graph.state_graph
     import asp.graph.symmetry
     from cad import Assembly, compute_relations
@@ -154,7 +155,7 @@ def test_an_infeasible_assembly_graph_is_built_once(monkeypatch, proved):
     spy(asp.graph.state_graph, "build_state_graph")
     spy(asp.graph.symmetry, "symmetry_reduction")
     if not proved:
-        monkeypatch.setattr(asp.graph.symmetry, "refutation", lambda *_args, **_kw: None)
+        monkeypatch.setattr(asp.graph.precedences, "refutation", lambda *_args, **_kw: None)
     lines = []
     graph = pipeline.state_graph(pipeline.Assembly(tower_spec(rel), rel), on_step=lines.append)
     assert len(graph.spec.subassemblies) == 2
