@@ -84,3 +84,25 @@ def test_every_overlapping_pair_is_in_one_message_counted_ten_named():
     assert message.startswith("12 pairs of parts interpenetrate") and "\n" not in message
     assert len(re.findall(r"by about 1 mm", message)) == 10 and "and 2 more" in message
     assert np.all([f"'b{k:02d}' and 'b{k + 1:02d}'" in message for k in range(10)])
+
+
+@pytest.mark.filterwarnings("ignore:part 'top'")
+@pytest.mark.parametrize("sink", [1.0, 0.05])
+def test_an_open_mesh_gets_a_depth_over_its_tolerance_or_touches(sink):
+    """Issue 26 item 10: an open mesh sunk into another is reported with a measured depth
+    over the pair's tolerance (it said 'less than 0.00015 mm (tolerance 0.222 mm)'), and
+    one sunk less than the tolerance touches."""
+    meshes = {p.id: p.mesh.copy() for p in shapes.stacked_cubes(sink).parts}
+    top = meshes["top"]
+    top.update_faces(np.arange(len(top.faces)) >= 2)  # one face of the cube gone: open
+    top.remove_unreferenced_vertices()
+    assert not top.is_watertight
+    if sink < 0.2:
+        assert compute_relations(Assembly.from_meshes(meshes), penetration_tol=0.2).tc.any()
+        return
+    with pytest.raises(ValueError) as info:
+        compute_relations(Assembly.from_meshes(meshes), penetration_tol=0.2)
+    message = str(info.value)
+    depth = float(re.search(r"by (?:about|at least) ([\d.]+) mm", message).group(1))
+    tolerance = float(re.search(r"tolerance of this pair ([\d.]+) mm", message).group(1))
+    assert depth > tolerance and "less than" not in message
