@@ -99,7 +99,7 @@ from __future__ import annotations
 
 import sys
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import NamedTuple
 
 import numba
@@ -121,6 +121,7 @@ from asp.concurrent.rules import (
     reply_rows,
 )
 from asp.graph.together import edge
+from asp.heap import memory_budget
 
 INF = 1 << 60
 """A value above every makespan (scaled)."""
@@ -852,10 +853,12 @@ def _compile_kernels(rules: Rules, prefs: np.ndarray, n_prefs: np.ndarray) -> No
 
 @dataclass
 class Limits:
-    """What the search may use: ``memory`` bytes (the table and the policy games),
-    ``max_nodes`` positions expanded, ``time_limit`` seconds (None: no limit)."""
+    """What the search may use: ``memory`` bytes (the table and the policy games; default
+    :data:`DEFAULT_MEMORY`, or less when the memory available says so: the one rule,
+    :func:`asp.heap.memory_budget`), ``max_nodes`` positions expanded, ``time_limit``
+    seconds (None: no limit)."""
 
-    memory: int = DEFAULT_MEMORY
+    memory: int = field(default_factory=lambda: memory_budget(DEFAULT_MEMORY))
     max_nodes: int = DEFAULT_MAX_NODES
     time_limit: float | None = None
 
