@@ -369,8 +369,14 @@ def load(
     from asp.graph.feasibility import spec_relations
     from cad.unit_hints import size_hint
 
-    read = read_source(source, units=units, gravity=gravity)
-    spec = with_tolerances(read.spec, contact_tol, penetration_tol)
+    read = read_source(
+        source,
+        units=units,
+        gravity=gravity,
+        contact_tol=contact_tol,
+        penetration_tol=penetration_tol,
+    )
+    spec = read.spec
 
     def note(text: str) -> None:
         if on_step is not None:
@@ -402,22 +408,6 @@ def load(
         for line in decided.notes():
             note(line)
     return Assembly(spec=spec, relations=rel)
-
-
-def with_tolerances(
-    spec: AssemblySpec, contact_tol: float | None = None, penetration_tol: float | None = None
-) -> AssemblySpec:
-    """``spec`` with the tolerances given (mm) in place of its own; None keeps the spec's."""
-    from dataclasses import replace
-
-    from cad.tolerances import checked_tolerance
-
-    changes = {
-        key: checked_tolerance(value, key)
-        for key, value in (("contact_tol", contact_tol), ("penetration_tol", penetration_tol))
-        if value is not None
-    }
-    return replace(spec, **changes) if changes else spec
 
 
 def part_relations(

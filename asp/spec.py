@@ -645,6 +645,18 @@ class _Parser:
                     )
 
 
+def with_tolerances(
+    spec: AssemblySpec, contact_tol: float | None = None, penetration_tol: float | None = None
+) -> AssemblySpec:
+    """``spec`` with the tolerances given (mm) in place of its own; None keeps the spec's."""
+    changes = {
+        key: checked_tolerance(value, key)
+        for key, value in (("contact_tol", contact_tol), ("penetration_tol", penetration_tol))
+        if value is not None
+    }
+    return replace(spec, **changes) if changes else spec
+
+
 def with_subassemblies(
     spec: AssemblySpec, units: Iterable[tuple[str, Iterable[str]]]
 ) -> AssemblySpec:
@@ -750,5 +762,6 @@ __all__ = [
     "spec_from_dict",
     "tool_values",
     "with_subassemblies",
+    "with_tolerances",
 ]
 """What other modules may use (asmplan and arl among them)."""

@@ -48,6 +48,7 @@ import yaml
 from asmplan.study.assignment import DESIGNS, ORDERS, PLAN_ORDERS
 from asmplan.study.conditions import ROBOTS, Condition
 from asmplan.study.questionnaire import Item, items_from_data, scale_from_data
+from asp.spec import TURN_MODELS
 from cad.yamlfile import PlainNumbers
 
 FORMAT = "asmplan-study/1"
@@ -201,8 +202,8 @@ def _plans(data, where: str, base: Path) -> tuple[StudyPlan, ...]:
         if not source.exists():
             raise ValueError(f"{where}[{n}]: source {source}: no such file or folder")
         turn = raw.get("turn_model")
-        if turn is not None and turn not in ("alternate", "concurrent"):
-            raise ValueError(f"{where}[{n}]: turn_model: expected alternate or concurrent")
+        if turn is not None and turn not in TURN_MODELS:
+            raise ValueError(f"{where}[{n}]: turn_model: expected {' or '.join(TURN_MODELS)}")
         out.append(StudyPlan(source, turn))
     return tuple(out)
 

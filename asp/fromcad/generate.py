@@ -52,7 +52,14 @@ import numpy as np
 
 from asp.errors import SpecError
 from asp.numbers import json_number
-from asp.spec import SPEC_FILE, AssemblySpec, load_spec, spec_from_dict, with_subassemblies
+from asp.spec import (
+    SPEC_FILE,
+    AssemblySpec,
+    load_spec,
+    spec_from_dict,
+    with_subassemblies,
+    with_tolerances,
+)
 from cad.yamlfile import DecimalsAsText
 
 HUMAN_BASE_S = 3.0
@@ -353,24 +360,31 @@ class Source:
 
 
 def read_source(
-    path: str | os.PathLike[str], *, units: str | None = None, gravity: str | None = None
+    path: str | os.PathLike[str],
+    *,
+    units: str | None = None,
+    gravity: str | None = None,
+    contact_tol: float | None = None,
+    penetration_tol: float | None = None,
 ) -> Source:
     """The spec of ``path`` (as :func:`load_any` reads it) and its parts' geometry.
 
     A CAD file or folder of meshes is read once (:func:`cad_assembly`) and the spec
     generated from that geometry; a spec's part files are read once
-    (:func:`spec_geometry`).
+    (:func:`spec_geometry`). The tolerances given (mm) replace the spec's
+    (:func:`asp.spec.with_tolerances`), as ``units`` and ``gravity`` do.
     """
     check_overrides(units, gravity)
     if not is_cad_input(path):
-        spec = _read_spec(path, units, gravity)
+        spec = with_tolerances(_read_spec(path, units, gravity), contact_tol, penetration_tol)
         return Source(spec, spec_geometry(spec) if spec.has_geometry else None)
     geometry = cad_assembly(path, units)
     if Path(path).is_file():  # what reading a scene's parts as part files warns of
         from cad.loading import warn_part_scales
 
         warn_part_scales(geometry)
-    return Source(spec_from_geometry(path, geometry, gravity=gravity, units=units), geometry)
+    spec = spec_from_geometry(path, geometry, gravity=gravity, units=units)
+    return Source(with_tolerances(spec, contact_tol, penetration_tol), geometry)
 
 
 def load_any(
