@@ -121,6 +121,8 @@ def dag_from_dict(data: dict, source: str = "<dict>") -> GameDAG:
         )
     except (KeyError, TypeError, AttributeError) as exc:
         raise FormatError(f"{source}: malformed graph ({type(exc).__name__}: {exc})") from None
+    except FormatError:
+        raise  # it names the file already
     except OverflowError:
         raise GraphError(f"{source}: a cost is too large (the limit is {MAX_COST:g})") from None
     except ValueError as exc:
@@ -142,7 +144,10 @@ def _check_texts(source: str, what: str, values: list) -> None:
     """Every text at most a name long (:func:`cad.texts.bounded`)."""
     for k, value in enumerate(values):
         if isinstance(value, str):
-            bounded(value, f"{source}: {what} {k + 1}")
+            try:
+                bounded(value, f"{source}: {what} {k + 1}")
+            except ValueError as exc:
+                raise FormatError(str(exc)) from None
 
 
 def load_dag(path: str | os.PathLike[str]) -> GameDAG:
@@ -170,7 +175,17 @@ def load_dag(path: str | os.PathLike[str]) -> GameDAG:
         if not g.is_directed():
             raise GraphError(f"{path}: expected a directed graph")
         try:
-            return from_networkx(g)
+            dag = from_networkx(g)
+            for what, texts in (
+                ("node id", dag.node_ids),
+                ("node label", dag.node_labels),
+                ("edge operation", dag.operations),
+                ("edge agent", dag.agents),
+            ):
+                _check_texts(str(path), what, list(texts or ()))
+            return dag
+        except FormatError:
+            raise  # it names the file already
         except OverflowError:
             raise GraphError(f"{path}: a cost is too large (the limit is {MAX_COST:g})") from None
         except ValueError as exc:

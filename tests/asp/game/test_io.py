@@ -183,3 +183,14 @@ def test_texts_of_a_dag_file_are_bounded(tmp_path, change, message):
     with pytest.raises(ValueError, match="over the limit of 200") as info:
         load_dag(path)
     assert message in str(info.value) and "\n" not in str(info.value)
+    assert str(info.value).count(str(path)) == 1  # the file named once
+
+
+def test_texts_of_a_graphml_file_are_bounded(tmp_path):
+    g = nx.DiGraph()
+    g.add_edge("s", "t" * 201, cost=1.0)
+    path = tmp_path / "g.graphml"
+    nx.write_graphml(g, path)
+    with pytest.raises(ValueError, match="node id 2: 201 characters, over the limit of 200") as e:
+        load_dag(path)
+    assert str(e.value).count(str(path)) == 1
