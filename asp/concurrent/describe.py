@@ -36,11 +36,11 @@ def state_description(game: ConcurrentGame, v: int) -> dict:
             "budget": None,
             "turn": "end",
         }
-    key = model.graph.key(state)
-    ids = model.spec.op_ids
+    ids = model.op_ids
+    done, tools = model.state_names(state)
     out = {
-        "done": model.graph.model.done_ops(key),
-        "tools": model.graph.model.tool_state(key),
+        "done": list(done),
+        "tools": dict(tools),
         "running": [
             {
                 "agent": model.workers[w].name,
@@ -67,7 +67,7 @@ def commit_description(game: ConcurrentGame, e: int) -> dict:
     """A robot edge as ``{"start": {robot: op id}, "wait": [robots], "instruct": {human: op
     id or "wait"}}``."""
     model = game.model
-    ids = model.spec.op_ids
+    ids = model.op_ids
     action = game.actions[e]
     out: dict = {"start": {}, "wait": [], "instruct": {}}
     for w, o in enumerate(action.ops):
@@ -96,7 +96,7 @@ def move_starts(game: ConcurrentGame, e: int) -> tuple[list[tuple[str, str, floa
         Deviations from the instructions (0 for a robot edge).
     """
     model = game.model
-    ids = model.spec.op_ids
+    ids = model.op_ids
     action = game.actions[e]
     if isinstance(action, Commit):
         running = game.nodes[int(game.dag.targets[e])][2]
@@ -144,7 +144,7 @@ def timeline(game: ConcurrentGame, robot_policy: np.ndarray, human: str = "worst
     bars: list[Bar] = []
     open_: dict[int, tuple[int, int, bool]] = {}  # worker -> (op, start, deviation)
     instructions: tuple = ()
-    ids = model.spec.op_ids
+    ids = model.op_ids
     while v != dag.end:
         kind, state, running, budget_left, _ = game.nodes[v]
         if kind == "R":

@@ -65,6 +65,7 @@ class ConcurrentModel:
     complete: np.ndarray
     _memo: dict = field(default_factory=dict, repr=False)
     _lookups: dict = field(default_factory=dict, repr=False)
+    _names: dict = field(default_factory=dict, repr=False)
 
     @property
     def succ(self) -> dict:
@@ -91,6 +92,25 @@ class ConcurrentModel:
             enabled[s].append(o)
         self._lookups["succ"] = succ
         self._lookups["enabled"] = [tuple(e) for e in enabled]
+
+    @property
+    def op_ids(self) -> tuple[str, ...]:
+        """The spec's operation ids (made once: the plan file names every move by them)."""
+        ids = self._names.get("ops")
+        if ids is None:
+            ids = self._names["ops"] = self.spec.op_ids
+        return ids
+
+    def state_names(self, state: int) -> tuple[tuple[str, ...], dict]:
+        """The done operations (ids) and the tool values of a state of the graph, made once
+        per state (a policy game has many nodes per state)."""
+        names = self._names.setdefault("states", {})
+        out = names.get(state)
+        if out is None:
+            key = self.graph.key(state)
+            gm = self.graph.model
+            out = names[state] = (tuple(gm.done_ops(key)), gm.tool_state(key))
+        return out
 
     @property
     def n_ops(self) -> int:
