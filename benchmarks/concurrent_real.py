@@ -117,10 +117,11 @@ def main() -> None:
         if args.memory:
             cmd += ["--memory", str(args.memory)]
         env = {**os.environ, "PYTHONPATH": str(ROOT)}
-        out = subprocess.run(cmd, capture_output=True, text=True, env=env)
+        # the child's progress (and any error) goes straight to stderr
+        out = subprocess.run(cmd, stdout=subprocess.PIPE, text=True, env=env)
         lines = [x for x in out.stdout.splitlines() if x.startswith("{")]
         if out.returncode or not lines:
-            print(f"{path.name}: exit {out.returncode}: {out.stderr.strip()[-300:]}", flush=True)
+            print(f"{path.name}: exit {out.returncode} (its stderr above)", flush=True)
             continue
         print(lines[-1], flush=True)
 

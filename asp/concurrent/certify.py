@@ -27,6 +27,7 @@ The walk is plain Python over the compiled move generators (:func:`commit_rows`,
 
 from __future__ import annotations
 
+import sys
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -207,9 +208,10 @@ TICK_MASK = (1 << 15) - 1
 """The clock is looked at every ``TICK_MASK + 1`` positions valued."""
 OK, FULL, STOPPED = 0, 1, 2
 """What :func:`_values` ended with: every start valued, the memo full, a limit reached."""
-ENTRIES, CAPACITY, VALUED, DEADLINE_MS = range(4)
+ENTRIES, CAPACITY, VALUED, DEADLINE_MS, PROGRESS_MS, T0_MS = range(6)
 """The counters of :func:`_values` (an int64 array): positions in the memo, the most it
-may hold, positions valued in all, the deadline (ms of ``time.perf_counter``, 0: none)."""
+may hold, positions valued in all, the deadline (ms of ``time.perf_counter``, 0: none), the
+next progress line (0: none), the start."""
 
 
 @numba.njit(cache=True)
@@ -259,11 +261,17 @@ def _values(T, H, P, starts, kind, prefs, n_prefs, st, cnt, out):  # pragma: no 
                 jr[d] = 0
                 v[d] = 0 if delta.shape[0] == 0 else -1
                 cnt[VALUED] += 1
-                if (cnt[VALUED] & TICK_MASK) == 0 and cnt[DEADLINE_MS] > 0:
+                if (cnt[VALUED] & TICK_MASK) == 0 and (cnt[DEADLINE_MS] or cnt[PROGRESS_MS]):
                     with numba.objmode(now="float64"):
                         now = time.perf_counter()
-                    if np.int64(now * 1000) >= cnt[DEADLINE_MS]:
+                    ms = np.int64(now * 1000)
+                    if cnt[DEADLINE_MS] > 0 and ms >= cnt[DEADLINE_MS]:
                         return STOPPED
+                    if cnt[PROGRESS_MS] > 0 and ms >= cnt[PROGRESS_MS]:
+                        cnt[PROGRESS_MS] = ms + 5000
+                        valued, entries, secs = cnt[VALUED], cnt[ENTRIES], (ms - cnt[T0_MS]) / 1000
+                        with numba.objmode():
+                            _report(kind, valued, entries, secs)
             delta = rdelta_l[d]
             rws = rrows_l[d]
             pushed = False
@@ -297,6 +305,18 @@ def _values(T, H, P, starts, kind, prefs, n_prefs, st, cnt, out):  # pragma: no 
     return OK
 
 
+def _report(kind: int, valued: int, entries: int, secs: float) -> None:
+    from asp.concurrent.search import GREEDY, HYBRID, SCHEDULE
+
+    name = {GREEDY: "greedy", HYBRID: "hybrid", SCHEDULE: "schedule"}.get(kind, str(kind))
+    print(
+        f"  certifying the {name} policy: {valued:,} positions valued, {entries:,} kept "
+        f"({secs:.0f} s)",
+        file=sys.stderr,
+        flush=True,
+    )
+
+
 def best_response_values(
     search,
     kind: int,
@@ -305,6 +325,7 @@ def best_response_values(
     schedule: list[dict] | None = None,
     memory: int | None = None,
     time_limit: float | None = None,
+    progress: bool = False,
 ) -> dict | None:
     """The certified worst case of a fixed robot policy per budget, without its policy game.
 
@@ -332,6 +353,8 @@ def best_response_values(
         Bytes of the memo at most (default: half the search's memory limit).
     time_limit : float, optional
         Seconds at most.
+    progress : bool
+        A line on stderr every 5 s (positions valued and kept).
 
     Returns
     -------
@@ -350,9 +373,12 @@ def best_response_values(
     )
     memory = search.limits.memory // 2 if memory is None else int(memory)
     most = int(memory // ((8 * kw + 8) / LOAD))  # only the keys and values are resident
-    cnt = np.zeros(4, dtype=np.int64)
+    cnt = np.zeros(6, dtype=np.int64)
     if time_limit is not None:
         cnt[DEADLINE_MS] = int((t0 + time_limit) * 1000)
+    cnt[T0_MS] = int(t0 * 1000)
+    if progress:
+        cnt[PROGRESS_MS] = cnt[T0_MS] + 5000
     st = search.stats.copy()
     st[0:3] = 0  # NODES, NODE_LIMIT, ABORT of the search: the policies never search
     out = np.zeros(len(budgets), dtype=np.int64)

@@ -21,7 +21,7 @@ from asp.concurrent.build import ConcurrentGame
 from asp.concurrent.certify import best_response_values
 from asp.concurrent.model import UNBOUNDED
 from asp.concurrent.rules import Rules, lower_bound_of
-from asp.concurrent.search import GREEDY, HYBRID, ROBUST, SCHEDULE, Limits, Search
+from asp.concurrent.search import GREEDY, HYBRID, INF, ROBUST, SCHEDULE, Limits, Search
 
 
 @dataclass(frozen=True, eq=False)
@@ -83,12 +83,13 @@ class Curve:
     def gap(self, i: int) -> float:
         """The gap of entry ``i`` in per cent of the upper bound."""
         lo, hi = self.lower[i], self.upper[i]
+        if not np.isfinite(hi):  # no policy certified there (k = inf past its time)
+            return 100.0
         return 0.0 if hi <= lo or hi <= 0 else 100.0 * (hi - lo) / hi
 
     def to_list(self) -> list[dict]:
         """``[{"k", "bound", "lower", "upper", "exact"}, ..., {"k": None, ...}]``: ``bound``
         is the certified worst case of the plan's policy (``W*(k)`` where exact)."""
-        from asp.numbers import json_number
 
         out = []
         n = len(self.lower)
@@ -96,13 +97,20 @@ class Curve:
             out.append(
                 {
                     "k": None if i == n - 1 else i,
-                    "bound": json_number(self.bounds[i], 6),
-                    "lower": json_number(self.lower[i], 6),
-                    "upper": json_number(self.upper[i], 6),
+                    "bound": _number(self.bounds[i]),
+                    "lower": _number(self.lower[i]),
+                    "upper": _number(self.upper[i]),
                     "exact": self.lower[i] == self.upper[i],
                 }
             )
         return out
+
+
+def _number(x: float):
+    """A value for ``plan.json``: None where no policy is certified (infinite)."""
+    from asp.numbers import json_number
+
+    return json_number(x, 6) if np.isfinite(x) else None
 
 
 def solve_curve(
@@ -150,39 +158,57 @@ def solve_curve(
             print(f"  {text} ({time.perf_counter() - t0:.1f} s)", file=sys.stderr, flush=True)
 
     exact: dict = {}  # budget (None: inf) -> W* (scaled)
+    limit = search.limits.time_limit
+    end = None if limit is None else search.t0 + limit
     v0 = search.value(0, floor)
     if v0 is not None:
         exact[0] = v0
         say(f"W*(0) = {v0 / scale:g}")
+        # W*(inf) next, in half the time left when there is a limit: past it, the finite
+        # budgets (the person's few deviations: far smaller games) go on in the rest.
+        if end is not None:
+            now = time.perf_counter()
+            search.resume(now + max(0.0, end - now) / 2)
         top = search.value(None, v0)
+        search.resume(end)
         if top is not None:
             exact[None] = top
             say(f"W*(inf) = {top / scale:g}")
+        else:
+            say("W*(inf) not found in half the time: the finite budgets first")
     k = 0
-    while None in exact and k < max_k and not (exact[k] == exact[None] and k >= min_k):
-        if exact[k] == exact[None]:
+    while 0 in exact and k < max_k:
+        if None in exact and exact[k] == exact[None]:
+            if k >= min_k:
+                break
             v = exact[None]  # flat from k on (the curve never falls, never passes W*(inf))
         else:
-            v = search.value(k + 1, exact[k], exact[None] + 1)
+            v = search.value(k + 1, exact[k], exact[None] + 1 if None in exact else INF)
             if v is None:
                 break
             say(f"W*({k + 1}) = {v / scale:g}")
         exact[k + 1] = v
         k += 1
+    if 0 in exact and None not in exact and not search.stopped:  # in the time still left
+        top = search.value(None, exact[k])
+        if top is not None:
+            exact[None] = top
+            say(f"W*(inf) = {top / scale:g}")
     finished = None in exact and (k == max_k or exact[k] == exact[None])
     flat = None in exact and exact.get(k) == exact[None]
-    K = k if finished else min(max_k, max(min_k, k))  # stopped: the budgets reached so far
+    K = k if finished or k == max_k else min(max_k, max(min_k, k))  # stopped: as reached
     budgets = list(range(K + 1))
     return certified_curve(
         search,
         exact,
         budgets,
-        finished=finished,
+        finished=all(b in exact for b in range(K + 1)),
         flat=flat,
         floor=floor,
         schedule=schedule,
         t0=t0,
         say=say,
+        progress=progress,
     )
 
 
@@ -197,6 +223,7 @@ def certified_curve(
     schedule: list[dict] | None,
     t0: float,
     say,
+    progress: bool = False,
 ):
     """The :class:`Curve` of a search that has found the values
     ``exact`` (budget, None for ``k = inf`` -> scaled ``W*``) for the plan's ``budgets``
@@ -206,7 +233,8 @@ def certified_curve(
     falls), of the policies certified here: the robust policy when every value is known
     (its policy game, which the plan file needs anyway), else the hybrid and greedy policies,
     and the CP-SAT schedule run as a plan, each by :func:`best_response_values` (values only:
-    a policy whose game is over the memory allowed is still certified). ``L(k)`` is the exact
+    a policy whose game is over the memory allowed is still certified; with a time limit,
+    the search's seconds again, shared out among them in turn). ``L(k)`` is the exact
     value, else the best bound the search proved (never below ``floor``, the CP-SAT bound,
     nor below ``L(k - 1)``). Only the policy handed to the cell, the one certified at
     ``U(K)``, gets its policy game: with every budget's start, else with ``0..K`` only (its
@@ -236,20 +264,44 @@ def certified_curve(
             sol = solve(game.dag)
             games["robust"] = (game, sol)
             certified["robust"] = _start_values(game, sol)
-    schedule_worst: list = []
-    names = ["schedule"] if "robust" in certified else ["hybrid", "greedy", "schedule"]
-    for name in names:
-        if name == "schedule" and not schedule:
-            continue
-        values = best_response_values(search, kinds[name], everything, schedule=schedule)
+    robust_inf = "robust" in certified and None in exact
+    names = ["schedule"] if robust_inf else ["hybrid", "greedy", "schedule"]
+    names = [n for n in names if n != "schedule" or schedule]
+    seconds = search.limits.time_limit  # the certificates' time, shared out in turn
+    t_cert = time.perf_counter()
+
+    def share(left: int) -> float | None:
+        if seconds is None:
+            return None
+        return max(1.0, (seconds - (time.perf_counter() - t_cert)) / left)
+
+    found: dict[str, dict] = {}
+    # The finite budgets first (the person's deviations are few: small best responses),
+    # then k = inf (the budget at its cap: every order of the person's operations), the
+    # policies of least worst case at K first.
+    for i, name in enumerate(names):
+        values = best_response_values(
+            search, kinds[name], budgets, schedule=schedule, time_limit=share(2 * len(names) - i),
+            progress=progress,
+        )  # fmt: skip
         if values is None:
-            say(f"the {name} policy: its best response is over the memory allowed")
+            say(f"the {name} policy: its best response is over the memory or time allowed")
             continue
-        say(f"the {name} policy certified at {_fmt_values(values, budgets)}")
-        if name == "schedule":
-            schedule_worst = [{"k": b, "bound": values[b]} for b in ks]
-        if "robust" not in certified:
-            certified[name] = values
+        found[name] = values
+    ranked = sorted(found, key=lambda n: (found[n][K], names.index(n)))
+    for i, name in enumerate(ranked):
+        top = best_response_values(
+            search, kinds[name], [None], schedule=schedule, time_limit=share(len(ranked) - i),
+            progress=progress,
+        )  # fmt: skip
+        if top is not None:
+            found[name][None] = top[None]
+        say(f"the {name} policy certified at {_fmt_values(found[name], budgets)}")
+    schedule_worst = [
+        {"k": b, "bound": found["schedule"][b]} for b in ks if b in found.get("schedule", {})
+    ]
+    if not robust_inf:
+        certified.update(found)
     if not certified:
         raise GameError(
             f"--max-memory: {search.limits.memory:,} bytes certify no policy of this game "
@@ -278,9 +330,10 @@ def certified_curve(
             break
         kind = kinds[name]
         sched = schedule if name == "schedule" else None
-        game = search.policy_game(everything, kind, sched) or search.policy_game(
-            budgets, kind, sched
-        )
+        game = None
+        if None in certified[name]:  # (else its game at the cap is too large to walk)
+            game = search.policy_game(everything, kind, sched)
+        game = game or search.policy_game(budgets, kind, sched)
         if game is not None:
             games[name] = (game, solve(game.dag))
             break
@@ -325,4 +378,5 @@ def _start_values(game: ConcurrentGame, solution) -> dict:
 
 def _fmt_values(values: dict, budgets: list[int]) -> str:
     finite = " ".join(f"{values[b]:g}" for b in budgets)
-    return f"k = 0..{budgets[-1]}: {finite}, k = inf: {values[None]:g}"
+    top = f"{values[None]:g}" if None in values else "not certified (over the time allowed)"
+    return f"k = 0..{budgets[-1]}: {finite}, k = inf: {top}"

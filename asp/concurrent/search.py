@@ -932,6 +932,14 @@ class Search:
         st[ABORT] = 0
         return True
 
+    def resume(self, deadline: float | None) -> None:
+        """Search on after a time stop, until ``deadline`` (``time.perf_counter`` seconds;
+        None: no time limit). The table holds proven intervals only, so what the stopped
+        search found stays valid."""
+        if self.stats[ABORT] == STOP_TIME:
+            self.stats[ABORT] = 0
+        self.stats[DEADLINE] = 0 if deadline is None else int(deadline * 1000)
+
     def _run(self, row, alpha: int, beta: int) -> int:
         """:func:`_search` of ``row``, again with a larger table while it grows (the entries
         kept, so the search goes on where it stopped)."""
