@@ -367,7 +367,6 @@ def load(
     """
     from asp.fromcad.generate import decide_generated, read_source
     from asp.graph.feasibility import spec_relations
-    from cad.unit_hints import size_hint
 
     read = read_source(
         source,
@@ -398,8 +397,8 @@ def load(
     if spec.has_geometry:
         if on_step is not None:
             on_step(f"computing part relations of {len(spec.parts)} parts ...")
-        if hint := size_hint(read.geometry):
-            note(f"units: {hint}")
+        if read.size_note:
+            note(f"units: {read.size_note}")
         rel = spec_relations(spec, read.geometry, progress=progress)
         decided = decide_generated(
             spec, rel, read.geometry, say=on_step, progress=progress, given_gravity=bool(gravity)

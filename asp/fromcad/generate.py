@@ -353,10 +353,14 @@ class Source:
         applied, ``groups`` the file's hierarchy), the value the spec was generated from
         and, along another gravity or in another frame, is generated again from
         (:func:`decide_generated`); nothing below reads the file again.
+    size_note : str
+        What the geometry's size says of its unit (:func:`cad.unit_hints.size_hint`: an
+        assembly implausibly small or large for it), else "".
     """
 
     spec: AssemblySpec
     geometry: object | None = None
+    size_note: str = ""
 
 
 def read_source(
@@ -374,17 +378,23 @@ def read_source(
     (:func:`spec_geometry`). The tolerances given (mm) replace the spec's
     (:func:`asp.spec.with_tolerances`), as ``units`` and ``gravity`` do.
     """
+    from cad.unit_hints import size_hint
+
     check_overrides(units, gravity)
     if not is_cad_input(path):
         spec = with_tolerances(_read_spec(path, units, gravity), contact_tol, penetration_tol)
-        return Source(spec, spec_geometry(spec) if spec.has_geometry else None)
+        if not spec.has_geometry:
+            return Source(spec)
+        geometry = spec_geometry(spec)
+        return Source(spec, geometry, size_hint(geometry))
     geometry = cad_assembly(path, units)
     if Path(path).is_file():  # what reading a scene's parts as part files warns of
         from cad.loading import warn_part_scales
 
         warn_part_scales(geometry)
+    note = size_hint(geometry)
     spec = spec_from_geometry(path, geometry, gravity=gravity, units=units)
-    return Source(with_tolerances(spec, contact_tol, penetration_tol), geometry)
+    return Source(with_tolerances(spec, contact_tol, penetration_tol), geometry, note)
 
 
 def load_any(

@@ -338,4 +338,5 @@ def spec_relations(spec: AssemblySpec, geometry, *, progress: bool = False):
         progress=progress,
         overlap_ok=spec.overlap_ok,
     )
-    return with_flex(with_nearest(relations), spec.flex)
+    relations = with_nearest(relations)
+    return with_flex(relations, spec.flex)
