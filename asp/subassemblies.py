@@ -106,7 +106,9 @@ def build_with_units(
     held by one host enter with it), overlapping groups merge (with the units of earlier
     rounds too), and the graph is built again (at most :data:`MAX_ROUNDS` rounds); if no
     new unit can be found, the file's remaining sub-assemblies are given up before the
-    first error is raised. With ``reduce``, a round whose derived precedences already prove
+    first error is raised (a round of automatic units over the state limit raises the
+    first round's proof, led by the pairs that lock each other: :func:`_with_locking`).
+    With ``reduce``, a round whose derived precedences already prove
     that no complete sequence exists (:func:`asp.graph.precedences.refutation`, milliseconds)
     builds no checked graph, and its graph for the stuck operations only up to
     :data:`PROVED_ROUND_STATES` states; beyond, the operation the proof names is the stuck
@@ -204,6 +206,14 @@ def build_with_units(
             current = prepared_units(current, relations, say)
             try:
                 return build(current)
+            except StateLimit:
+                if not isinstance(first_error, _Proved):
+                    raise
+                # units guessed for a proved failure, too many states to try: the proof
+                said = _with_locking(first_error, relations)
+                raise InfeasibleAssembly(
+                    f"{said}; the automatic subassemblies tried for it exceed the state limit"
+                ) from None
             except InfeasibleAssembly as exc:
                 if relations is None:
                     raise
@@ -442,9 +452,27 @@ def _graph_report(proof: _Proved, relations, kwargs: dict) -> SpecError:
 
     try:
         build_state_graph(proof.spec, relations, **kwargs)
+    except StateLimit:  # too many states to report on: the proof is the report
+        return _with_locking(proof, relations)
     except SpecError as exc:
         return exc
     return proof
+
+
+def _with_locking(proof: _Proved, relations) -> InfeasibleAssembly:
+    """``proof`` led by the pairs of parts that block each other along every direction and
+    the ``flex:`` line for them (:func:`asp.cad_keys.flex_hint`), as the state graph's
+    report leads with them; the proof itself when no pair locks."""
+    from asp.cad_keys import flex_hint
+    from cad.freedom import locking_pairs
+
+    pairs = locking_pairs(relations.tt, relations.parts) if relations is not None else []
+    if not pairs:
+        return proof
+    return InfeasibleAssembly(
+        f"{proof.spec.source}: infeasible assembly, no complete sequence: "
+        f"{flex_hint(pairs)}{proof.proof.why}"
+    )
 
 
 @dataclass(frozen=True)

@@ -125,6 +125,46 @@ def hold_unsupported(spec: AssemblySpec, relations) -> tuple[AssemblySpec, tuple
     return (replace(spec, operations=tuple(ops)) if held else spec), held
 
 
+def hold_refuted(spec: AssemblySpec, relations) -> tuple[AssemblySpec, bool]:
+    """A generated spec with ``held: true`` also on each part whose placement the derived
+    precedences refute while it is not held (or a part its proof looks at, its own first:
+    the first whose mark takes that proof away), until none is refuted or no mark helps;
+    and whether none is refuted then.
+
+    Why: a part that rests only on parts which must come after it (a wheel arch resting
+    on the screws that fix it: they block it along the only way it can go in) has nothing
+    to rest on when it goes in, as an unsupported part has (:func:`hold_unsupported`);
+    held, it needs no support, so its supports need not come first. Only ``held`` marks
+    are added, each taking away a proof that the precedences give while it is loose, so a
+    spec they do not refute is unchanged, and a mark is kept when another cause remains
+    (two parts locking each other, which a ``flex:`` line resolves: the marks are then
+    what the plan needs as well).
+    """
+    from asp.graph.precedences import refutation
+
+    placing = {p: k for k, op in enumerate(spec.operations) for p in op.parts}
+    proof = refutation(spec, relations)
+    for _ in range(len(spec.operations)):
+        if proof is None:
+            return spec, True
+        named = spec.operations[spec.op_index(proof.operation)].parts
+        for part in dict.fromkeys((*named, *proof.parts)):  # its own part first
+            k = placing.get(part)
+            op = spec.operations[k] if k is not None else None
+            if op is None or op.held or len(op.parts) != 1 or part == spec.base_part:
+                continue
+            ops = list(spec.operations)
+            ops[k] = replace(op, held=True)
+            marked = replace(spec, operations=tuple(ops))
+            again = refutation(marked, relations)
+            if again is None or again.operation != proof.operation:
+                spec, proof = marked, again  # the mark took this proof away
+                break
+        else:
+            break  # no mark helps: it is locked in, or another cause
+    return spec, False
+
+
 def workable_base(spec: AssemblySpec, relations) -> tuple[AssemblySpec, str]:
     """A generated spec on a base part from which the assembly is not ruled out.
 
@@ -134,7 +174,8 @@ def workable_base(spec: AssemblySpec, relations) -> tuple[AssemblySpec, str]:
     part rests on parts that need the parts above it), the other parts are tried, those
     touching the most parts first (then in operation order), and the first not ruled out
     becomes the base; its placement moves to the front. ``held`` is set as
-    :func:`hold_unsupported` does. A user's spec, or one no other base helps, is unchanged.
+    :func:`hold_unsupported` does; when no base helps, the spec on its own base gets
+    the ``held`` marks of :func:`hold_refuted` too. A user's spec is unchanged.
 
     Returns
     -------
@@ -169,7 +210,7 @@ def workable_base(spec: AssemblySpec, relations) -> tuple[AssemblySpec, str]:
                 f"sequence can start from {spec.base_part}: {why})"
             )
             return candidate, note
-    return held, ""
+    return hold_refuted(held, relations)[0], ""
 
 
 def spec_geometry(spec: AssemblySpec):
