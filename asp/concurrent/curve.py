@@ -87,13 +87,25 @@ class Curve:
             return 100.0
         return 0.0 if hi <= lo or hi <= 0 else 100.0 * (hi - lo) / hi
 
+    @property
+    def largest_gap(self) -> float:
+        """The largest gap (per cent) of the certified entries."""
+        return max((self.gap(i) for i in range(len(self.lower)) if self.certified(i)), default=0)
+
+    def certified(self, i: int) -> bool:
+        """Some policy is certified at entry ``i`` (always, but ``k = inf`` when its best
+        responses were over the time allowed)."""
+        return bool(np.isfinite(self.upper[i]))
+
     def to_list(self) -> list[dict]:
         """``[{"k", "bound", "lower", "upper", "exact"}, ..., {"k": None, ...}]``: ``bound``
-        is the certified worst case of the plan's policy (``W*(k)`` where exact)."""
-
+        is the certified worst case of the plan's policy (``W*(k)`` where exact). The row
+        of ``k = inf`` is left out when no policy is certified there (:meth:`certified`)."""
         out = []
         n = len(self.lower)
         for i in range(n):
+            if not self.certified(i):
+                continue
             out.append(
                 {
                     "k": None if i == n - 1 else i,
@@ -107,10 +119,9 @@ class Curve:
 
 
 def _number(x: float):
-    """A value for ``plan.json``: None where no policy is certified (infinite)."""
     from asp.numbers import json_number
 
-    return json_number(x, 6) if np.isfinite(x) else None
+    return json_number(x, 6)
 
 
 def solve_curve(
@@ -234,7 +245,7 @@ def certified_curve(
     (its policy game, which the plan file needs anyway), else the hybrid and greedy policies,
     and the CP-SAT schedule run as a plan, each by :func:`best_response_values` (values only:
     a policy whose game is over the memory allowed is still certified; with a time limit,
-    the search's seconds again, shared out among them in turn). ``L(k)`` is the exact
+    half the search's seconds, shared out among them in turn). ``L(k)`` is the exact
     value, else the best bound the search proved (never below ``floor``, the CP-SAT bound,
     nor below ``L(k - 1)``). Only the policy handed to the cell, the one certified at
     ``U(K)``, gets its policy game: with every budget's start, else with ``0..K`` only (its
@@ -267,7 +278,8 @@ def certified_curve(
     robust_inf = "robust" in certified and None in exact
     names = ["schedule"] if robust_inf else ["hybrid", "greedy", "schedule"]
     names = [n for n in names if n != "schedule" or schedule]
-    seconds = search.limits.time_limit  # the certificates' time, shared out in turn
+    limit = search.limits.time_limit  # half the search's time for the certificates, in turn
+    seconds = None if limit is None else limit / 2
     t_cert = time.perf_counter()
 
     def share(left: int) -> float | None:
@@ -347,8 +359,8 @@ def certified_curve(
     values = certified[name]
     bounds = [values.get(b, upper_k[i]) for i, b in enumerate(ks)]
     if search.stopped:
-        worst = max(range(len(ks)), key=lambda i: upper_k[i] - lower_k[i])
-        gap = 100 * (upper_k[worst] - lower_k[worst]) / upper_k[worst] if upper_k[worst] else 0
+        finite = [i for i in range(len(ks)) if np.isfinite(upper_k[i]) and upper_k[i] > 0]
+        gap = max((100 * (upper_k[i] - lower_k[i]) / upper_k[i] for i in finite), default=0)
         say(
             f"{search.stopped} reached: W*({K}) in [{lower_k[K]:g}, {upper_k[K]:g}], "
             f"the largest gap {gap:.1f} %"

@@ -214,8 +214,13 @@ def robustness_table(plan: ConcurrentPlan) -> str:
             f"{name:>12} | {_value_text(curve, i)} | {_fmt(row['bound'])} | "
             f"{_fmt(worst.get(k))}{note}"
         )
+    if not curve.certified(len(curve.lower) - 1):
+        lines.append(
+            f"{'inf':>12} | >= {_fmt(curve.lower[-1])}: no policy certified against the fully "
+            "adversarial person in the time allowed (its best responses were cut short)"
+        )
     if curve.stopped:
-        gaps = max(curve.gap(i) for i in range(len(curve.lower)))
+        gaps = curve.largest_gap
         lines.append(
             f"the search stopped at its {curve.stopped} (--search-time-limit, --max-nodes, "
             f"--max-memory give it more): W*(k) lies in [L, U] (largest gap {gaps:.1f} %); "
