@@ -363,6 +363,9 @@ class _Parser:
 
     def prose(self, value, key: str) -> str:
         """A free description (empty when absent), at most :data:`cad.texts.MAX_TEXT`."""
+        if isinstance(value, dict | list):
+            kind = "a mapping" if isinstance(value, dict) else "a list"
+            raise self.fail(key, f"expected a text, got {kind}")
         return self.bounded("" if value is None else str(value), key, MAX_TEXT)
 
     def mapping(self, value, key: str, known: tuple[str, ...] = ()) -> dict:
@@ -443,8 +446,10 @@ class _Parser:
         except ValueError as exc:
             raise self.fail("frame", str(exc)) from None
         spec = AssemblySpec(
-            name=self.bounded(
-                str(data.get("name") or Path(self.source).parent.name or "assembly"), "name"
+            name=(
+                self.text(data["name"], "name")
+                if data.get("name") not in (None, "")
+                else self.bounded(Path(self.source).parent.name or "assembly", "name")
             ),
             operations=ops,
             agents=agents,

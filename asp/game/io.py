@@ -34,6 +34,7 @@ from asp.atomic import write_bytes, write_text
 from asp.errors import FormatError, GraphError
 from asp.game.dag import MAX_COST, SIDE_NAMES, GameDAG, from_edges, from_networkx, side_from_name
 from asp.numbers import json_number, plain
+from cad.numbers import plain_number
 from cad.texts import bounded
 
 FORMAT = "asmplan-dag/1"
@@ -102,7 +103,7 @@ def dag_from_dict(data: dict, source: str = "<dict>") -> GameDAG:
         _check_texts(source, "node label", labels)
         _check_texts(source, "edge operation", [e.get("operation") for e in edges])
         _check_texts(source, "edge agent", [e.get("agent") for e in edges])
-        costs = [float(e.get("cost", 1)) for e in edges]
+        costs = [_cost(source, k, e.get("cost", 1)) for k, e in enumerate(edges)]
         sides = [side_from_name(e.get("side", "any")) for e in edges]
         has_ops = any("operation" in e for e in edges)
         has_agents = any("agent" in e for e in edges)
@@ -140,6 +141,16 @@ def _check_ids(source: str, what: str, values: list) -> None:
     _check_texts(source, what, values)
 
 
+def _cost(source: str, k: int, value) -> float:
+    """Edge ``k``'s cost as written: a number (never a bool), else refused naming the edge."""
+    x = plain_number(value)
+    if x is None:
+        raise FormatError(
+            f"{source}: edge {k + 1} cost {json.dumps(value)[:40]}: expected a number"
+        )
+    return x
+
+
 def _check_texts(source: str, what: str, values: list) -> None:
     """Every text at most a name long (:func:`cad.texts.bounded`)."""
     for k, value in enumerate(values):
@@ -148,6 +159,19 @@ def _check_texts(source: str, what: str, values: list) -> None:
                 bounded(value, f"{source}: {what} {k + 1}")
             except ValueError as exc:
                 raise FormatError(str(exc)) from None
+
+
+class _DuplicateKey(ValueError):
+    """A key written twice in one JSON object (the reader would keep the last silently)."""
+
+
+def _unique_keys(pairs: list[tuple[str, object]]) -> dict:
+    out: dict = {}
+    for key, value in pairs:
+        if key in out:
+            raise _DuplicateKey(json.dumps(key)[:60])
+        out[key] = value
+    return out
 
 
 def load_dag(path: str | os.PathLike[str]) -> GameDAG:
@@ -161,7 +185,9 @@ def load_dag(path: str | os.PathLike[str]) -> GameDAG:
     suffix = path.suffix.lower()
     if suffix in JSON_SUFFIXES:
         try:
-            data = json.loads(path.read_text(encoding="utf-8"))
+            data = json.loads(path.read_text(encoding="utf-8"), object_pairs_hook=_unique_keys)
+        except _DuplicateKey as exc:
+            raise FormatError(f"{path}: duplicate key {exc} in a JSON object") from None
         except (json.JSONDecodeError, UnicodeDecodeError) as exc:
             raise FormatError(f"{path}: malformed JSON ({exc})") from None
         except RecursionError:

@@ -79,6 +79,12 @@ def test_valid_spec_defaults():
         (("parts",), [{"id": "A"}, {"id": "A"}], r"parts: duplicate part id 'A'"),
         (("operations",), [], r"operations: expected a non-empty list"),
         (("operations", 1, "parts"), ["A"], r"operations\[2\]: both part and parts: give one"),
+        # issue 26 (the reliability probe): a name or text of the wrong type is refused
+        (("name",), {"a": 1}, r"name: expected a name, got \{'a': 1\}"),
+        (("name",), ["a"], r"name: expected a name"),
+        (("operations", 0, "description"), {"a": 1}, r"description: expected a text, got a map"),
+        (("agents", "H", "description"), [1, 2], r"H\.description: expected a text, got a list"),
+        (("credit",), {"by": "me"}, r"credit: expected a text"),
     ],
 )
 def test_validation_errors_name_file_key_and_culprit(path, value, message):

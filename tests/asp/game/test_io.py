@@ -71,6 +71,18 @@ def test_plain_networkx_graphml(tmp_path):
         ('{"nodes": [1, null], "edges": [{"source": 1, "target": null}]}', "node id null"),
         ('{"nodes": [1, 2], "edges": [{"source": 1.0, "target": 2}]}', "edge end 1.0"),
         ('{"nodes": [1, 2], "edges": [{"source": 1, "target": 2}], "start": 1.0}', "start/end 1.0"),
+        # issue 26 (the reliability probe): a cost not written as a number names the edge
+        ('{"nodes": [1, 2], "edges": [{"source": 1, "target": 2, "cost": "x"}]}', "edge 1 cost"),
+        ('{"nodes": [1, 2], "edges": [{"source": 1, "target": 2, "cost": true}]}', "cost true"),
+        ('{"nodes": [1, 2], "edges": [{"source": 1, "target": 2, "cost": [1]}]}', "cost \\[1\\]"),
+        (
+            '{"nodes": [1, 2], "edges": [{"source": 1, "target": 2}], "start": 1, "start": 2}',
+            'duplicate key "start"',
+        ),
+        (
+            '{"nodes": [1, 2], "edges": [{"source": 1, "target": 2, "cost": 1, "cost": 5}]}',
+            'duplicate key "cost"',
+        ),
     ],
 )
 def test_bad_json_names_the_file(tmp_path, content, message):
