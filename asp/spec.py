@@ -210,6 +210,10 @@ class AssemblySpec:
     credit: str = ""
     max_states: int | None = None
     generated: bool = False
+    hierarchy: tuple[tuple[str, tuple[str, ...]], ...] = ()
+    """A generated spec's CAD hierarchy: the file's sub-assemblies over its parts (group id,
+    member part ids; outermost first, two parts or more), taken from the file as it was read
+    (:func:`asp.fromcad.generate.file_hierarchy`); empty for a spec read from a file."""
     subassemblies: tuple[tuple[str, tuple[str, ...]], ...] = ()
     """Units built in their own workspace and inserted whole: (unit id, member part ids)."""
     unit_gravity: tuple[tuple[str, str], ...] = ()

@@ -616,7 +616,7 @@ def cad_units(
 ) -> tuple[HierarchyUnit, ...]:
     """Decide which of the CAD file's sub-assemblies become units.
 
-    The file's groups (:func:`asp.fromcad.generate.spec_hierarchy`), outermost first; a part
+    The file's groups (``spec.hierarchy``, as the file was read), outermost first; a part
     belongs to one unit, so a group inside a used one is not used. A group is used when
 
     - it does not hold the base part (that stands first in the main assembly);
@@ -635,12 +635,11 @@ def cad_units(
     leaves no complete sequence). ``exclude``: groups given up already (their own groups
     are then candidates).
     """
-    from asp.fromcad.generate import spec_hierarchy
     from asp.graph.feasibility import insertion_oracle
 
     if relations is None:
         return ()
-    groups = spec_hierarchy(spec)
+    groups = spec.hierarchy
     if not groups:
         return ()
     exclude = set(exclude)

@@ -228,33 +228,11 @@ def spec_geometry(spec: AssemblySpec):
     return load_parts(spec.parts, spec.folder, spec.units, frame=spec.frame)
 
 
-def spec_hierarchy(spec: AssemblySpec) -> tuple[tuple[str, tuple[str, ...]], ...]:
-    """The CAD file's hierarchy over ``spec``'s parts: group id -> the spec's part ids.
-
-    Parts named ``scene#node`` are looked up in their scene's tree (:mod:`cad.scene`), a
-    part joined of nodes (``scene#a+b+c``, :mod:`cad.merging`) standing for each of them;
-    groups keep the spec's parts among their members and count when two or more remain.
-    Outermost groups first; empty when no part comes from a scene with a hierarchy.
-    """
-    from cad.scene import read_scene
-
-    by_file: dict[str, dict[str, str]] = {}  # scene file -> scene part id -> spec part id
-    for part in spec.parts:
-        name, _, node = str(part.file or "").partition("#")
-        if node:
-            scene = read_scene(spec.folder / name)
-            found = [scene.find(node)] if scene.find(node) is not None else []
-            if not found and "+" in node:
-                found = [k for k in map(scene.find, node.split("+")) if k is not None]
-            for k in found:
-                by_file.setdefault(name, {})[scene.ids[k]] = part.id
-    out = []
-    for name, spec_id in by_file.items():
-        for gid, members in read_scene(spec.folder / name).groups:
-            mapped = tuple(dict.fromkeys(spec_id[m] for m in members if m in spec_id))
-            if len(mapped) >= 2:
-                out.append((gid, mapped))
-    return tuple(out)
+def file_hierarchy(geometry) -> tuple[tuple[str, tuple[str, ...]], ...]:
+    """The CAD file's hierarchy over its parts as read (``geometry.groups``: group id -> part
+    ids, outermost first; a part joined of several nodes, :mod:`cad.merging`, stands for
+    them), the groups of two parts or more: a generated spec's ``hierarchy``."""
+    return tuple((gid, tuple(members)) for gid, members in geometry.groups if len(members) >= 2)
 
 
 def cad_assembly(path: str | Path, units: str | None = None):
@@ -493,7 +471,7 @@ def spec_from_geometry(
     data, _ = spec_data(path, geometry, gravity=gravity, frame=frame, units=units)
     folder = path if path.is_dir() else path.parent
     spec = spec_from_dict(data, source=str(folder / SPEC_FILE))
-    return replace(spec, generated=True, source=str(path))
+    return replace(spec, generated=True, source=str(path), hierarchy=file_hierarchy(geometry))
 
 
 def gravity_choice(relations, geometry, default: str):
@@ -860,7 +838,8 @@ def _hierarchy_lines(data: dict, assembly, relations, spec_folder, decide) -> li
             {**record, "file": os.path.normpath(os.path.join(folder, file)) + hash_ + node}
         )
     spec = spec_from_dict({**data, "parts": parts}, source=os.path.join(folder, SPEC_FILE))
-    spec, _ = hold_unsupported(replace(spec, generated=True), relations)
+    spec = replace(spec, generated=True, hierarchy=file_hierarchy(assembly))
+    spec, _ = hold_unsupported(spec, relations)
     choices = decide(spec, relations)
     used = [u for u in choices if u.used]
     lines = [

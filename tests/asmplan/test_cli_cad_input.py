@@ -116,10 +116,10 @@ def test_a_bom_beside_the_scene_overrides_and_adds_parts(tmp_path):
 
 def test_the_cad_hierarchy_of_a_spec(tmp_path):
     pytest.importorskip("cascadio")
-    from asp.fromcad.generate import generated_spec, spec_hierarchy
+    from asp.fromcad.generate import generated_spec
 
     spec = generated_spec(STEP)
-    assert spec_hierarchy(spec) == (
+    assert spec.hierarchy == (
         ("pillar_unit_1", ("cap_1", "pillar_1")),
         ("pillar_unit_2", ("cap_2", "pillar_2")),
     )
