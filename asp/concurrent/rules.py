@@ -106,6 +106,8 @@ class Tables(NamedTuple):
         ``ROBOT`` or ``HUMAN``.
     human_op (n,) bool
         Some human may do the operation (the budget cap).
+    human_left (N,) int64
+        Per state, the operations not done that some human may do (the budget cap).
     fast (n,) int64, side_dur (2, n) int64, n_side (2,) int64
         Bounds: the least duration any worker takes (a person's range at its maximum, see
         :meth:`Rules.lower_bound`), the least of each side (a large number for none), the
@@ -134,6 +136,7 @@ class Tables(NamedTuple):
     conflict: np.ndarray
     side: np.ndarray
     human_op: np.ndarray
+    human_left: np.ndarray
     fast: np.ndarray
     side_dur: np.ndarray
     n_side: np.ndarray
@@ -409,6 +412,7 @@ def concurrent_rules(spec, graph, *, step: float | None = 1.0, fixed_order: bool
         conflict=np.asarray(conflict, dtype=np.bool_),
         side=side,
         human_op=np.asarray(human_op, dtype=np.bool_),
+        human_left=_human_left(graph.keys, human_op, graph.n_states),
         fast=fast.astype(np.int64),
         side_dur=side_dur,
         n_side=n_side,
@@ -421,6 +425,16 @@ def concurrent_rules(spec, graph, *, step: float | None = 1.0, fixed_order: bool
         kbits=np.array(bits, dtype=np.int64),
     )
     return Rules(model=model, tables=tables, fixed=fixed)
+
+
+def _human_left(keys: np.ndarray, human_op: np.ndarray, n_states: int) -> np.ndarray:
+    """(N,) int64: per state, the operations not done that some human may do."""
+    keys = np.ascontiguousarray(keys, dtype=np.uint64).reshape(n_states, -1)
+    left = np.zeros(n_states, dtype=np.int64)
+    for o in np.flatnonzero(human_op):
+        done = (keys[:, o >> 6] >> np.uint64(o & 63)) & np.uint64(1)
+        left += (done == 0).astype(np.int64)
+    return left
 
 
 def _topological(preds: list[list[int]]) -> list[int]:
@@ -444,18 +458,18 @@ def _topological(preds: list[list[int]]) -> list[int]:
 # --------------------------------------------------------------------------- kernels
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def is_done(T, s, o):  # pragma: no cover - compiled
     return (T.keys[s, o >> 6] >> np.uint64(o & 63)) & np.uint64(1) != np.uint64(0)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _label(T, o):  # pragma: no cover - compiled
     """The label of operation ``o`` (WAIT and NONE as they are)."""
     return o if o < 0 else T.label[o]
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def budget_cap_of(T, row):  # pragma: no cover - compiled
     """The budget cap: the humans times the operations not done and not running that some
     human may do (module docstring)."""
@@ -463,11 +477,7 @@ def budget_cap_of(T, row):  # pragma: no cover - compiled
     if s < 0:
         return 0
     nw = T.side.shape[0]
-    n = T.label.shape[0]
-    r = 0
-    for o in range(n):
-        if T.human_op[o] and not is_done(T, s, o):
-            r += 1
+    r = T.human_left[s]
     for w in range(nw):
         o = row[2 + w]
         if o >= 0 and T.human_op[o]:
@@ -487,23 +497,21 @@ def _start_row(T, budget):  # pragma: no cover - compiled
     return row
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def key_of(T, row):  # pragma: no cover - compiled
     """The canonical key of a (canonical) position row: its fields packed into int64 words."""
     nw = T.side.shape[0]
-    out = np.zeros(T.kword[-1] + 1, np.int64)
-    vals = np.empty(2 + 2 * nw, np.int64)
-    vals[0] = row[0] + 1
-    vals[1] = row[1] + 1
+    kword, kshift = T.kword, T.kshift
+    out = np.zeros(kword[-1] + 1, np.int64)
+    out[kword[0]] |= (row[0] + 1) << kshift[0]
+    out[kword[1]] |= (row[1] + 1) << kshift[1]
     for w in range(nw):
-        vals[2 + w] = row[2 + w] + 2
-        vals[2 + nw + w] = row[2 + nw + w]
-    for f in range(vals.shape[0]):
-        out[T.kword[f]] |= vals[f] << T.kshift[f]
+        out[kword[2 + w]] |= (row[2 + w] + 2) << kshift[2 + w]
+        out[kword[2 + nw + w]] |= row[2 + nw + w] << kshift[2 + nw + w]
     return out
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _resolve(T, s, labels, m, taken, nt, out):  # pragma: no cover - compiled
     """Real operations of the labels ``labels[:m]`` (WAIT skipped) started next to the
     operations ``taken[:nt]`` in state ``s``: an alike label takes its chain's first operation
@@ -513,95 +521,103 @@ def _resolve(T, s, labels, m, taken, nt, out):  # pragma: no cover - compiled
         if lab < 0:
             out[i] = lab
             continue
-        c = T.chain_of[lab]
-        if c < 0:
-            for j in range(nt):
-                if taken[j] == lab:
-                    return False
-            for j in range(i):
-                if out[j] == lab:
-                    return False
-            out[i] = lab
-            continue
-        found = -1
-        for p in range(T.chain_len[c]):
-            o = T.chains[c, p]
-            if is_done(T, s, o):
-                continue
-            used = False
-            for j in range(nt):
-                if taken[j] == o:
-                    used = True
-            for j in range(i):
-                if out[j] == o:
-                    used = True
-            if not used:
-                found = o
-                break
-        if found < 0:
+        o = _first_free(T, s, lab, taken, nt, out, i)
+        if o == NONE:
             return False
-        out[i] = found
+        out[i] = o
     return True
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
+def _first_free(T, s, lab, a, na, b, nb):  # pragma: no cover - compiled
+    """The real operation of the label ``lab`` (an operation) next to the operations
+    ``a[:na]`` and ``b[:nb]``: itself, or for an alike one its chain's first neither done nor
+    among them; NONE when none is left."""
+    c = T.chain_of[lab]
+    if c < 0:
+        for j in range(na):
+            if a[j] == lab:
+                return NONE
+        for j in range(nb):
+            if b[j] == lab:
+                return NONE
+        return lab
+    for p in range(T.chain_len[c]):
+        o = T.chains[c, p]
+        if is_done(T, s, o):
+            continue
+        used = False
+        for j in range(na):
+            if a[j] == o:
+                used = True
+        for j in range(nb):
+            if b[j] == o:
+                used = True
+        if not used:
+            return o
+    return NONE
+
+
+@numba.njit(cache=True, inline="always")
 def _together(T, s, ops, m):  # pragma: no cover - compiled
     """:func:`asp.graph.together.together_as` of the real operations ``ops[:m]`` (WAITs dropped)."""
-    buf = np.empty(max(m, 1), np.int64)
-    keys = np.empty(max(m, 1), np.int64)
     k = 0
     for i in range(m):
         if ops[i] >= 0:
-            buf[k] = ops[i]
-            keys[k] = T.label[ops[i]]
             k += 1
     if k == 0:
         return True
+    buf = ops  # (no WAIT among them, the callers' case: read in place)
+    if k < m:
+        buf = np.empty(k, np.int64)
+        k = 0
+        for i in range(m):
+            if ops[i] >= 0:
+                buf[k] = ops[i]
+                k += 1
+    keys = np.empty(k, np.int64)
+    for i in range(k):
+        keys[i] = T.label[buf[i]]
     return together_as(s, buf, keys, k, T.indptr, T.dst, T.lab, T.conflict)[0] == OK
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _options(T, s, w, busy, nb, out):  # pragma: no cover - compiled
     """WAIT, then the labels of the transitions of ``s`` worker ``w`` may do (state order),
     into ``out``; their number. A label whose chain has nothing left next to ``busy`` is
     left out."""
     out[0] = WAIT
     c = 1
-    one = np.empty(1, np.int64)
-    real = np.empty(1, np.int64)
     for k in range(T.indptr[s], T.indptr[s + 1]):
         lab = T.lab[k]
         if T.ndur[w, lab] == 0:
             continue
-        one[0] = lab
-        if _resolve(T, s, one, 1, busy, nb, real):
+        if _first_free(T, s, lab, busy, nb, busy, 0) != NONE:
             out[c] = lab
             c += 1
     return c
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _has_candidate(T, s, w, final, m):  # pragma: no cover - compiled
     """Worker ``w`` has an operation it may start next to the running ``final[:m]``."""
-    one = np.empty(1, np.int64)
-    real = np.empty(1, np.int64)
     both = np.empty(m + 1, np.int64)
+    for i in range(m):
+        both[i] = final[i]
     for k in range(T.indptr[s], T.indptr[s + 1]):
         lab = T.lab[k]
         if T.ndur[w, lab] == 0:
             continue
-        one[0] = lab
-        if not _resolve(T, s, one, 1, final, m, real):
+        o = _first_free(T, s, lab, final, m, final, 0)
+        if o == NONE:
             continue
-        for i in range(m):
-            both[i] = final[i]
-        both[m] = real[0]
+        both[m] = o
         if _together(T, s, both, m + 1):
             return True
     return False
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _busy(T, row):  # pragma: no cover - compiled
     nw = T.side.shape[0]
     busy = np.empty(nw, np.int64)
@@ -613,7 +629,7 @@ def _busy(T, row):  # pragma: no cover - compiled
     return busy, nb
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _union(busy, nb, real, nd, out):  # pragma: no cover - compiled
     """``busy[:nb]`` and the operations of ``real[:nd]`` (WAITs left out) into ``out``; the
     count."""
@@ -628,7 +644,7 @@ def _union(busy, nb, real, nd, out):  # pragma: no cover - compiled
     return m
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _deciders(T, row, first, busy, nb):  # pragma: no cover - compiled
     """The free workers deciding at ``row`` (``first`` 0: robots then humans; 1: humans) and
     their options (:func:`_options`): ``(deciders, nd, opts, n_opts, joint choices)``."""
@@ -651,7 +667,7 @@ def _deciders(T, row, first, busy, nb):  # pragma: no cover - compiled
     return deciders, nd, opts, n_opts, total
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _next_digit(digit, n_opts, nd):  # pragma: no cover - compiled
     """Advance the odometer ``digit[:nd]`` (the last digit fastest); False past its end."""
     d = nd - 1
@@ -696,7 +712,7 @@ def commit_rows(T, row):  # pragma: no cover - compiled
     return out[:m_out]
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def committed_row(T, row, commit):  # pragma: no cover - compiled
     """The row after the robots of ``commit`` start (durations with tool change), and the
     instructions per worker (NONE where there is none)."""
@@ -770,26 +786,30 @@ def _advance(T, cur):  # pragma: no cover - compiled
 def reply_rows(T, row, commit):  # pragma: no cover - compiled
     """Every reply to ``commit`` at ``row`` (:meth:`Rules.replies`): per reply the free
     humans' operations and durations (NONE elsewhere), its deviations, the time until the
-    next event, and the row after it."""
-    nw = T.side.shape[0]
-    width_row = 2 + 2 * nw
-    s = row[0]
-    budget = row[1]
+    next event, and the row after it (:func:`reply_choices`, then :func:`replies_of`)."""
     cur, told = committed_row(T, row, commit)
+    return replies_of(T, row, cur, reply_choices(T, cur, told))
+
+
+@numba.njit(cache=True)
+def reply_choices(T, cur, told):  # pragma: no cover - compiled
+    """(K, W + 1) int64: the joint choices of the free humans at ``cur`` (the robots' starts
+    running) told ``told``: per worker the operation (or WAIT) a free human starts, NONE for
+    the others, and in the last column the deviations. Every rule of a reply but the budget
+    (the operations resolved and compatible, a human not told to wait never idle while it has
+    something to start): they read the state, the running operations and the instructions
+    only, never the remaining times nor the budget."""
+    nw = T.side.shape[0]
+    s = cur[0]
     busy, nb = _busy(T, cur)
-    deciders, nd, opts, n_opts, _ = _deciders(T, cur, 1, busy, nb)
-    cap = 16
-    r_ops = np.full((cap, nw), NONE, np.int64)
-    r_dur = np.full((cap, nw), NONE, np.int64)
-    r_cost = np.zeros((cap, 2), np.int64)  # deviations, time until the next event
-    r_rows = np.zeros((cap, width_row), np.int64)
+    deciders, nd, opts, n_opts, total = _deciders(T, cur, 1, busy, nb)
+    out = np.full((max(total, 1), nw + 1), NONE, np.int64)
     n_out = 0
-    digit = np.zeros(max(nd, 1), np.int64)
-    labels = np.empty(max(nd, 1), np.int64)
-    real = np.empty(max(nd, 1), np.int64)
-    final = np.empty(nw, np.int64)
-    sd = np.zeros(max(nd, 1), np.int64)
-    nxt = np.empty(width_row, np.int64)
+    scratch = np.zeros(4 * nw, np.int64)
+    digit = scratch[:nw]
+    labels = scratch[nw : 2 * nw]
+    real = scratch[2 * nw : 3 * nw]
+    final = scratch[3 * nw :]
     while True:
         for d in range(nd):
             labels[d] = opts[d, digit[d]]
@@ -798,12 +818,6 @@ def reply_rows(T, row, commit):  # pragma: no cover - compiled
         if ok:
             m = _union(busy, nb, real, nd, final)
             ok = m > 0 and _together(T, s, final, m)
-        dev = 0
-        if ok:
-            for d in range(nd):
-                if _label(T, real[d]) != _label(T, told[deciders[d]]):
-                    dev += 1
-            ok = dev <= budget
         if ok:
             # A human not told to wait does not idle while it has something to start.
             for d in range(nd):
@@ -812,61 +826,104 @@ def reply_rows(T, row, commit):  # pragma: no cover - compiled
                     ok = False
                     break
         if ok:
+            dev = 0
             for d in range(nd):
-                sd[d] = 0
-            while True:
-                nxt[:] = cur
-                for d in range(nd):
-                    o = real[d]
-                    if o >= 0:
-                        w = deciders[d]
-                        nxt[2 + w] = o
-                        nxt[2 + nw + w] = (
-                            T.dur[w, o, sd[d]] + T.change[edge(s, T.label[o], T.indptr, T.lab)]
-                        )
-                nxt[1] = budget - dev
-                durations = nxt[2 + nw :].copy()
-                delta = _advance(T, nxt)
-                dup = False
-                for i in range(n_out):
-                    if r_cost[i, 1] == delta:
-                        same = True
-                        for f in range(width_row):
-                            if r_rows[i, f] != nxt[f]:
-                                same = False
-                                break
-                        if same:
-                            dup = True
-                            break
-                if not dup:
-                    if n_out == cap:
-                        cap *= 2
-                        r_ops = _grow(r_ops, cap, NONE)
-                        r_dur = _grow(r_dur, cap, NONE)
-                        r_rows = _grow(r_rows, cap, 0)
-                        r_cost = _grow(r_cost, cap, 0)
-                    for d in range(nd):
-                        w = deciders[d]
-                        r_ops[n_out, w] = real[d]
-                        if real[d] >= 0:
-                            r_dur[n_out, w] = durations[w]
-                    r_cost[n_out, 0] = dev
-                    r_cost[n_out, 1] = delta
-                    r_rows[n_out] = nxt
-                    n_out += 1
-                # next durations
-                d = nd - 1
-                while d >= 0:
-                    if real[d] >= 0:
-                        sd[d] += 1
-                        if sd[d] < T.ndur[deciders[d], real[d]]:
-                            break
-                        sd[d] = 0
-                    d -= 1
-                if d < 0:
-                    break
+                out[n_out, deciders[d]] = real[d]
+                if _label(T, real[d]) != _label(T, told[deciders[d]]):
+                    dev += 1
+            out[n_out, nw] = dev
+            n_out += 1
         if not _next_digit(digit, n_opts, nd):
             break
+    return out[:n_out]
+
+
+@numba.njit(cache=True)
+def replies_of(T, row, cur, choices):  # pragma: no cover - compiled
+    """The replies (as :func:`reply_rows`) of the joint choices ``choices``
+    (:func:`reply_choices` at ``cur``, the row ``row`` with the robots' starts running) the
+    budget allows: each with every duration its humans may take, the next event after it,
+    and replies that lead to the same position at the same cost given once."""
+    nw = T.side.shape[0]
+    width_row = 2 + 2 * nw
+    s = row[0]
+    budget = row[1]
+    cap = 16
+    r_ops = np.full((cap, nw), NONE, np.int64)
+    r_dur = np.full((cap, nw), NONE, np.int64)
+    r_cost = np.zeros((cap, 2), np.int64)  # deviations, time until the next event
+    r_rows = np.zeros((cap, width_row), np.int64)
+    n_out = 0
+    # The scratch arrays in one allocation (this runs per commitment tried).
+    scratch = np.zeros(4 * nw + width_row, np.int64)
+    deciders = scratch[:nw]
+    real = scratch[nw : 2 * nw]
+    sd = scratch[2 * nw : 3 * nw]
+    durations = scratch[3 * nw : 4 * nw]
+    nxt = scratch[4 * nw :]
+    for k in range(choices.shape[0]):
+        dev = choices[k, nw]
+        if dev > budget:
+            continue
+        nd = 0
+        for w in range(nw):
+            if choices[k, w] != NONE:
+                deciders[nd] = w
+                real[nd] = choices[k, w]
+                nd += 1
+        for d in range(nd):
+            sd[d] = 0
+        while True:
+            nxt[:] = cur
+            for d in range(nd):
+                o = real[d]
+                if o >= 0:
+                    w = deciders[d]
+                    nxt[2 + w] = o
+                    nxt[2 + nw + w] = (
+                        T.dur[w, o, sd[d]] + T.change[edge(s, T.label[o], T.indptr, T.lab)]
+                    )
+            nxt[1] = budget - dev
+            durations[:] = nxt[2 + nw :]
+            delta = _advance(T, nxt)
+            dup = False
+            for i in range(n_out):
+                if r_cost[i, 1] == delta:
+                    same = True
+                    for f in range(width_row):
+                        if r_rows[i, f] != nxt[f]:
+                            same = False
+                            break
+                    if same:
+                        dup = True
+                        break
+            if not dup:
+                if n_out == cap:
+                    cap *= 2
+                    r_ops = _grow(r_ops, cap, NONE)
+                    r_dur = _grow(r_dur, cap, NONE)
+                    r_rows = _grow(r_rows, cap, 0)
+                    r_cost = _grow(r_cost, cap, 0)
+                for d in range(nd):
+                    w = deciders[d]
+                    r_ops[n_out, w] = real[d]
+                    if real[d] >= 0:
+                        r_dur[n_out, w] = durations[w]
+                r_cost[n_out, 0] = dev
+                r_cost[n_out, 1] = delta
+                r_rows[n_out] = nxt
+                n_out += 1
+            # next durations
+            d = nd - 1
+            while d >= 0:
+                if real[d] >= 0:
+                    sd[d] += 1
+                    if sd[d] < T.ndur[deciders[d], real[d]]:
+                        break
+                    sd[d] = 0
+                d -= 1
+            if d < 0:
+                break
     return r_ops[:n_out], r_dur[:n_out], r_cost[:n_out, 0], r_cost[:n_out, 1], r_rows[:n_out]
 
 
@@ -898,9 +955,14 @@ def lower_bound_of(T, row):  # pragma: no cover - compiled
         return 0
     nw = T.side.shape[0]
     n = T.label.shape[0]
-    ef = np.full(n, -1, np.int64)  # -1: done
+    scratch = np.empty(2 * n + nw, np.int64)  # (one allocation: this runs per commitment)
+    ef = scratch[:n]  # -1: done
+    ef[:] = -1
+    todo = scratch[n : 2 * n]  # 1: to do
+    todo[:] = 0
+    rems = scratch[2 * n :]
+    rems[:] = 0
     lb = 0
-    rems = np.zeros(nw, np.int64)
     for w in range(nw):
         o = row[2 + w]
         if o >= 0:
@@ -909,13 +971,13 @@ def lower_bound_of(T, row):  # pragma: no cover - compiled
             rems[w] = r
             if r > lb:
                 lb = r
-    todo = np.zeros(n, np.bool_)
-    forced = np.zeros(2, np.int64)
+    forced0 = 0
+    forced1 = 0
     for i in range(n):
         o = T.topo[i]
         if ef[o] >= 0 or is_done(T, s, o):
             continue
-        todo[o] = True
+        todo[o] = 1
         e = 0
         for k in range(T.pred_ptr[o], T.pred_ptr[o + 1]):
             p = T.pred[k]
@@ -926,25 +988,25 @@ def lower_bound_of(T, row):  # pragma: no cover - compiled
             lb = ef[o]
         rb, hb = T.side_dur[0, o] < BIG, T.side_dur[1, o] < BIG
         if rb and not hb:
-            forced[0] += T.side_dur[0, o]
+            forced0 += T.side_dur[0, o]
         elif hb and not rb:
-            forced[1] += T.side_dur[1, o]
+            forced1 += T.side_dur[1, o]
     # Load: the least T >= lb at which the work fits the two sides.
     hi = lb
-    while not _fits(T, hi, rems, forced, todo):
+    while not _fits(T, hi, rems, forced0, forced1, todo):
         hi = 2 * hi + 1
     lo = lb
     while lo < hi:
         mid = (lo + hi) // 2
-        if _fits(T, mid, rems, forced, todo):
+        if _fits(T, mid, rems, forced0, forced1, todo):
             hi = mid
         else:
             lo = mid + 1
     return lo
 
 
-@numba.njit(cache=True)
-def _fits(T, t, rems, forced, todo):  # pragma: no cover - compiled
+@numba.njit(cache=True, inline="always")
+def _fits(T, t, rems, forced0, forced1, todo):  # pragma: no cover - compiled
     """Whether the remaining work fits both sides by time ``t`` (:func:`lower_bound_of`)."""
     nw = T.side.shape[0]
     cap0 = 0  # (scalars, not an array: this runs a dozen times per bound)
@@ -955,13 +1017,13 @@ def _fits(T, t, rems, forced, todo):  # pragma: no cover - compiled
                 cap0 += t - rems[w]
             else:
                 cap1 += t - rems[w]
-    room = cap1 - forced[1]
-    if room < 0 or cap0 < forced[0]:
+    room = cap1 - forced1
+    if room < 0 or cap0 < forced0:
         return False
     need = 0.0  # robot work of the operations both may do, the person taking the best ratio
     for i in range(T.flex.shape[0]):
         o = T.flex[i]
-        if not todo[o]:
+        if todo[o] == 0:
             continue
         h = T.side_dur[1, o]
         if room >= h:
@@ -970,4 +1032,4 @@ def _fits(T, t, rems, forced, todo):  # pragma: no cover - compiled
             frac = 1.0 - room / h if h > 0 else 0.0
             room = 0
             need += frac * T.side_dur[0, o]
-    return need <= cap0 - forced[0] + 1e-9
+    return need <= cap0 - forced0 + 1e-9

@@ -64,6 +64,17 @@ Every rule that cuts the search, with its proof:
    floor ends the search at once (the schedule's line at ``k = 0`` when CP-SAT proved it
    optimal), instead of refuting every other commitment.
 
+8. *Moves memoised.* A position's commitments (:func:`asp.concurrent.rules.commit_rows`)
+   depend on its state and on which operation each worker runs, not on the remaining times
+   nor on the budget (the kernel reads no other field), so each search call keeps them per
+   ``(state, running operations)`` (:func:`_commits_of`) and positions that differ only
+   there share one list. Likewise the human side's joint choices after a commitment
+   (:func:`asp.concurrent.rules.reply_choices`: every rule of a reply but the budget) per
+   state, running operations and instructions (:func:`_choices_of`); the budget, the
+   durations and the next event are applied to them per position
+   (:func:`asp.concurrent.rules.replies_of`). The same lists, so the values and the order
+   are unchanged; each memo holds at most one entry per position or human node expanded.
+
 The values ``W*(k)`` for ``k = 0, 1, ...`` and ``W*(inf)`` (the budget at its cap) share one
 table; a curve stops when ``W*(k) = W*(inf)`` (flat), at ``max_k``, or when a limit is hit.
 
@@ -118,6 +129,8 @@ from asp.concurrent.rules import (
     is_done,
     key_of,
     lower_bound_of,
+    replies_of,
+    reply_choices,
     reply_rows,
 )
 from asp.graph.together import edge
@@ -407,6 +420,113 @@ def _report(nodes: int, entries: int, best: int, budget: int, secs: float) -> No
     )
 
 
+@numba.njit(cache=True)
+def _new_moves(nw, slots, pool):  # pragma: no cover - compiled
+    """A free memo of commitments (:func:`_commits_of`): keys ``(state + 1, running ops)``
+    (``slots``, a power of two), each entry's first row and count in ``pool`` (rows of
+    ``nw``), and ``[entries, pool rows used]``."""
+    return (
+        np.zeros((slots, 2), np.int64),
+        np.empty(slots, np.int64),
+        np.empty(slots, np.int64),
+        np.empty((pool, nw), np.int64),
+        np.zeros(2, np.int64),
+    )
+
+
+@numba.njit(cache=True)
+def _moves_slot(keys, k0, k1):  # pragma: no cover - compiled
+    """The slot of the memo key ``(k0, k1)``: where it is, or the free slot where it goes."""
+    h = np.uint64(k0) * np.uint64(0x9E3779B97F4A7C15)
+    h ^= np.uint64(k1) * np.uint64(0xBF58476D1CE4E5B9)
+    h ^= h >> np.uint64(29)
+    mask = keys.shape[0] - 1
+    i = np.int64(h & np.uint64(mask))
+    while keys[i, 0] != 0 and not (keys[i, 0] == k0 and keys[i, 1] == k1):
+        i = (i + 1) & mask
+    return i
+
+
+@numba.njit(cache=True)
+def _moves_grow(mv, more):  # pragma: no cover - compiled
+    """The memo ``mv`` in arrays with room for one more entry of ``more`` rows."""
+    keys, start, count, pool, meta = mv
+    slots = keys.shape[0]
+    while 2 * (meta[0] + 1) > slots:
+        slots *= 2
+    rows = pool.shape[0]
+    while meta[1] + more > rows:
+        rows *= 2
+    new = _new_moves(pool.shape[1], slots, rows)
+    nk, ns, nc, npool, nmeta = new
+    npool[: meta[1]] = pool[: meta[1]]
+    nmeta[:] = meta
+    for i in range(keys.shape[0]):
+        if keys[i, 0] != 0:
+            j = _moves_slot(nk, keys[i, 0], keys[i, 1])
+            nk[j] = keys[i]
+            ns[j] = start[i]
+            nc[j] = count[i]
+    return new
+
+
+@numba.njit(cache=True)
+def _memo_put(mv, k0, k1, rows):  # pragma: no cover - compiled
+    """``rows`` into the memo ``mv`` under the key ``(k0, k1)`` (absent); ``(slot, mv)``,
+    the memo grown when it was full (the caller keeps the new one)."""
+    keys, start, count, pool, meta = mv
+    m = rows.shape[0]
+    if 2 * (meta[0] + 1) > keys.shape[0] or meta[1] + m > pool.shape[0]:
+        mv = _moves_grow(mv, m)
+        keys, start, count, pool, meta = mv
+    i = _moves_slot(keys, k0, k1)
+    keys[i, 0] = k0
+    keys[i, 1] = k1
+    start[i] = meta[1]
+    count[i] = m
+    pool[meta[1] : meta[1] + m] = rows
+    meta[1] += m
+    meta[0] += 1
+    return i, mv
+
+
+@numba.njit(cache=True)
+def _commits_of(T, mv, row):  # pragma: no cover - compiled
+    """:func:`asp.concurrent.rules.commit_rows` of ``row``, memoised in ``mv`` per state and
+    running operations (rule 8): ``(commitments, mv)``."""
+    nw = T.side.shape[0]
+    bits = T.kbits[2]
+    if nw * bits > 62:  # the running operations do not pack in one word: no memo
+        return commit_rows(T, row), mv
+    k1 = 0
+    for w in range(nw):
+        k1 |= (row[2 + w] + 2) << (bits * w)
+    k0 = row[0] + 1
+    i = _moves_slot(mv[0], k0, k1)
+    if mv[0][i, 0] == 0:
+        i, mv = _memo_put(mv, k0, k1, commit_rows(T, row))
+    return mv[3][mv[1][i] : mv[1][i] + mv[2][i]], mv
+
+
+@numba.njit(cache=True)
+def _choices_of(T, mv, cur, told):  # pragma: no cover - compiled
+    """:func:`asp.concurrent.rules.reply_choices` at ``cur`` told ``told``, memoised in ``mv``
+    per state, running operations and instructions (rule 8): ``(choices, mv)``."""
+    nw = T.side.shape[0]
+    bits = T.kbits[2]
+    if 2 * nw * bits > 62:  # no memo
+        return reply_choices(T, cur, told), mv
+    k1 = 0
+    for w in range(nw):
+        k1 |= (cur[2 + w] + 2) << (bits * w)
+        k1 |= (told[w] + 2) << (bits * (nw + w))
+    k0 = cur[0] + 1
+    i = _moves_slot(mv[0], k0, k1)
+    if mv[0][i, 0] == 0:
+        i, mv = _memo_put(mv, k0, k1, reply_choices(T, cur, told))
+    return mv[3][mv[1][i] : mv[1][i] + mv[2][i]], mv
+
+
 ENTER, NEXT_COMMIT, NEXT_REPLY, AFTER_CHILD = 0, 1, 2, 3
 """Phases of a frame of :func:`_search`'s explicit stack."""
 
@@ -464,6 +584,8 @@ def _search(T, H, root, alpha, beta, st, prefs, n_prefs):  # pragma: no cover - 
         rdelta_l.append(np.empty((1, 2), np.int64)[:0, 1])
         rlbs_l.append(np.empty(0, np.int64))
         rby_l.append(np.empty(0, np.int64))
+    moves = _new_moves(nw, 1024, 4096)  # the commitments of each (state, running ops)
+    replies = _new_moves(nw + 1, 1024, 4096)  # the human side's choices (rule 8)
     if root[0] < 0:
         return 0
     d = 0
@@ -495,7 +617,7 @@ def _search(T, H, root, alpha, beta, st, prefs, n_prefs):  # pragma: no cover - 
             slot[d] = s_
             a_[d] = max(win_a[d], lo)
             b_[d] = min(win_b[d], hi)
-            commits = commit_rows(T, row)
+            commits, moves = _commits_of(T, moves, row)
             m = commits.shape[0]
             f = H.move[s_]
             if not (0 <= f < m):
@@ -561,7 +683,9 @@ def _search(T, H, root, alpha, beta, st, prefs, n_prefs):  # pragma: no cover - 
             # The human node of the chosen commitment: the max over its replies.
             ci[d] = chosen
             beta_h[d] = min(b_[d], best[d])
-            ops, durs, dev, delta, rws = reply_rows(T, rows[d], commits[chosen])
+            cur_c, told_c = committed_row(T, rows[d], commits[chosen])
+            choices, replies = _choices_of(T, replies, cur_c, told_c)
+            ops, durs, dev, delta, rws = replies_of(T, rows[d], cur_c, choices)
             n = delta.shape[0]
             lbs = np.empty(n, np.int64)
             key_r = np.empty(n, np.int64)
