@@ -269,7 +269,13 @@ def certified_curve(
     kinds = {"hybrid": HYBRID, "greedy": GREEDY, "schedule": SCHEDULE}
     certified: dict[str, dict] = {}  # name -> budget -> certified worst case (spec units)
     games: dict[str, tuple] = {}  # name -> (policy game, its solution)
+    stopped = search.stopped
+    limit = search.limits.time_limit  # half the search's time for the certificates, in turn
+    seconds = None if limit is None else limit / 2
     if finished:
+        # W*(0..K) are known: the robust policy's positions are searched to their values
+        # again (on the search's table, past its time stop: small games at budgets <= K).
+        search.resume(None if seconds is None else time.perf_counter() + seconds)
         game = search.policy_game(budgets, ROBUST)
         if game is not None:
             sol = solve(game.dag)
@@ -278,8 +284,6 @@ def certified_curve(
     robust_inf = "robust" in certified and None in exact
     names = ["schedule"] if robust_inf else ["hybrid", "greedy", "schedule"]
     names = [n for n in names if n != "schedule" or schedule]
-    limit = search.limits.time_limit  # half the search's time for the certificates, in turn
-    seconds = None if limit is None else limit / 2
     t_cert = time.perf_counter()
 
     def share(left: int) -> float | None:
@@ -358,11 +362,11 @@ def certified_curve(
     game, solution = games[name]
     values = certified[name]
     bounds = [values.get(b, upper_k[i]) for i, b in enumerate(ks)]
-    if search.stopped:
+    if stopped:
         finite = [i for i in range(len(ks)) if np.isfinite(upper_k[i]) and upper_k[i] > 0]
         gap = max((100 * (upper_k[i] - lower_k[i]) / upper_k[i] for i in finite), default=0)
         say(
-            f"{search.stopped} reached: W*({K}) in [{lower_k[K]:g}, {upper_k[K]:g}], "
+            f"{stopped} reached: W*({K}) in [{lower_k[K]:g}, {upper_k[K]:g}], "
             f"the largest gap {gap:.1f} %"
         )
     return Curve(
@@ -374,7 +378,7 @@ def certified_curve(
         solution=solution,
         policy=name,
         schedule_worst=schedule_worst,
-        stopped=search.stopped,
+        stopped=stopped,
         nodes=search.nodes,
         positions=search.positions,
         seconds=time.perf_counter() - t0,
