@@ -23,8 +23,10 @@ from __future__ import annotations
 
 import hashlib
 import json
+import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -520,18 +522,44 @@ def _train_phase(
     _freeze_opponent(run, learner, tabulated)
     model.set_env(run.learning_env(learner), force_reset=True)
     model.set_random_seed(_phase_seed(run.seed, cycle, learner))
-    logger = None
-    if folder is not None:
-        tb = folder.staging_tb(AGENTS[learner])
-        logger = Logger(folder=str(tb), output_formats=[TensorBoardOutputFormat(str(tb))])
-        model.set_logger(logger)
     recorder = _EpisodeRecorder()
-    try:
-        model.learn(run.cfg.phase_steps, callback=recorder, reset_num_timesteps=False)
-    finally:
-        if logger is not None:
-            logger.close()
+    with writer_errors_raised():
+        logger = None
+        if folder is not None:
+            tb = folder.staging_tb(AGENTS[learner])
+            logger = Logger(folder=str(tb), output_formats=[TensorBoardOutputFormat(str(tb))])
+            model.set_logger(logger)
+        try:
+            model.learn(run.cfg.phase_steps, callback=recorder, reset_num_timesteps=False)
+        finally:
+            if logger is not None:
+                logger.close()
     return recorder.rewards
+
+
+@contextmanager
+def writer_errors_raised() -> Iterator[None]:
+    """An ``OSError`` of another thread in the block (TensorBoard's log writer writes in a
+    thread of its own) raised here, in the caller's thread, after the block, instead of
+    printed as that thread's traceback (a full disk printed one beside the command's own
+    one-line error: the reliability probe, issue 26). Other errors of threads print as
+    before."""
+    caught: list[BaseException] = []
+    previous = threading.excepthook
+
+    def hook(args) -> None:
+        if args.exc_type is not None and issubclass(args.exc_type, OSError):
+            caught.append(args.exc_value)
+        else:
+            previous(args)
+
+    threading.excepthook = hook
+    try:
+        yield
+    finally:
+        threading.excepthook = previous
+    if caught:
+        raise caught[0]
 
 
 def _freeze_opponent(run: _Run, learner: int, tabulated: bool = True) -> None:

@@ -127,3 +127,23 @@ def test_policy_stop_rule_waits_for_min_cycles_and_a_stable_window():
     assert should_stop([*stable, {"policy_hash": "a", "wcpl": 5.0}], cfg)
     changed = [*stable, {"policy_hash": "a", "wcpl": 6.0}]
     assert not should_stop(changed, cfg)  # the greedy-vs-greedy cost moved
+
+
+def test_a_writer_threads_disk_error_is_raised_in_the_caller_not_printed(capsys):
+    """The reliability probe (issue 26): on a full disk TensorBoard's writer thread printed
+    an ``OSError`` traceback beside the command's one-line error; the trainer raises it in
+    its own thread instead (the command line's error policy makes it one line)."""
+    import threading
+
+    from arl.trainer import writer_errors_raised
+
+    def full_disk():
+        raise OSError(28, "No space left on device")
+
+    before = threading.excepthook
+    with pytest.raises(OSError, match="No space left"), writer_errors_raised():
+        worker = threading.Thread(target=full_disk)
+        worker.start()
+        worker.join()
+    assert "Traceback" not in capsys.readouterr().err
+    assert threading.excepthook is before

@@ -165,3 +165,17 @@ def test_a_kill_at_any_write_point_never_leaves_a_manifest_naming_deleted_files(
             assert {(folder / n).read_bytes() for n in doc["files"]} in ({b"old"}, {b"new"})
         one_run(folder, new)  # the next run needs no --force and cleans up
         assert names(folder) == sorted([MANIFEST, *new]), f"killed at {point}"
+
+
+def test_a_full_disk_names_the_file_and_leaves_no_temporary(tmp_path, monkeypatch):
+    """The reliability probe (issue 26): a write refused by a full disk said only "no space
+    left on device" (a write's error carries no file name); it names the target now."""
+
+    def full(fd):
+        raise OSError(28, "No space left on device")
+
+    monkeypatch.setattr(atomic.os, "fsync", full)
+    with pytest.raises(OSError) as info:
+        atomic.write_bytes(tmp_path / "plan.json", b"{}")
+    assert info.value.errno == 28 and info.value.filename == str(tmp_path / "plan.json")
+    assert list(tmp_path.iterdir()) == []
