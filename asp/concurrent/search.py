@@ -584,8 +584,8 @@ def _search(T, H, root, alpha, beta, st, prefs, n_prefs):  # pragma: no cover - 
         rdelta_l.append(np.empty((1, 2), np.int64)[:0, 1])
         rlbs_l.append(np.empty(0, np.int64))
         rby_l.append(np.empty(0, np.int64))
-    moves = _new_moves(nw, 1024, 4096)  # the commitments of each (state, running ops)
-    replies = _new_moves(nw + 1, 1024, 4096)  # the human side's choices (rule 8)
+    moves = _new_moves(nw, 64, 256)  # the commitments of each (state, running ops)
+    replies = _new_moves(nw + 1, 64, 256)  # the human side's choices (rule 8)
     if root[0] < 0:
         return 0
     d = 0
@@ -751,6 +751,9 @@ def _choose(T, H, row, commits, kind, prefs, n_prefs, st):  # pragma: no cover -
     """The commitment (index) a policy of ``kind`` takes at ``row``; -1 when stopped."""
     m = commits.shape[0]
     if kind == ROBUST:
+        i = _find(H, key_of(T, row))
+        if i >= 0 and H.lo[i] == H.hi[i] and H.move[i] >= 0:
+            return H.move[i]  # exact with its move: what the search below would return
         v = _search(T, H, row, -1, INF, st, prefs, n_prefs)
         if st[ABORT]:
             return -1
