@@ -133,7 +133,15 @@ def run(args: list[str], timeout: float = 120, stdin: str = "", preexec=None, cw
         os.killpg(proc.pid, signal.SIGKILL)
         out, err = proc.communicate()
         rc = None
-    return Run(rc, out, err, time.monotonic() - t0)
+    seconds = time.monotonic() - t0
+    with _RUNS_LOCK:
+        RUNS.append((seconds, " ".join(Path(str(a)).name or str(a) for a in args)[:160]))
+    return Run(rc, out, err, seconds)
+
+
+RUNS: list[tuple[float, str]] = []
+"""Every child run: (wall seconds, its command line), for the slowest-runs list."""
+_RUNS_LOCK = threading.Lock()
 
 
 def traced(r: Run) -> bool:
@@ -1555,6 +1563,9 @@ def _table(probe: Probe, wall: float, cpu: float) -> None:
         for c in CLASSES:
             total[c] += row[c]
     print(f"| all | {sum(total.values())} | {' | '.join(str(total[c]) for c in CLASSES)} |")
+    print("\nslowest child runs (wall s):")
+    for seconds, line in sorted(RUNS, reverse=True)[:10]:
+        print(f"  {seconds:6.1f}  asmplan {line}")
     failing = [r for r in probe.results if r.cls != "clean"]
     if failing:
         print("\nfailing cases:")
