@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from types import MappingProxyType
 
+import numpy as np
 import trimesh
 
 from cad.errors import GeometryError
@@ -78,6 +79,10 @@ class Reader:
     needs : str or None
         The optional module the format needs (``cascadio`` for STEP), with
         ``extra`` the pip extra that installs it.
+    merged : bool
+        trimesh merges the vertices of this format's meshes as it reads them (and drops
+        the non-finite ones); False for glTF (and STEP, read as GLB), whose meshes it keeps
+        as stored. :func:`load_file` reads unmerged, checks, then merges where trimesh would.
     """
 
     name: str
@@ -88,6 +93,7 @@ class Reader:
     mislabel: Mislabel | None = None
     needs: str | None = None
     extra: str | None = None
+    merged: bool = True
 
     def load(self, path: Path) -> trimesh.Scene:
         """``path`` as a trimesh scene, one-line errors for bad files (:func:`load_file`)."""
@@ -95,19 +101,60 @@ class Reader:
 
 
 def load_file(path: Path, reader: Reader) -> trimesh.Scene:
-    """Read ``path`` with ``reader``'s options; a STEP through :func:`cad.step.read_step`."""
+    """Read ``path`` with ``reader``'s options; a STEP through :func:`cad.step.read_step`.
+
+    The file's meshes are read as stored (``process=False``), checked
+    (:func:`check_finite`), then processed where trimesh processes them on its own
+    (:attr:`Reader.merged`): the same meshes as ``trimesh.load(path, **options)``.
+
+    Raises
+    ------
+    GeometryError
+        A vertex with a NaN or infinite coordinate (:func:`check_finite`).
+    """
 
     def load() -> trimesh.Scene:
         try:
-            return trimesh.load(str(path), force="scene", **reader.options)
+            return trimesh.load(str(path), force="scene", process=False, **reader.options)
         except KeyError:  # trimesh cannot merge primitives without a material
-            return trimesh.load(str(path), force="scene")
+            return trimesh.load(str(path), force="scene", process=False)
 
     if reader.needs == "cascadio":
         from cad.step import read_step
 
-        return read_step(path, load)
-    return load()
+        scene = read_step(path, load)
+    else:
+        scene = load()
+    check_finite(scene, path)
+    if reader.merged:
+        for geometry in scene.geometry.values():
+            if isinstance(geometry, trimesh.Trimesh):
+                geometry.process()
+    return scene
+
+
+def check_finite(scene: trimesh.Scene, path: Path) -> None:
+    """Refuse a mesh with a NaN or infinite vertex coordinate (trimesh would drop the
+    vertex and its triangles without a word: a hole, or a part of another shape).
+
+    Raises
+    ------
+    GeometryError
+        ``FILE: vertex K has a non-finite coordinate (x, y, z)`` (``FILE: mesh 'm':
+        ...`` in a file of several), and how many such vertices there are.
+    """
+    meshes = [(n, g) for n, g in scene.geometry.items() if isinstance(g, trimesh.Trimesh)]
+    for name, mesh in meshes:
+        vertices = np.asarray(mesh.vertices, dtype=float).reshape(-1, 3)
+        bad = np.flatnonzero(~np.isfinite(vertices).all(axis=1))
+        if len(bad):
+            k = int(bad[0])
+            where = f" mesh {name!r}:" if len(meshes) > 1 else ""
+            shown = ", ".join(f"{x:g}" for x in vertices[k])
+            more = f" ({len(bad)} such vertices of {len(vertices)})" if len(bad) > 1 else ""
+            raise GeometryError(
+                f"{path}:{where} vertex {k + 1} has a non-finite coordinate ({shown}){more}"
+            )
 
 
 _STEP = Reader(
@@ -119,6 +166,7 @@ _STEP = Reader(
     mislabel=Mislabel("in", "inches", MAX_INCH_ASSEMBLY_M, 1.0 / 25.4),
     needs="cascadio",
     extra="asmplan[step]",
+    merged=False,
 )
 _GLTF = Reader(
     name="glTF",
@@ -127,6 +175,7 @@ _GLTF = Reader(
     declares_unit=True,
     default_unit="m",
     mislabel=Mislabel("m", "metres (glTF)", MAX_GLTF_ASSEMBLY_M, 1e-3),
+    merged=False,
 )
 
 READERS: Mapping[str, Reader] = MappingProxyType(

@@ -345,6 +345,7 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
         generic.append(raw is None or bool(_BODY_WORD.match(clean_name(raw))))
     bases = _alike_bases(bases, generic, meshes)
     ids = unique_ids(bases)
+    check_solid(file, ids, meshes)
     split = ()
     shells = solid_shells(file) if len(meshes) == 1 and is_format(file, "STEP") else None
     if len(meshes) == 1 and (bodies := closed_bodies(meshes[0], shells)) is not None:
@@ -369,6 +370,30 @@ def _read_scene_cached(path: str, _mtime: int, _size: int) -> SceneParts:
         rescale=rescale,
         split=split,
     )
+
+
+ZERO_AREA = 1e-12
+"""A mesh has no area when its triangles' area is at most this times its largest extent
+squared (every triangle collapsed to a line or a point, up to rounding)."""
+
+
+def check_solid(file: Path, ids: list[str], meshes: list[trimesh.Trimesh]) -> None:
+    """Refuse a part whose triangles all have zero area (:data:`ZERO_AREA`): it has no
+    surface, so no size, contact or motion; planned, it is a part of size 0.
+
+    Raises
+    ------
+    GeometryError
+        ``FILE: no solid geometry: all N triangles have zero area`` (``FILE: part 'x':
+        ...`` in a file of several).
+    """
+    for pid, mesh in zip(ids, meshes, strict=True):
+        extent = float(np.max(mesh.extents)) if len(mesh.vertices) else 0.0
+        if mesh.area <= ZERO_AREA * extent**2:
+            part = f" part {pid!r}:" if len(meshes) > 1 else ""
+            n = len(mesh.faces)
+            each = "its one triangle has" if n == 1 else f"all {n:,} triangles have"
+            raise GeometryError(f"{file}:{part} no solid geometry: {each} zero area (degenerate)")
 
 
 def warn_split(file: Path, scene: SceneParts) -> None:

@@ -12,6 +12,7 @@ from typer.testing import CliRunner
 from asmplan.cli import app
 from tests.cad import shapes
 from tests.cad.test_loading import write_folder
+from tests.cad.test_mesh_checks import FLAT_STL, INF_STL, NAN_STL
 from tests.cad.test_scene import write_3dxml, write_named_glb
 
 STEP = Path(__file__).resolve().parents[1] / "cad" / "data" / "table_frame_in.step"
@@ -244,3 +245,37 @@ def test_load_reads_a_cad_file_once(tmp_path, kind, monkeypatch):
         assembly = pipeline.load(source, on_step=lambda _: None)
     assert assembly.spec.generated and assembly.relations is not None
     assert reads == ["load_assembly"] + (["load_parts"] if kind == "folder" else [])
+
+
+@pytest.mark.parametrize("command", ["plan", "relations", "init"])
+@pytest.mark.parametrize(
+    ("content", "said"),
+    [
+        (NAN_STL, "vertex 3 has a non-finite coordinate (nan, 1, 0)"),
+        (INF_STL, "vertex 10 has a non-finite coordinate (inf, 0, 0)"),
+        (FLAT_STL, "no solid geometry: all 4 triangles have zero area (degenerate)"),
+    ],
+    ids=["nan", "inf", "zero area"],
+)
+def test_a_part_file_of_no_solid_is_refused_at_reading(tmp_path, command, content, said):
+    """A NaN, infinite or all-degenerate STL: exit 2 with one line naming the file, nothing
+    written (it was planned: a NaN triangle dropped, a zero-area part of size 0)."""
+    path = tmp_path / "part.stl"
+    path.write_text(content)
+    out = tmp_path / "out"
+    tail = {"plan": ["-o", str(out)], "init": ["-o", str(out / "assembly.yaml")]}
+    args = [command, str(path), *tail.get(command, ["--format", "json"])]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 2, result.output
+    errors = [line for line in result.stderr.splitlines() if not line.startswith("[")]
+    assert errors == [f"asmplan: error: {path}: {said}"]  # [1/5] ...: plan's progress
+    assert not result.stdout and not out.exists()
+
+
+def test_a_folder_part_of_no_solid_is_named(tmp_path):
+    """A folder whose part's mesh holds a NaN: the part's file is named."""
+    folder = write_folder(tmp_path / "asm", shapes.boxed_container())
+    (folder / "lid.stl").write_text(NAN_STL)
+    result = CliRunner().invoke(app, ["relations", str(folder)])
+    assert result.exit_code == 2 and result.stderr.count("\n") == 1
+    assert f"{folder / 'lid.stl'}: vertex 3 has a non-finite" in result.stderr
