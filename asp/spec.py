@@ -82,7 +82,7 @@ from cad.bom import PartRecord, part_records, refuse_unknown_keys
 from cad.directions import DIRECTIONS
 from cad.frame import parse_frame
 from cad.numbers import WRITTEN_PLAINLY, plain_number
-from cad.texts import MAX_NAME, MAX_TEXT, bounded
+from cad.texts import MAX_NAME, MAX_TEXT, bounded, text_value
 from cad.tolerances import checked_tolerance
 from cad.units import unit_scale
 from cad.yamlfile import read_yaml
@@ -367,10 +367,7 @@ class _Parser:
 
     def prose(self, value, key: str) -> str:
         """A free description (empty when absent), at most :data:`cad.texts.MAX_TEXT`."""
-        if isinstance(value, dict | list):
-            kind = "a mapping" if isinstance(value, dict) else "a list"
-            raise self.fail(key, f"expected a text, got {kind}")
-        return self.bounded("" if value is None else str(value), key, MAX_TEXT)
+        return text_value(value, f"{self.source}: {key}", MAX_TEXT, strip=False)
 
     def mapping(self, value, key: str, known: tuple[str, ...] = ()) -> dict:
         """A mapping (None: empty); with ``known``, any other key is refused."""

@@ -22,7 +22,7 @@ from typing import Any
 
 from cad.errors import AsmplanError
 from cad.numbers import WRITTEN_PLAINLY, plain_integer
-from cad.texts import MAX_TEXT, bounded
+from cad.texts import MAX_TEXT, text_value
 from cad.yamlfile import read_yaml
 
 PART_KEYS = ("id", "name", "file", "quantity", "type", "shape")
@@ -87,26 +87,25 @@ def part_record(row: Any, where: str) -> PartRecord:
     ------
     AsmplanError
         ``where: ...`` naming the problem: not a mapping, no id, an unknown key (the nearest
-        known one suggested), a quantity that is not a positive integer.
+        known one suggested), a mapping or list where a text goes (the key and the part
+        named), a quantity that is not a positive integer.
     """
     if isinstance(row, str | int) and not isinstance(row, bool):
         row = {"id": row}
     if not isinstance(row, dict):
         raise AsmplanError(f"{where}: expected a mapping with an 'id' or a part id")
     refuse_unknown_keys(row, PART_KEYS, where)
-    raw_id = row.get("id")
-    pid = "" if raw_id is None or isinstance(raw_id, dict | list) else str(raw_id).strip()
-    pid = bounded(pid, f"{where}: id")
+    pid = text_value(row.get("id"), f"{where}: id")
     if not pid:
         raise AsmplanError(f"{where}: part has no id")
     at = f"{where} (part {pid!r})"
     return PartRecord(
         id=pid,
-        name=bounded(_text(row.get("name")), f"{at}: name") or pid,
-        file=bounded(_text(row.get("file")), f"{at}: file", MAX_TEXT) or None,
+        name=text_value(row.get("name"), f"{at}: name") or pid,
+        file=text_value(row.get("file"), f"{at}: file", MAX_TEXT) or None,
         quantity=_quantity(row.get("quantity"), at),
-        type=bounded(_text(row.get("type")), f"{at}: type"),
-        shape=bounded(_text(row.get("shape")), f"{at}: shape"),
+        type=text_value(row.get("type"), f"{at}: type"),
+        shape=text_value(row.get("shape"), f"{at}: shape"),
     )
 
 
@@ -152,10 +151,6 @@ def read_bom(path: str | Path) -> tuple[PartRecord, ...]:
     if not isinstance(rows, list):
         raise AsmplanError(f"BOM {path} must be a list of parts")
     return part_records(rows, f"BOM {path}: row")
-
-
-def _text(value: Any) -> str:
-    return "" if value is None else str(value).strip()
 
 
 def _quantity(value: Any, where: str) -> int:

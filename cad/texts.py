@@ -4,7 +4,8 @@ A name (an assembly, a part, an operation, an agent, a tool, a value) is drawn i
 titles and table cells and keyed on; a description is printed beside a step. Neither has a
 use at megabytes, where drawing a title alone took minutes and gigabytes (a 5 MB assembly
 name). :func:`bounded` refuses a longer text in one line naming where it is, its length and
-the bound.
+the bound; :func:`text_value` also refuses a mapping or a list where a text is read (it
+would become the text of a Python dict).
 """
 
 from __future__ import annotations
@@ -32,4 +33,20 @@ def bounded(text: str, where: str, limit: int = MAX_NAME) -> str:
     return text
 
 
-__all__ = ["MAX_NAME", "MAX_TEXT", "bounded"]
+def text_value(value, where: str, limit: int = MAX_NAME, *, strip: bool = True) -> str:
+    """``value`` read as a text ("" for None; a number as written), within ``limit``
+    (:func:`bounded`), stripped unless ``strip`` is False.
+
+    Raises
+    ------
+    AsmplanError
+        ``where: expected a text, got a mapping`` (or a list), or over the limit.
+    """
+    if isinstance(value, dict | list):
+        kind = "a mapping" if isinstance(value, dict) else "a list"
+        raise AsmplanError(f"{where}: expected a text, got {kind}")
+    text = "" if value is None else str(value)
+    return bounded(text.strip() if strip else text, where, limit)
+
+
+__all__ = ["MAX_NAME", "MAX_TEXT", "bounded", "text_value"]

@@ -85,6 +85,17 @@ def test_valid_spec_defaults():
         (("operations", 0, "description"), {"a": 1}, r"description: expected a text, got a map"),
         (("agents", "H", "description"), [1, 2], r"H\.description: expected a text, got a list"),
         (("credit",), {"by": "me"}, r"credit: expected a text"),
+        # a part's text given a mapping or list: the key, the part and the value's type
+        (
+            ("parts", 0, "type"),
+            {"a": 1},
+            r"parts\[0\] \(part 'A'\): type: expected a text, got a map",
+        ),
+        (("parts", 0, "type"), ["screw"], r"\(part 'A'\): type: expected a text, got a list"),
+        (("parts", 1, "name"), {"a": 1}, r"\(part 'B'\): name: expected a text, got a mapping"),
+        (("parts", 1, "shape"), [1], r"\(part 'B'\): shape: expected a text, got a list"),
+        (("parts", 0, "file"), {"a": 1}, r"\(part 'A'\): file: expected a text, got a mapping"),
+        (("parts", 0, "id"), {"a": 1}, r"parts\[0\]: id: expected a text, got a mapping"),
     ],
 )
 def test_validation_errors_name_file_key_and_culprit(path, value, message):

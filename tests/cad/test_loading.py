@@ -155,6 +155,12 @@ BAD = [
     ),
     ("bad quantity", lambda d: _bad_bom(d, "a,,lid.stl,many,\n"), ValueError, "quantity"),
     (
+        "bom type a mapping",
+        lambda d: _write(d / "bom.yaml", "parts: [{id: lid, file: lid.stl, type: {a: 1}}]\n") and d,
+        ValueError,
+        r"row\[0\] \(part 'lid'\): type: expected a text, got a mapping",
+    ),
+    (
         "unreadable file",
         lambda d: _write(d / "junk.stl", "not a mesh at all"),
         ValueError,
