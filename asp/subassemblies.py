@@ -208,7 +208,10 @@ def build_with_units(
                 return build(current)
             except StateLimit:
                 if not isinstance(first_error, _Proved):
-                    raise
+                    graph = _fasteners_in_order(build, current, relations, say)
+                    if graph is None:
+                        raise
+                    return graph
                 # units guessed for a proved failure, too many states to try: the proof
                 said = _with_locking(first_error, relations)
                 raise InfeasibleAssembly(
@@ -265,6 +268,39 @@ def build_with_units(
             f"the file's sub-assembl{'y' if len(drop) == 1 else 'ies'} {', '.join(sorted(drop))}"
             f": {GIVEN_UP}; planned without it"
         )
+
+
+def _fasteners_in_order(build, spec: AssemblySpec, relations, say):
+    """The state graph of ``spec`` with its joining parts (screws, pins) in one order after
+    the parts they join (:func:`asp.graph.fasteners.fastener_order`: sound, and complete
+    whenever some complete sequence places each after its two parts), or None when it has
+    none of them or that graph also fails (the caller's error stands)."""
+    from asp.graph.fasteners import fastener_order
+
+    ordered, found = fastener_order(spec, relations)
+    if not found:
+        return None
+
+    def listed(ids: list[str]) -> str:
+        return ", ".join(ids[:6]) + (f" and {len(ids) - 6} more" if len(ids) > 6 else "")
+
+    held = [
+        op.parts[0]
+        for op, was in zip(ordered.operations, spec.operations, strict=True)
+        if op.held > was.held
+    ]
+    say(
+        f"too many states: {len(found)} joining parts (each touches only the two parts it "
+        "joins and goes in whatever else is there: screws, pins) placed in one order, each "
+        f"after the two parts it joins ({listed([j.part for j in found])}; "
+        "asp/graph/fasteners.py)"
+        + (f"; held while its joining parts go in: {listed(held)}" if held else "")
+    )
+    try:
+        return build(ordered)
+    except (StateLimit, InfeasibleAssembly) as exc:
+        say(f"with the joining parts in one order: {exc}")
+        return None
 
 
 def refuted_units(
@@ -359,7 +395,7 @@ def built_in_turn(spec: AssemblySpec) -> AssemblySpec:
     units = list(spec.subassemblies)
     if math.prod(len(ms) + 1 for _, ms in units) <= MAX_WORKSPACE_PRODUCT:
         return spec
-    from dataclasses import replace
+    from asp.graph.precedences import with_waits
 
     position = {p: k for k, op in enumerate(spec.operations) for p in op.parts}
     units.sort(key=lambda u: min(position[m] for m in u[1]))
@@ -371,13 +407,7 @@ def built_in_turn(spec: AssemblySpec) -> AssemblySpec:
     for (before, _), (uid, _) in zip(units, units[1:], strict=False):
         for o in ops_of[uid]:
             wait[o] = tuple(ops_of[before])
-    ops = [
-        replace(op, after=tuple(dict.fromkeys((*op.after, *wait[op.id]))))
-        if wait.get(op.id)
-        else op
-        for op in spec.operations
-    ]
-    return replace(spec, operations=tuple(ops))
+    return with_waits(spec, wait)
 
 
 def hung_on_units(

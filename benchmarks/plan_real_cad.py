@@ -141,10 +141,11 @@ def check_plan(path: str, doc: dict) -> str:
     return "ok"
 
 
-def follow_message(path: str, out: str, timeout: float) -> dict | None:
-    """The plan after the one message an overlapping file gets: ``asmplan init`` writes the
-    spec with the lines the message names commented (``overlap_ok:``, and ``flex:`` when
-    parts then lock); uncommented, the spec is planned as :func:`plan_one` plans a file.
+def follow_message(path: str, out: str, timeout: float, message: str = "") -> dict | None:
+    """The plan after the one message a file gets: ``asmplan init`` writes the spec with the
+    lines the message names commented (``overlap_ok:``, and ``flex:`` when parts then
+    lock); uncommented, and a line of ``message`` init does not write added (a ``flex:``
+    found by the state graph), the spec is planned as :func:`plan_one` plans a file.
     None when init fails."""
     folder = Path(out) / "spec"
     folder.mkdir(parents=True, exist_ok=True)
@@ -155,7 +156,11 @@ def follow_message(path: str, out: str, timeout: float) -> dict | None:
     if made.returncode != 0 or not spec.is_file():
         return None
     text = spec.read_text()
-    spec.write_text(re.sub(r"(?m)^# ((overlap_ok|flex): \[)", r"\1", text))
+    text = re.sub(r"(?m)^# ((overlap_ok|flex): \[)", r"\1", text)
+    for line in re.findall(r"`((?:overlap_ok|flex): \[[^`]*\])`", message):
+        if not re.search(rf"(?m)^{line.split(':')[0]}:", text):
+            text = text.replace("\noperations:", f"\n{line}\noperations:", 1)
+    spec.write_text(text)
     return plan_one(str(spec), str(Path(out) / "followed"), timeout)
 
 
@@ -235,7 +240,7 @@ def main(argv: list[str]) -> None:
         print(json.dumps(plan_one(argv[1], argv[2], float(argv[3]))))
         return
     if argv[:1] == ["--follow"]:
-        print(json.dumps(follow_message(argv[1], argv[2], float(argv[3]))))
+        print(json.dumps(follow_message(argv[1], argv[2], float(argv[3]), *argv[4:5])))
         return
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("paths", nargs="*", help="assemblies, or folders to search for them")
@@ -275,9 +280,11 @@ def main(argv: list[str]) -> None:
             print_row(row)
             if "error" in row:
                 errors.append(f"{row['assembly']}: {row['error']}")
-            if "`overlap_ok: [" in row.get("error", ""):  # the one message, followed
+            message = row.get("error", "")
+            if "`overlap_ok: [" in message or "`flex: [" in message:  # the one message, followed
                 run = subprocess.run(
-                    [sys.executable, __file__, "--follow", str(path), str(out), str(args.timeout)],
+                    [sys.executable, __file__, "--follow", str(path), str(out), str(args.timeout)]
+                    + [message],
                     capture_output=True,
                     text=True,
                 )

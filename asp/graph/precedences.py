@@ -431,6 +431,18 @@ def _closure(must: list[int]) -> list[int]:
     return out
 
 
+def with_waits(spec: AssemblySpec, wait: dict[str, tuple[str, ...]]) -> AssemblySpec:
+    """``spec`` with each operation ``o`` of ``wait`` also after ``wait[o]`` (``after``, each
+    predecessor once): precedences added, so the state graph only loses sequences."""
+    ops = tuple(
+        replace(op, after=tuple(dict.fromkeys((*op.after, *wait[op.id]))))
+        if wait.get(op.id)
+        else op
+        for op in spec.operations
+    )
+    return replace(spec, operations=ops)
+
+
 def with_derived_precedences(spec: AssemblySpec, relations) -> AssemblySpec:
     """``spec`` with the derived precedences of :func:`reduced_model` as ``after`` (only the
     direct ones: a predecessor implied by another is left out). Every completable state keeps

@@ -1,0 +1,140 @@
+"""Joining parts (screws, pins) in one order after the parts they join: sound, complete."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from asp.errors import StateLimit
+from asp.graph.checker import PlanCheckError, check_line
+from asp.graph.fasteners import fastener_order, joining_parts
+from asp.graph.state_graph import build_state_graph
+from asp.spec import spec_from_dict
+from asp.subassemblies import build_with_units
+from tests.asp.helpers_assembly import LATERAL, relations
+
+
+def screwed_brackets(n_brackets=3, screws=2):
+    """A base, brackets standing on it, each fixed by screws through it into the base
+    (a screw touches its bracket and the base, goes in along -z, and once in keeps its
+    bracket from leaving upwards)."""
+    brackets = [f"bracket{k}" for k in range(n_brackets)]
+    fixing = {b: [f"{b}_screw{s}" for s in range(screws)] for b in brackets}
+    parts = ("base", *brackets, *(s for ss in fixing.values() for s in ss))
+    contacts = [(b, "base", "-z") for b in brackets]
+    blocks = [(b, "base", "-z") for b in brackets]
+    for b, ss in fixing.items():
+        contacts += [c for s in ss for c in ((s, b, "-z"), (s, "base", "-z"))]
+        blocks += [(s, q, d) for s in ss for q in (b, "base") for d in ("-z", *LATERAL)]
+    rel = relations(parts, contacts, blocks)
+    ops = [
+        {"id": p, "agents": {"H": 2 + k % 3, "R": 3}, "part": p} for k, p in enumerate(parts[1:])
+    ]
+    data = {
+        "parts": [{"id": p, "file": f"{p}.stl"} for p in parts],
+        "agents": {"H": {"side": "human"}, "R": {"side": "robot"}},
+        "base_part": "base",
+        "operations": ops,
+    }
+    return spec_from_dict(data, source="brackets.yaml"), rel
+
+
+def done_sets(graph) -> set[frozenset[str]]:
+    """Every state of ``graph`` as the set of operations done on some path to it."""
+    out = set()
+    for seq in graph.sequences(limit=10_000):
+        for k in range(len(seq) + 1):
+            out.add(frozenset(seq[:k]))
+    return out
+
+
+def test_the_screws_are_the_joining_parts_and_wait_for_what_they_join():
+    spec, rel = screwed_brackets()
+    found = joining_parts(spec, rel)
+    assert sorted(j.part for j in found) == sorted(p for p in rel.parts if "screw" in p)
+    assert all(set(j.joins) == {"base", j.part.split("_")[0]} for j in found)
+    ordered, chain = fastener_order(spec, rel)
+    for before, j in zip(chain, chain[1:], strict=False):  # one chain, after both joined
+        assert set(ordered.operation(j.operation).after) == {j.joins[1], before.operation}
+    assert not any(op.held for op in ordered.operations)  # the brackets rest on the base
+
+
+def test_the_order_keeps_only_sound_sequences_and_a_complete_one():
+    spec, rel = screwed_brackets()
+    full = build_state_graph(spec, rel)
+    ordered, _ = fastener_order(spec, rel)
+    reduced = build_state_graph(ordered, rel)
+    assert reduced.n_states < full.n_states // 10
+    assert done_sets(reduced) <= done_sets(full)  # a sub-graph of the full graph
+    sequences = reduced.sequences(limit=50)
+    assert sequences
+    for seq in sequences:
+        check_line(spec, rel, seq)  # the original spec's rules, replayed independently
+
+
+@pytest.mark.parametrize(
+    "change",
+    [
+        "screw blocked by a cover along its only way",  # (2): does not go in whatever is there
+        "screw touches a third part",  # (1)
+        "screw has a predecessor",
+    ],
+)
+def test_a_part_that_is_no_joining_part_is_left_alone(change):
+    spec, rel = screwed_brackets(n_brackets=2, screws=1)
+    screw = "bracket0_screw0"
+    s = rel.parts.index(screw)
+    tc, tt = rel.tc.copy(), rel.tt.copy()
+    if change.startswith("screw blocked"):
+        other = rel.parts.index("bracket1")
+        tt[s, other, 4] = tt[other, s, 5] = False
+    elif change.startswith("screw touches"):
+        other = rel.parts.index("bracket1")
+        tc[s, other, 0] = tc[other, s, 1] = True
+    else:
+        ops = [
+            op.__class__(**{**op.__dict__, "after": ("bracket1",)}) if op.id == screw else op
+            for op in spec.operations
+        ]
+        spec = spec.__class__(**{**spec.__dict__, "operations": tuple(ops)})
+    rel = type(rel)(rel.parts, tc, tt)
+    assert screw not in {j.part for j in joining_parts(spec, rel)}
+
+
+def test_a_part_resting_only_on_its_screws_is_held_while_they_go_in():
+    spec, rel = screwed_brackets(n_brackets=2, screws=2)
+    sp = rel.tc.copy()
+    b = rel.parts.index("bracket0")
+    sp[b, :, :] = False  # bracket0 touches the base but rests only on its screws
+    for s in ("bracket0_screw0", "bracket0_screw1"):
+        sp[b, rel.parts.index(s), 5] = True
+    with_support = SimpleNamespace(parts=rel.parts, tc=rel.tc, tt=rel.tt, sp=sp)
+    ordered, _ = fastener_order(spec, with_support)
+    assert [op.id for op in ordered.operations if op.held] == ["bracket0"]
+    graph = build_state_graph(ordered, with_support)
+    for seq in graph.sequences(limit=20):
+        check_line(ordered, with_support, seq)  # replayed with the plan's held flags
+        with pytest.raises(PlanCheckError):  # loose, it has nothing to rest on
+            check_line(spec, with_support, seq)
+
+
+def test_the_state_limit_builds_the_graph_again_with_the_order_and_says_so():
+    spec, rel = screwed_brackets()
+    full = build_state_graph(spec, rel).n_states
+    ordered = build_state_graph(fastener_order(spec, rel)[0], rel).n_states
+    limit = (full + ordered) // 2
+    said: list[str] = []
+    graph = build_with_units(spec, rel, max_states=limit, on_unit=said.append)
+    assert graph.n_states == ordered
+    assert any("joining parts" in line and "one order" in line for line in said)
+    with pytest.raises(StateLimit):  # below what the order needs: the limit stands
+        build_with_units(spec, rel, max_states=ordered - 1)
+
+
+def test_no_joining_parts_no_change():
+    spec, rel = screwed_brackets(n_brackets=1, screws=1)
+    assert fastener_order(spec, rel) == (spec, [])
+    rel = type(rel)(rel.parts, np.zeros_like(rel.tc), rel.tt)
+    assert joining_parts(spec, rel) == []
