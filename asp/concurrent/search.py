@@ -74,6 +74,25 @@ Every rule that cuts the search, with its proof:
    durations and the next event are applied to them per position
    (:func:`asp.concurrent.rules.replies_of`). The same lists, so the values and the order
    are unchanged; each memo holds at most one entry per position or human node expanded.
+9. *Deviation-aware floors.* A new position at budget ``b`` takes as ``lo`` the largest of
+   its static bound and the ``lo`` the table has proved for the same position at every
+   budget ``b' < b`` (not only ``b - 1``). *Proof*: a human side allowed ``b`` deviations
+   can play every strategy of ``b'``, so ``W(s, b') <= W(s, b)`` (rule 3, by induction over
+   the budgets between), and each stored ``lo`` is a proven lower bound of its own value
+   (rule 1). A human with deviations left is thus credited with what the table proved
+   about the harm of the deviations it had before; the bound is exact wherever a lower
+   budget's value is. The values are unchanged (rule 1 holds for any admissible ``lo``);
+   only the windows close earlier.
+10. *A higher budget's move.* Where the robust policy needs the move of a position
+   ``(s, b)`` (its policy game, below) and the table proves ``W(s, b) >= v`` while the same
+   position at a budget ``b' > b`` has a stored move ``m`` proving ``hi(s, b') <= v``, ``m``
+   is optimal at ``(s, b)`` with value ``v``, without a search. *Proof*: ``m``'s human node
+   at ``b`` has a subset of its replies at ``b'`` (a reply's deviations must fit the
+   budget), each leading to the same position at a budget no larger, so by rule 3 its
+   value at ``b`` is at most its value at ``b'``, at most ``hi(s, b') <= v <= W(s, b)``,
+   and no move does better than ``W(s, b)``. (The commitments do not depend on the budget,
+   rule 8, so ``m`` is the same commitment at both.) The policy is still optimal at every
+   state it reaches; where two moves are optimal it may take the other one.
 
 The values ``W*(k)`` for ``k = 0, 1, ...`` and ``W*(inf)`` (the budget at its cap) share one
 table; a curve stops when ``W*(k) = W*(inf)`` (flat), at ``max_k``, or when a limit is hit.
@@ -254,11 +273,41 @@ def _find(H, key):  # pragma: no cover - compiled
     return -1 if H.keys[i, 0] == 0 else i
 
 
+@numba.njit(cache=True, inline="always")
+def _at_budget(T, key, b, nb):  # pragma: no cover - compiled
+    """The key ``key`` of a position at budget ``b`` with its budget set to ``nb`` (a copy;
+    the budget is one packed field, :func:`asp.concurrent.rules.key_of`)."""
+    out = key.copy()
+    out[T.kword[1]] += (nb - b) << T.kshift[1]
+    return out
+
+
+@numba.njit(cache=True)
+def _new_bounds(T, H, row, key, lb):  # pragma: no cover - compiled
+    """The interval a new entry of the position ``row`` (its key ``key``) starts with:
+    ``lo`` its lower bound (``lb`` when given, >= 0), raised to the best ``lo`` the table has
+    proved for the same position at any lower budget (rule 9), and ``hi`` its one budget
+    higher's or the cap's (rule 3), never below ``lo``."""
+    lo = lb if lb >= 0 else lower_bound_of(T, row)
+    hi = INF
+    b = row[1]
+    for nb in range(b - 1, -1, -1):  # fewer deviations left: W never rises (rule 9)
+        j = _find(H, _at_budget(T, key, b, nb))
+        if j >= 0 and H.lo[j] > lo:
+            lo = H.lo[j]
+    cap = budget_cap_of(T, row)
+    for nb in (b + 1, cap):  # one budget higher, and the cap (k = inf): W never falls
+        if nb > b:
+            j = _find(H, _at_budget(T, key, b, nb))
+            if j >= 0 and H.hi[j] < hi:
+                hi = H.hi[j]
+    return lo, max(hi, lo)
+
+
 @numba.njit(cache=True)
 def _entry(T, H, row, st, lb):  # pragma: no cover - compiled
-    """The slot of the position ``row``, made when new: ``lo`` its lower bound (``lb`` when
-    given, >= 0), raised to the same position's one budget lower and ``hi`` lowered to its
-    one budget higher or the cap's (rule 3). -1 (and the stop flag) when the table is full."""
+    """The slot of the position ``row``, made when new with the interval of
+    :func:`_new_bounds`. -1 (and the stop flag) when the table is full."""
     key = key_of(T, row)
     i = _slot(H, key)
     if H.keys[i, 0] != 0:
@@ -266,29 +315,26 @@ def _entry(T, H, row, st, lb):  # pragma: no cover - compiled
     if st[ENTRIES] >= st[MAX_ENTRIES]:
         st[ABORT] = STOP_MEMORY
         return -1
-    lo = lb if lb >= 0 else lower_bound_of(T, row)
-    hi = INF
-    b = row[1]
-    other = row.copy()
-    if b > 0:
-        other[1] = b - 1
-        j = _find(H, key_of(T, other))
-        if j >= 0 and H.lo[j] > lo:
-            lo = H.lo[j]
-    cap = budget_cap_of(T, row)
-    for nb in (b + 1, cap):  # one budget higher, and the cap (k = inf): W never falls
-        if nb > b:
-            other[1] = nb
-            j = _find(H, key_of(T, other))
-            if j >= 0 and H.hi[j] < hi:
-                hi = H.hi[j]
+    lo, hi = _new_bounds(T, H, row, key, lb)
     i = _slot(H, key)  # (the probes above did not write)
     H.keys[i] = key
     H.lo[i] = lo
-    H.hi[i] = max(hi, lo)
+    H.hi[i] = hi
     H.move[i] = -1
     st[ENTRIES] += 1
     return i
+
+
+@numba.njit(cache=True)
+def _move_above(T, H, row, key, v, m):  # pragma: no cover - compiled
+    """A move of the same position at a higher budget that proved a value at most ``v``
+    there, or -1 (rule 10: with ``v <= W`` at ``row``'s budget, it is optimal there)."""
+    b = row[1]
+    for nb in range(b + 1, budget_cap_of(T, row) + 1):
+        j = _find(H, _at_budget(T, key, b, nb))
+        if j >= 0 and 0 <= H.move[j] < m and H.hi[j] <= v:
+            return H.move[j]
+    return -1
 
 
 # --------------------------------------------------------------------------- search kernels
@@ -751,14 +797,23 @@ def _choose(T, H, row, commits, kind, prefs, n_prefs, st):  # pragma: no cover -
     """The commitment (index) a policy of ``kind`` takes at ``row``; -1 when stopped."""
     m = commits.shape[0]
     if kind == ROBUST:
-        i = _find(H, key_of(T, row))
+        key = key_of(T, row)
+        i = _find(H, key)
         if i >= 0 and H.lo[i] == H.hi[i] and H.move[i] >= 0:
             return H.move[i]  # exact with its move: what the search below would return
+        if i >= 0:  # a higher budget's move proving at most the proven floor (rule 10)
+            f = _move_above(T, H, row, key, H.lo[i], m)
+            if f >= 0:
+                return f
         v = _search(T, H, row, -1, INF, st, prefs, n_prefs)
         if st[ABORT]:
             return -1
-        i = _find(H, key_of(T, row))
-        if H.move[i] < 0:  # exact by bounds alone (rule 3): search again for the move
+        i = _find(H, key)
+        if H.move[i] < 0:
+            f = _move_above(T, H, row, key, v, m)
+            if f >= 0:
+                return f
+            # exact by bounds alone (rule 3): search again for the move
             H.hi[i] = INF
             _search(T, H, row, v - 1, v + 1, st, prefs, n_prefs)
             if st[ABORT]:
@@ -1113,6 +1168,21 @@ class Search:
         if i < 0:
             return int(lower_bound_of(self.rules.tables, row)), INF
         return int(self.table.lo[i]), int(self.table.hi[i])
+
+    def interval(self, pos) -> tuple[int, int]:
+        """The interval (scaled) the table proves for a position
+        (:class:`asp.concurrent.rules.Position`), or, for one it does not hold, the interval
+        a new entry would start with (rules 2, 3 and 9): ``lo <= W <= hi``."""
+        if self.rules.is_end(pos):
+            return 0, 0
+        t = self.rules.tables
+        row = pos.row()
+        key = key_of(t, row)
+        i = _find(self.table, key)
+        if i >= 0:
+            return int(self.table.lo[i]), int(self.table.hi[i])
+        lo, hi = _new_bounds(t, self.table, row, key, -1)
+        return int(lo), int(hi)
 
     def policy_game(
         self, budgets: list[int | None], kind: int, schedule: list[dict] | None = None

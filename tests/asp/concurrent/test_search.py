@@ -226,3 +226,47 @@ def test_a_table_that_grows_gives_the_same_values(data):
         start_values(curve.game, range(curve.k + 1))
         == [w / rules.scale for w in want][: curve.k + 1]
     )
+
+
+def every_position(rules, pos, out: dict) -> int:
+    """The exact value (scaled) of ``pos`` by plain recursion over the rules; ``out`` gets
+    every position reached, by key, with its value."""
+    if rules.is_end(pos):
+        return 0
+    key = rules.key(pos)
+    if key not in out:
+        out[key] = (
+            pos,
+            min(
+                max(r.delta + every_position(rules, nxt, out) for r, nxt in rules.replies(pos, c))
+                for c in rules.commits(pos)
+            ),
+        )
+    return out[key][1]
+
+
+@SETTINGS
+@given(
+    random_jobs(humans=(1, 2), ranges=True), st.randoms(use_true_random=False), st.integers(0, 3)
+)
+def test_deviation_aware_bounds_hold_every_exact_value(data, rnd, slack):
+    """Rule 9: after searches of the budgets in any order and from any proven floor, every
+    position of the game (each budget's) has its exact value inside the interval the table
+    proves for it, or inside the interval a new entry would start with (its lower budgets'
+    proven floors, its higher budgets' ceilings); the values are the compiled game's."""
+    ops, agents = data
+    spec, graph = job(ops, agents=agents)
+    rules = concurrent_rules(spec, graph)
+    top = top_budget(agents, ops)
+    want = oracle_values(spec, graph, top)
+    exact: dict = {}
+    assert [every_position(rules, rules.start(k), exact) for k in range(top + 1)] == want
+    search = Search(rules)
+    budgets = list(range(top + 1))
+    rnd.shuffle(budgets)
+    for k in budgets:
+        floor = max(0, want[k] - rnd.randint(0, slack))
+        assert search.value(k, floor, want[-1] + 1 + rnd.randint(0, slack)) == want[k], k
+        for pos, w in exact.values():
+            lo, hi = search.interval(pos)
+            assert lo <= w <= hi, (pos, lo, w, hi)
