@@ -36,12 +36,13 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # pragma: no cover - types only
-    from asmplan.planfile import AlternateStates, PlayedPolicy
+    from asmplan.planfile import AlternateStates
     from asmplan.report.plot import DagFigure
     from asp.concurrent.plan import ConcurrentPlan
     from asp.concurrent.search import Limits
     from asp.game.dag import GameDAG
     from asp.game.plan import PlanStep
+    from asp.game.policy import PlayedPolicy
     from asp.game.solve import Solution
     from asp.graph.state_graph import StateGraph
     from asp.schedule.cpsat import BaselineResult
@@ -152,7 +153,7 @@ class PlayedGame:
 
     Attributes
     ----------
-    policy : asmplan.planfile.PlayedPolicy
+    policy : asp.game.policy.PlayedPolicy
         The robust policy's table, named, with the game's sizes, TCT and W*.
     describe : asmplan.planfile.AlternateStates
         Names the game's states (done operations and tools).
@@ -593,8 +594,9 @@ def solve_game(dag: GameDAG) -> Solution:
 
 def played_game(graph: StateGraph, game: Game, solution: Solution) -> PlayedGame:
     """What the outputs of a plan take from its solved game (:class:`PlayedGame`)."""
-    from asmplan.planfile import alternate_states, played_policy
+    from asmplan.planfile import alternate_states
     from asmplan.report.plot import dag_figure
+    from asp.game.policy import played_policy
     from asp.game.solve import play
 
     dag = game.dag

@@ -4,7 +4,8 @@
 array-backed DAG), :mod:`~asp.game.io` (its JSON and GraphML files),
 :mod:`~asp.game.synth` (synthetic DAGs), :mod:`~asp.game.solve` (the exact solver),
 :mod:`~asp.game.metrics` (the paper's metrics, exact), :mod:`~asp.game.plan` (the robust
-plan as steps), :mod:`~asp.game.play` (a person playing one side) and
+plan as steps), :mod:`~asp.game.policy` (the robust policy as a table of states and
+moves), :mod:`~asp.game.play` (a person playing one side) and
 :mod:`~asp.game.alike` (alike operations at run time).
 """
 
@@ -29,6 +30,13 @@ __all__, __getattr__ = lazy_exports(
         "io": ("load_dag", "save_dag"),
         "metrics": ("PlanMetrics", "adversarial_tax", "is_robust_optimal", "plan_metrics"),
         "plan": ("PlanStep", "relations_summary", "robust_plan"),
+        "policy": (
+            "PlayedPolicy",
+            "PolicyTable",
+            "StateDescriber",
+            "played_policy",
+            "policy_table",
+        ),
         "play": ("ROBOT_KINDS", "GameSession", "fast_greedy_policy", "fmt", "side_name"),
         "rules": (
             "COST_MODELS",

@@ -7,33 +7,7 @@ from asp.game.solve import solve
 from asp.graph.game_dag import game_dag
 from asp.graph.state_graph import build_state_graph
 from asp.spec import spec_from_dict
-
-CELL = {
-    "name": "cell",
-    "agents": {"H": {"side": "human"}, "R1": {"side": "robot"}, "R2": {"side": "robot"}},
-    "tools": {"R1.bit": {"initial": "hex", "change_time": 3}},
-    "cost": "time",
-    "operations": [
-        {"id": "a", "description": "prepare", "agents": {"H": 2, "R2": 4}},
-        {"id": "b", "description": "place base", "agents": {"H": 5, "R1": 3}, "after": ["a"]},
-        {"id": "c", "description": "fit cover", "agents": {"H": 4}, "after": ["a"]},
-        {
-            "id": "d",
-            "description": "change bit",
-            "agents": {"H": 6},
-            "requires": {"R1.bit": "hex"},
-            "sets": {"R1.bit": "cross"},
-        },
-        {
-            "id": "e",
-            "description": "screw",
-            "agents": {"R1": 2, "H": 9},
-            "requires": {"R1.bit": "cross"},
-            "after": ["b", "c"],
-        },
-        {"id": "f", "description": "inspect", "agents": {"R2": 1, "H": 1}, "after": ["e"]},
-    ],
-}
+from tests.asp.helpers_assembly import CELL
 
 CHOICES = {
     "name": "choices",
