@@ -253,7 +253,11 @@ def replay_rules(relations: Relations) -> dict:
         :data:`cad.support.SUPPORT_RULES`), ``fits`` (``inner, outer, extra_shrink`` mm: the inner
         part is shrunk by that much more against the outer one only), ``through`` (pairs
         accepted as overlapping, nested too deep to part: never tested against each other,
-        touching and resting on each other; only when there are some) and ``open_parts``.
+        touching and resting on each other; only when there are some), ``open_parts`` and
+        ``nearest`` (pairs across the model's gaps joining its contact graph's pieces,
+        :func:`with_nearest`: ``part``, ``near`` on its ``side``, the ``gap`` in mm; each pair
+        touches, and ``part`` rests on ``near`` when ``side`` is gravity, ``near`` on ``part``
+        when it is the opposite; only when there are some).
     """
     ids = [str(p) for p in relations.parts]
     reach = tuple(getattr(relations, "part_reach", ()))
@@ -274,6 +278,16 @@ def replay_rules(relations: Relations) -> dict:
             else {}
         ),
         "open_parts": [str(p) for p in getattr(relations, "open_parts", ())],
+        **(
+            {
+                "nearest": [
+                    {"part": str(a), "near": str(b), "side": DIRECTIONS[d], "gap": float(gap)}
+                    for a, b, d, gap in nearest
+                ]
+            }
+            if (nearest := getattr(relations, "nearest", ()))
+            else {}
+        ),
     }
 
 

@@ -5,7 +5,8 @@ state-key codec: which operations are enabled in which states),
 :mod:`~asp.graph.enabled_kernel` (its numba inner loops), :mod:`~asp.graph.state_graph`
 (the graph, built layer by layer), :mod:`~asp.graph.precedences` (derived
 precedences and infeasibility proofs), :mod:`~asp.graph.symmetry` (the interchangeable-part
-reduction), :mod:`~asp.graph.fixed_order`
+reduction), :mod:`~asp.graph.fasteners` (joining parts in one order, past the state limit),
+:mod:`~asp.graph.fixed_order`
 (that reduction undone for schedules), :mod:`~asp.graph.together` (which operations may run
 at once, one rule), :mod:`~asp.graph.game_dag` (from the state graph to the game DAG) and
 :mod:`~asp.graph.checker` (an independent plan checker that shares no code with the rest).

@@ -211,6 +211,11 @@ class Replay:
         # pairs accepted as overlapping, nested too deep to part: touching, resting on each
         # other, never blocking each other
         self.through = {frozenset(pair) for pair in geo.get("through", [])}
+        # pairs across the model's gaps: touching; resting on the part on their gravity side
+        self.nearest = {}
+        for n in geo.get("nearest", []):
+            self.nearest[(n["part"], n["near"])] = vector(n["side"])
+            self.nearest[(n["near"], n["part"])] = -vector(n["side"])
         pull = float(geo.get("free_edge_pull", 0.0))
         self.open = {p for p, m in self.meshes.items() if not m.is_watertight}
         said = set(geo.get("open_parts", self.open))
@@ -302,7 +307,13 @@ class Replay:
         down = self.down.get(ins["workspace"], self.gravity)
         rests = self.falls_into(body, there, down)
         gaps = {(p, j): self.plain[p].gap(self.plain[j]) for p in body for j in there}
-        gaps.update({(p, j): 0.0 for p, j in gaps if frozenset((p, j)) in self.through})
+        gaps.update(
+            {
+                (p, j): 0.0
+                for p, j in gaps
+                if frozenset((p, j)) in self.through or (p, j) in self.nearest
+            }
+        )
         touching = any(g <= self.contact(*pj) * 1.01 + 1e-6 for pj, g in gaps.items())
         if not touching and not rests:
             (p, j), gap = min(gaps.items(), key=lambda kv: kv[1])
@@ -325,6 +336,13 @@ class Replay:
             return "rests"
         if any(frozenset((p, j)) in self.through for p in body for j in there):
             return "rests"
+        if any(
+            np.allclose(self.nearest[(p, j)], down)
+            for p in body
+            for j in there
+            if (p, j) in self.nearest
+        ):
+            return "nearest"
         axis = int(np.argmax(np.abs(down)))
         for p in body:
             for j in there:

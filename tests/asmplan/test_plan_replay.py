@@ -10,6 +10,7 @@ import pytest
 import trimesh
 
 from asmplan import pipeline
+from asmplan.planfile import validate_plan
 from tests.asmplan.mesh_replay import Rejected, Replay, Solid, replayed
 from tests.asmplan.test_generated_held import plate_with_dowel
 from tests.cad.real_shapes import box, finger_box, unmerged
@@ -237,3 +238,26 @@ def test_a_textured_glb_counts_open_parts_as_the_planner_does(tmp_path):
     assert plan["geometry"]["open_parts"] == []
     assert all(m.is_watertight for m in load_meshes(plan).values())
     replayed(plan)
+
+
+def test_a_part_joined_across_the_models_gap_replays_by_the_rule_the_plan_states(tmp_path):
+    """A lid floating 1 mm over a box (a visual model's gap) touches it by the nearest-part
+    rule (``cad.relations.with_nearest``): the plan file states the pair, the replay from
+    the meshes takes it as touching and the lid as resting on the box; without the stated
+    pair the replay refuses the lid."""
+    folder = tmp_path / "meshes"
+    folder.mkdir()
+    meshes = {
+        "foot": box((10, 10, -5), (30, 30, 0)),
+        "box": box((0, 0, 0), (40, 40, 20)),
+        "lid": box((0, 0, 21), (40, 40, 25)),
+    }
+    for name, mesh in meshes.items():
+        mesh.export(folder / f"{name}.stl")
+    plan = pipeline.plan(folder, time_limit=5).to_dict()
+    assert plan["geometry"]["nearest"] == [{"part": "box", "near": "lid", "side": "+z", "gap": 1.0}]
+    validate_plan(plan)
+    replayed(plan)
+    del plan["geometry"]["nearest"]
+    with pytest.raises(Rejected, match="touches none"):
+        replayed(plan)
