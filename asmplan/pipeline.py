@@ -61,8 +61,11 @@ PREVIEW_MAX_POSITIONS = 200_000
 """Positions the preview's concurrent search may expand (past them: an interval)."""
 
 SEARCH_SECONDS = 120.0
-"""Default ``--search-time-limit``: seconds of the concurrent search before it answers with
-certified intervals (:mod:`asp.concurrent.search`)."""
+"""Default ``--search-time-limit``: search seconds of the concurrent search before it answers
+with certified intervals, counted in positions (:data:`asp.concurrent.search.POSITIONS_PER_SECOND`)
+so the plan is the same at any load; the wall clock stops it only as a safety net
+(:func:`asp.schedule.cpsat.wall_safety`), recorded as ``concurrent.wall_stop`` in
+``timings.json``."""
 
 Progress = Callable[[str], None]
 """A callback that shows one line of progress (e.g. prints it on stderr)."""
@@ -246,7 +249,11 @@ class AssemblyPlan:
     def _documents(self) -> tuple[dict[str, Any], dict[str, Any]]:
         from asmplan.planfile import split_timings
 
-        return split_timings(self._document())
+        doc, timings = split_timings(self._document())
+        wall = None if self.concurrent is None else self.concurrent.curve.wall_stop
+        if wall is not None:  # the concurrent search's safety net stopped it: load-dependent
+            timings.setdefault("concurrent", {})["wall_stop"] = wall
+        return doc, timings
 
     def _document(self) -> dict[str, Any]:
         from asmplan.planfile import plan_document, played_document

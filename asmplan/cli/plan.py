@@ -176,7 +176,10 @@ def plan_command(
         SEARCH_SECONDS,
         "--search-time-limit",
         min=0.0,
-        help="Concurrent: seconds of the search for W*(k) (0: no limit); past it, W*(k) is a "
+        help="Concurrent: search seconds for W*(k), counted in positions expanded (about a "
+        "second of one core's search each: asp.concurrent.search.POSITIONS_PER_SECOND), so "
+        "the same plan at any load; the wall clock stops it only as a safety net, at 3x + "
+        "30 s, said on stderr and in timings.json (0: no limit). Past it, W*(k) is a "
         "certified interval [L, U] and the plan's policy the one certified at U.",
     ),
     max_nodes: int | None = typer.Option(
@@ -219,6 +222,13 @@ def plan_command(
         max_nodes=max_nodes,
         max_memory=max_memory,
     )
+    wall = None if result.concurrent is None else result.concurrent.curve.wall_stop
+    if wall is not None:
+        say(
+            f"the concurrent search was stopped by the wall clock's safety net at {wall:g} s, "
+            f"before its {search_time_limit:g} search seconds (a loaded machine): this plan "
+            "depends on the load (timings.json: concurrent.wall_stop)"
+        )
     for line in plan_summary(result):
         typer.echo(line)
     if output is not None:

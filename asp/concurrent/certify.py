@@ -208,10 +208,11 @@ TICK_MASK = (1 << 15) - 1
 """The clock is looked at every ``TICK_MASK + 1`` positions valued."""
 OK, FULL, STOPPED = 0, 1, 2
 """What :func:`_values` ended with: every start valued, the memo full, a limit reached."""
-ENTRIES, CAPACITY, VALUED, DEADLINE_MS, PROGRESS_MS, T0_MS = range(6)
+ENTRIES, CAPACITY, VALUED, DEADLINE_MS, PROGRESS_MS, T0_MS, MAX_VALUED, WALL = range(8)
 """The counters of :func:`_values` (an int64 array): positions in the memo, the most it
-may hold, positions valued in all, the deadline (ms of ``time.perf_counter``, 0: none), the
-next progress line (0: none), the start."""
+may hold, positions valued in all, the wall clock's safety net (ms of
+``time.perf_counter``, 0: none), the next progress line (0: none), the start, the positions
+the search seconds allow (0: no limit), and 1 once the safety net stopped it."""
 
 
 @numba.njit(cache=True)
@@ -261,11 +262,14 @@ def _values(T, H, P, starts, kind, prefs, n_prefs, st, cnt, out):  # pragma: no 
                 jr[d] = 0
                 v[d] = 0 if delta.shape[0] == 0 else -1
                 cnt[VALUED] += 1
+                if cnt[MAX_VALUED] > 0 and cnt[VALUED] > cnt[MAX_VALUED]:
+                    return STOPPED
                 if (cnt[VALUED] & TICK_MASK) == 0 and (cnt[DEADLINE_MS] or cnt[PROGRESS_MS]):
                     with numba.objmode(now="float64"):
                         now = time.perf_counter()
                     ms = np.int64(now * 1000)
                     if cnt[DEADLINE_MS] > 0 and ms >= cnt[DEADLINE_MS]:
+                        cnt[WALL] = 1
                         return STOPPED
                     if cnt[PROGRESS_MS] > 0 and ms >= cnt[PROGRESS_MS]:
                         cnt[PROGRESS_MS] = ms + 5000
@@ -352,7 +356,10 @@ def best_response_values(
     memory : int, optional
         Bytes of the memo at most (default: half the search's memory limit).
     time_limit : float, optional
-        Seconds at most.
+        Search seconds at most: positions valued, at
+        :data:`asp.concurrent.search.POSITIONS_PER_SECOND` a second (the same answer at any
+        load); the wall clock stops it only as a safety net
+        (:func:`asp.schedule.cpsat.wall_safety`), recorded by ``search.note_wall``.
     progress : bool
         A line on stderr every 5 s (positions valued and kept).
 
@@ -360,9 +367,10 @@ def best_response_values(
     -------
     dict or None
         Budget -> the policy's worst-case makespan (spec units); None when the memory or
-        the time ran out first.
+        the time ran out first. The positions valued are added to ``search.valued``.
     """
-    from asp.concurrent.search import LOAD, new_table, schedule_lists
+    from asp.concurrent.search import LOAD, new_table, schedule_lists, work_positions
+    from asp.schedule.cpsat import wall_safety
 
     t0 = time.perf_counter()
     rules = search.rules
@@ -373,9 +381,10 @@ def best_response_values(
     )
     memory = search.limits.memory // 2 if memory is None else int(memory)
     most = int(memory // ((8 * kw + 8) / LOAD))  # only the keys and values are resident
-    cnt = np.zeros(6, dtype=np.int64)
+    cnt = np.zeros(8, dtype=np.int64)
     if time_limit is not None:
-        cnt[DEADLINE_MS] = int((t0 + time_limit) * 1000)
+        cnt[MAX_VALUED] = work_positions(time_limit)
+        cnt[DEADLINE_MS] = int((t0 + wall_safety(time_limit)) * 1000)
     cnt[T0_MS] = int(t0 * 1000)
     if progress:
         cnt[PROGRESS_MS] = cnt[T0_MS] + 5000
@@ -391,6 +400,10 @@ def best_response_values(
         status = _values(
             rules.tables, search.table, memo, starts, kind, prefs, n_prefs, st, cnt, out
         )
+        if status != FULL or size >= most:
+            search.valued += int(cnt[VALUED])
+            if cnt[WALL]:
+                search.note_wall(wall_safety(time_limit))
         if status == OK:
             break
         if status == STOPPED or size >= most:

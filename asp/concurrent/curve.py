@@ -21,7 +21,17 @@ from asp.concurrent.build import ConcurrentGame
 from asp.concurrent.certify import best_response_values
 from asp.concurrent.model import UNBOUNDED
 from asp.concurrent.rules import Rules, lower_bound_of
-from asp.concurrent.search import GREEDY, HYBRID, INF, ROBUST, SCHEDULE, Limits, Search
+from asp.concurrent.search import (
+    GREEDY,
+    HYBRID,
+    INF,
+    POSITIONS_PER_SECOND,
+    ROBUST,
+    SCHEDULE,
+    Limits,
+    Search,
+    work_positions,
+)
 
 
 @dataclass(frozen=True, eq=False)
@@ -52,10 +62,15 @@ class Curve:
         The CP-SAT schedule's certified worst case per ``k`` (``None`` for ``inf``), empty
         without a schedule or when its policy game was over the limits.
     stopped : str or None
-        The limit that stopped the search (``"time limit"``, ...), None when exact.
+        The limit that stopped the search (``"time limit"``: its search seconds, ...), None
+        when exact.
     nodes, positions : int
         Positions the search expanded, and the table's entries.
     seconds : float
+    wall_stop : float or None
+        The seconds of the wall clock's safety net that stopped the search or a certificate
+        (:mod:`asp.concurrent.search`), when one did: the curve then depends on the load
+        (``timings.json`` says so, never ``plan.json``).
     """
 
     lower: tuple[float, ...]
@@ -70,6 +85,7 @@ class Curve:
     nodes: int
     positions: int
     seconds: float
+    wall_stop: float | None = None
 
     @property
     def k(self) -> int:
@@ -143,7 +159,9 @@ def solve_curve(
     min_k : int
         The curve goes at least this far (while ``<= max_k``), flat or not.
     limits : Limits, optional
-        Memory, positions and seconds for the search (default :class:`Limits`).
+        Memory, positions and search seconds for the search (default :class:`Limits`);
+        every share of the search seconds below is counted in positions, so the curve is
+        the same on every run.
     schedule : list of dict, optional
         A CP-SAT schedule (``{"task", "agent", "start"}`` rows), run as a plan: certified for
         every ``k``, and one more policy for ``U`` when the search stops.
@@ -169,17 +187,16 @@ def solve_curve(
             print(f"  {text} ({time.perf_counter() - t0:.1f} s)", file=sys.stderr, flush=True)
 
     exact: dict = {}  # budget (None: inf) -> W* (scaled)
-    limit = search.limits.time_limit
-    end = None if limit is None else search.t0 + limit
+    end = search.budget  # positions expanded the search seconds allow (None: no limit)
     v0 = search.value(0, floor)
     if v0 is not None:
         exact[0] = v0
         say(f"W*(0) = {v0 / scale:g}")
-        # W*(inf) next, in half the time left when there is a limit: past it, the finite
-        # budgets (the person's few deviations: far smaller games) go on in the rest.
+        # W*(inf) next, in half the search seconds left when there is a limit: past it,
+        # the finite budgets (the person's few deviations: far smaller games) go on in the
+        # rest.
         if end is not None:
-            now = time.perf_counter()
-            search.resume(now + max(0.0, end - now) / 2)
+            search.resume(search.nodes + max(0, end - search.nodes) // 2)
         top = search.value(None, v0)
         search.resume(end)
         if top is not None:
@@ -270,12 +287,16 @@ def certified_curve(
     certified: dict[str, dict] = {}  # name -> budget -> certified worst case (spec units)
     games: dict[str, tuple] = {}  # name -> (policy game, its solution)
     stopped = search.stopped
-    limit = search.limits.time_limit  # half the search's time for the certificates, in turn
+    limit = search.limits.time_limit  # half the search seconds for the certificates, in turn
     seconds = None if limit is None else limit / 2
     if finished:
         # W*(0..K) are known: the robust policy's positions are searched to their values
-        # again (on the search's table, past its time stop: small games at budgets <= K).
-        search.resume(None if seconds is None else time.perf_counter() + seconds)
+        # again (on the search's table, past its budget: small games at budgets <= K).
+        if seconds is None:
+            search.resume(None)
+        else:
+            search.resume(search.nodes + work_positions(seconds))
+            search.safety_net(seconds)
         game = search.policy_game(budgets, ROBUST)
         if game is not None:
             sol = solve(game.dag)
@@ -284,12 +305,12 @@ def certified_curve(
     robust_inf = "robust" in certified and None in exact
     names = ["schedule"] if robust_inf else ["hybrid", "greedy", "schedule"]
     names = [n for n in names if n != "schedule" or schedule]
-    t_cert = time.perf_counter()
+    valued = search.valued  # positions the certificates valued before these
 
-    def share(left: int) -> float | None:
+    def share(left: int) -> float | None:  # search seconds, counted in positions valued
         if seconds is None:
             return None
-        return max(1.0, (seconds - (time.perf_counter() - t_cert)) / left)
+        return max(1.0, (seconds - (search.valued - valued) / POSITIONS_PER_SECOND) / left)
 
     found: dict[str, dict] = {}
     # The finite budgets first (the person's deviations are few: small best responses),
@@ -382,6 +403,7 @@ def certified_curve(
         nodes=search.nodes,
         positions=search.positions,
         seconds=time.perf_counter() - t0,
+        wall_stop=search.wall_stop,
     )
 
 

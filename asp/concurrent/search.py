@@ -117,7 +117,11 @@ The table is sized before the search from the memory allowed (only its key array
 before a slot is written, so only the slots in use are resident) (``memory``: its bytes per
 entry are known, :func:`table_entries`); it never grows. The search stops when the table is
 full, at ``max_nodes`` positions expanded, or at ``time_limit``; the policy games stop at
-their own node limit (from the same memory). Stopped,
+their own node limit (from the same memory). ``time_limit`` is in search seconds, counted in
+positions (:data:`POSITIONS_PER_SECOND`), so the search stops at the same position on every
+run at any load and the plan is the same bytes; the wall clock stops it only as a safety
+net (:func:`asp.schedule.cpsat.wall_safety`, the CP-SAT stage's rule), and then
+:attr:`Search.wall_stop` says so (``timings.json``, never the plan). Stopped,
 :func:`asp.concurrent.curve.solve_curve` still answers:
 for each ``k`` a proven lower bound ``L(k)`` (the CP-SAT bound, the start's bound, what the
 search proved, and ``L(k - 1)``: the curve never falls) and the least certified worst case
@@ -154,6 +158,7 @@ from asp.concurrent.rules import (
 )
 from asp.graph.together import edge
 from asp.heap import memory_budget
+from asp.schedule.cpsat import wall_safety
 
 INF = 1 << 60
 """A value above every makespan (scaled)."""
@@ -171,13 +176,22 @@ GENERATOR = "asmplan.concurrent.search/1"
 """The ``generator`` of a policy game's DAG."""
 TICK = (1 << 15) - 1
 """The clock and the progress line are looked at every ``TICK + 1`` positions."""
+POSITIONS_PER_SECOND = 20_000
+"""Positions a search second stands for: the search's ``time_limit`` (and the certificates'
+share of it, :func:`asp.concurrent.certify.best_response_values`) is counted in positions
+expanded (valued), about a second of one core's search each (the real products' searches
+ran 14,000 to 22,000 positions a CPU second), so the same input stops at the same position
+whatever the load."""
 
 # stats array
 NODES, NODE_LIMIT, ABORT, ENTRIES, MAX_ENTRIES, DEADLINE, PROGRESS, NEXT_REPORT = range(8)
 ROOT_BEST, BUDGET, T0 = 8, 9, 10
 N_STATS = 11
 STOP_NODES, STOP_MEMORY, STOP_TIME = 1, 2, 3
-STOP_NAMES = {STOP_NODES: "node limit", STOP_MEMORY: "memory limit", STOP_TIME: "time limit"}
+STOP_NAMES = {STOP_NODES: "node limit", STOP_MEMORY: "memory limit", STOP_TIME: "wall-clock limit"}
+"""Why a search stopped; ``"time limit"`` is its budget of search seconds (a stop at
+``NODE_LIMIT`` below ``max_nodes``, :attr:`Search.stopped`), ``STOP_TIME`` the wall clock's
+safety net."""
 
 
 class Table(NamedTuple):
@@ -1038,7 +1052,8 @@ class Limits:
     """What the search may use: ``memory`` bytes (the table and the policy games; default
     :data:`DEFAULT_MEMORY`, or less when the memory available says so: the one rule,
     :func:`asp.heap.memory_budget`), ``max_nodes`` positions expanded, ``time_limit``
-    seconds (None: no limit)."""
+    search seconds (None: no limit): :data:`POSITIONS_PER_SECOND` positions each, the wall
+    clock a safety net at :func:`asp.schedule.cpsat.wall_safety` of it."""
 
     memory: int = field(default_factory=lambda: memory_budget(DEFAULT_MEMORY))
     max_nodes: int = DEFAULT_MAX_NODES
@@ -1079,19 +1094,45 @@ class Search:
         self.table = new_table(min(self.entries, FIRST_ENTRIES), kw)
         self.stats = np.zeros(N_STATS, dtype=np.int64)
         self.stats[MAX_ENTRIES] = min(self.entries, int(self.table.keys.shape[0] * LOAD))
-        self.stats[NODE_LIMIT] = self.limits.max_nodes
+        limit = self.limits.time_limit
+        # positions expanded the search seconds allow in all (None: no time limit)
+        self.budget = None if limit is None else work_positions(limit)
+        self.valued = 0  # positions the certificates valued (best_response_values)
+        self.net: float | None = None  # the wall-clock safety net of the phase, seconds
+        self.wall_stop: float | None = None  # the net that stopped a phase, when one did
+        self.stats[NODE_LIMIT] = self._cap(self.budget)
         self.stats[PROGRESS] = int(progress)
         _compile_kernels(rules, self.prefs, self.n_prefs)  # before the clock starts
         self.t0 = time.perf_counter()
         self.stats[T0] = int(self.t0 * 1000)
-        if self.limits.time_limit is not None:
-            self.stats[DEADLINE] = int((self.t0 + self.limits.time_limit) * 1000)
+        if limit is not None:
+            self.safety_net(limit)
+
+    def _cap(self, nodes: int | None) -> int:
+        return self.limits.max_nodes if nodes is None else min(self.limits.max_nodes, nodes)
+
+    def safety_net(self, seconds: float) -> None:
+        """The wall clock stops what follows at :func:`asp.schedule.cpsat.wall_safety` of
+        ``seconds`` search seconds from now (a stop already made by it is lifted)."""
+        self.net = wall_safety(seconds)
+        self.stats[DEADLINE] = int((time.perf_counter() + self.net) * 1000)
+        if self.stats[ABORT] == STOP_TIME:
+            self.stats[ABORT] = 0
+
+    def note_wall(self, net: float | None = None) -> None:
+        """Record a stop by the wall clock's safety net (``net``: its seconds, default the
+        search's), the first one."""
+        if self.wall_stop is None:
+            self.wall_stop = round(self.net if net is None else net, 3)
 
     @property
     def stopped(self) -> str | None:
-        """Why the search stopped (``"node limit"``, ``"memory limit"``, ``"time limit"``),
-        or None."""
-        return STOP_NAMES.get(int(self.stats[ABORT]))
+        """Why the search stopped (``"node limit"``, ``"memory limit"``, ``"time limit"``:
+        its search seconds, ``"wall-clock limit"``: the safety net), or None."""
+        why = int(self.stats[ABORT])
+        if why == STOP_NODES and self.nodes < self.limits.max_nodes:
+            return "time limit"  # the budget of search seconds, or the share of a phase
+        return STOP_NAMES.get(why)
 
     @property
     def nodes(self) -> int:
@@ -1114,13 +1155,14 @@ class Search:
         st[ABORT] = 0
         return True
 
-    def resume(self, deadline: float | None) -> None:
-        """Search on after a time stop, until ``deadline`` (``time.perf_counter`` seconds;
-        None: no time limit). The table holds proven intervals only, so what the stopped
-        search found stays valid."""
-        if self.stats[ABORT] == STOP_TIME:
+    def resume(self, nodes: int | None) -> None:
+        """Search on after a stop at its budget of search seconds (or a phase's share of
+        it), until ``nodes`` positions expanded in all (None: ``max_nodes`` alone). The
+        table holds proven intervals only, so what the stopped search found stays valid. A
+        stop by the wall clock's safety net stands (:meth:`safety_net` lifts it)."""
+        if self.stats[ABORT] == STOP_NODES and self.nodes < self.limits.max_nodes:
             self.stats[ABORT] = 0
-        self.stats[DEADLINE] = 0 if deadline is None else int(deadline * 1000)
+        self.stats[NODE_LIMIT] = self._cap(nodes)
 
     def _run(self, row, alpha: int, beta: int) -> int:
         """:func:`_search` of ``row``, again with a larger table while it grows (the entries
@@ -1129,7 +1171,12 @@ class Search:
         while True:
             v = _search(t, self.table, row, alpha, beta, self.stats, self.prefs, self.n_prefs)
             if not self._grow():
+                self._noted()
                 return int(v)
+
+    def _noted(self) -> None:
+        if self.stats[ABORT] == STOP_TIME:
+            self.note_wall()
 
     def value(self, budget: int | None, floor: int = 0, upper: int = INF) -> int | None:
         """``W*(budget)`` (scaled) where the caller has proved ``floor <= W* < upper``; None
@@ -1210,12 +1257,19 @@ class Search:
                 break
             if self._grow():
                 continue
+            self._noted()
             if self.stats[ABORT] or room >= most:
                 return None
             room = min(most, 4 * room)
         ok, rows, start_ids, src, dst, cost, side, e_ops, e_dur, e_dev = out
         edges = (src, dst, cost, side, e_ops, e_dur, e_dev)
         return _as_game(rules, budgets, rows, start_ids, edges, t0)
+
+
+def work_positions(seconds: float) -> int:
+    """Positions ``seconds`` search seconds stand for (:data:`POSITIONS_PER_SECOND`; at
+    least one)."""
+    return max(1, int(round(float(seconds) * POSITIONS_PER_SECOND)))
 
 
 def schedule_lists(rules: Rules, rows: list[dict]) -> tuple[np.ndarray, np.ndarray]:
