@@ -49,7 +49,8 @@ from pathlib import Path
 import numpy as np
 from stable_baselines3.common.callbacks import BaseCallback
 
-from arl.concurrent_env import ConcurrentHumanEnv, ConcurrentRobotEnv, robot_choose
+from arl.concurrent_env import ConcurrentHumanEnv, ConcurrentRobotEnv, Encoder, robot_choose
+from arl.memory import concurrent_training_room
 from arl.pace import SAMPLE_STEPS, CycleEstimate, Heartbeat, phase_seconds
 from asp.concurrent.certify import certify
 from asp.concurrent.rules import Rules
@@ -237,15 +238,17 @@ def estimate_cycle(
     seed: int = 0,
     budgets: list[int | None] | None = None,
     cycles_left: int | None = None,
+    max_memory: int | None = None,
 ) -> CycleEstimate:
     """The seconds a cycle of :func:`train_concurrent` will take, from a sample.
 
     The sample: throwaway models of the same configuration but rollouts of at most
     :data:`arl.pace.SAMPLE_STEPS` steps; the robot's phase is run twice (the first warms
     up) and the second timed, and the robot's greedy policy is certified once at
-    ``budgets`` (:func:`asp.concurrent.certify.certify`), timed. A cycle is then both
-    sides' ``phase_steps`` (rounded up to whole rollouts) at the measured seconds a step,
-    and one certification. Nothing of a run folder is read or written. The untrained
+    ``budgets`` (:func:`asp.concurrent.certify.certify`; ``max_memory``: the bytes its
+    policy game may use, default the one rule), timed. A cycle is then both sides'
+    ``phase_steps`` (rounded up to whole rollouts) at the measured seconds a step, and one
+    certification. Nothing of a run folder is read or written. The untrained
     robot's policy game may be larger or smaller than a trained one's.
     """
     cfg = get_config(config)
@@ -257,7 +260,7 @@ def estimate_cycle(
     robot.learn(k, reset_num_timesteps=False)
     step_s = (time.perf_counter() - t0) / k
     t0 = time.perf_counter()
-    certify(rules, learned_policy(rules, robot), budgets)
+    certify(rules, learned_policy(rules, robot), budgets, max_memory=max_memory)
     check_s = time.perf_counter() - t0
     return CycleEstimate(
         seconds=2 * phase_seconds(cfg.phase_steps, cfg.n_steps, step_s) + check_s,
@@ -281,8 +284,14 @@ def train_concurrent(
     max_cycle_seconds: float | None = None,
     on_estimate: Callable[[CycleEstimate], None] | None = None,
     heartbeat: Callable[[str], None] | None = None,
+    max_memory_gb: float | None = None,
 ) -> ConcurrentTrainResult:
     """Alternating PPO on the concurrent game of ``rules`` (module docstring).
+
+    Its memory is bounded before any work (:func:`arl.memory.concurrent_training_room`: the
+    learners refused over ``max_memory_gb``, default :func:`asp.heap.memory_budget`), and
+    each certificate's policy game gets what is left
+    (:func:`asp.concurrent.certify.certify`'s ``max_memory``).
 
     Parameters
     ----------
@@ -302,21 +311,30 @@ def train_concurrent(
     heartbeat : callable, optional
         Called every :data:`arl.pace.HEARTBEAT_S` seconds, from the estimate on, with a
         line saying what the run is doing and for how long (:class:`arl.pace.Heartbeat`).
+    max_memory_gb : float, optional
+        The memory limit (``--max-memory``).
+
+    Raises
+    ------
+    asp.errors.GameError
+        The learners alone are over the memory limit, or a certificate's policy game is
+        (:class:`asp.errors.GameLimit`), each one line naming ``--max-memory``.
     """
     cfg = get_config(config)
     budgets = list(budgets) if budgets is not None else list(DEFAULT_BUDGETS)
+    room = concurrent_training_room(Encoder(rules).size, cfg, max_memory_gb)
     t0 = time.perf_counter()
     with Heartbeat(heartbeat, lambda: time.perf_counter() - t0) as beat:
         if max_cycle_seconds is not None or on_estimate is not None:
             beat.doing = "estimating a cycle's time (a sample of steps, one certification)"
-            estimate = estimate_cycle(rules, cfg, seed=seed, budgets=budgets)
+            estimate = estimate_cycle(rules, cfg, seed=seed, budgets=budgets, max_memory=room)
             estimate.refuse_over(max_cycle_seconds)
             if on_estimate is not None:
                 on_estimate(estimate)
-        return _train(rules, cfg, seed, budgets, output, progress, beat)
+        return _train(rules, cfg, seed, budgets, output, progress, beat, room)
 
 
-def _train(rules, cfg, seed, budgets, output, progress, beat) -> ConcurrentTrainResult:
+def _train(rules, cfg, seed, budgets, output, progress, beat, room) -> ConcurrentTrainResult:
     """The loop of :func:`train_concurrent` (``beat``: its heartbeat, told each step)."""
     t0 = time.perf_counter()
     robot, human = _learners(rules, cfg, seed)
@@ -334,7 +352,7 @@ def _train(rules, cfg, seed, budgets, output, progress, beat) -> ConcurrentTrain
                 makespans = callback.makespans
         steps = int(robot.num_timesteps + human.num_timesteps)
         beat.doing = f"cycle {cycle} of {cfg.cycles}: {CERTIFICATION}"
-        cert = certify(rules, learned_policy(rules, robot), budgets)
+        cert = certify(rules, learned_policy(rules, robot), budgets, max_memory=room)
         record = {
             "cycle": cycle,
             "steps": steps,

@@ -36,18 +36,51 @@ BASE_BYTES = 2**30
 a 40,000-node graph, which peaked at 1.56 GB (issue 14), is estimated at about 1.5 GB."""
 
 
+def learner_bytes(width: int, hidden: int, batch_size: int, rollout_cells: int) -> int:
+    """The networks of both learning sides, a minibatch and the rollout buffer (module
+    docstring): first layers ``width x hidden``, ``rollout_cells`` observation cells."""
+    networks = 2 * 2 * width * hidden * 16
+    batch = 2 * batch_size * width * 4
+    return networks + batch + rollout_cells * 16
+
+
 def training_bytes(n_nodes: int, n_edges: int, max_moves: int, cfg: TrainConfig, width=None) -> int:
     """The estimate of the module docstring, in bytes (``width``: the feature count when
     ``cfg.obs == "features"``)."""
     n, k = int(n_nodes), max(1, int(max_moves))
     w = n if cfg.obs == "node" else int(width or 8)
     h = cfg.net_arch[0] if cfg.net_arch else 64
-    networks = 2 * 2 * w * h * 16
-    batch = 2 * cfg.batch_size * w * 4
-    rollout = cfg.n_steps * cfg.n_envs * (w if cfg.obs != "node" else 1) * 16
+    rollout = cfg.n_steps * cfg.n_envs * (w if cfg.obs != "node" else 1)
     tabulation = min(n * w, CHUNK_CELLS) * 4 + n * k * 24
     tables = n * (2 * k * 9 + 200) + int(n_edges) * 100
-    return BASE_BYTES + networks + batch + rollout + tabulation + tables
+    return BASE_BYTES + learner_bytes(w, h, cfg.batch_size, rollout) + tabulation + tables
+
+
+def concurrent_training_room(width: int, cfg, max_memory_gb: float | None = None) -> int:
+    """The bytes left for the certificates (the policy games of
+    :func:`asp.concurrent.certify.certify`) once training the concurrent game's learners is
+    counted (:data:`BASE_BYTES` and :func:`learner_bytes`: observations of ``width``
+    features, one environment a side; :class:`arl.concurrent_trainer.ConcurrentConfig`
+    ``cfg``), under the limit ``max_memory_gb`` (default :func:`asp.heap.memory_budget`).
+
+    Raises
+    ------
+    asp.errors.GameError
+        One line: the learners alone are over the limit (the estimate, the limit, the memory
+        available and ``--max-memory``).
+    """
+    gb = 2**30
+    limit = heap.memory_budget() if max_memory_gb is None else int(float(max_memory_gb) * gb)
+    h = cfg.net_arch[0] if cfg.net_arch else 64
+    need = BASE_BYTES + learner_bytes(width, h, cfg.batch_size, cfg.n_steps * width)
+    if need > limit:
+        raise GameError(
+            f"training the concurrent game needs about {need / gb:.2f} GB (observations of "
+            f"{width} features, first layer {h} wide) before its certificates, over the "
+            f"--max-memory limit of {limit / gb:.3g} GB ({heap.available_memory() / gb:.1f} GB "
+            "available); --max-memory GB raises it"
+        )
+    return limit - need
 
 
 def check_training_size(dag, cfg: TrainConfig, max_memory_gb: float | None = None) -> None:

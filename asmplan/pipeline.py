@@ -493,6 +493,7 @@ def state_graph(
     max_states: int | None = None,
     on_step: Progress | None = None,
     concurrent: bool = False,
+    max_memory: int | None = None,
 ) -> StateGraph:
     """The assembly state graph: every feasible partial assembly and operation.
 
@@ -525,6 +526,9 @@ def state_graph(
         plan's search keep their values either way (they undo a fixed order,
         :mod:`asp.graph.fixed_order`, :mod:`asp.concurrent.rules`), so :func:`plan` builds
         the fixed order for both turn models.
+    max_memory : int, optional
+        Bytes each build may use (default :func:`asp.heap.memory_budget`, the one rule;
+        ``train --max-memory``).
 
     Returns
     -------
@@ -541,6 +545,7 @@ def state_graph(
         on_unit=on_step,
         progress=progress,
         max_states=max_states,
+        max_memory=max_memory,
     )
 
 

@@ -73,16 +73,18 @@ CERTIFIED_BUDGETS = [0, 1, 2, None]
 """The budgets a concurrent run's robot is certified at (None: ``k = inf``)."""
 
 
-def _concurrent_rules(source: Path, what: str):
+def _concurrent_rules(source: Path, what: str, max_memory_gb: float | None = None):
     """The concurrent game's rules of the assembly ``source`` (``what``: the option that
-    needs it, for the error)."""
+    needs it, for the error; ``max_memory_gb``: the state graph's memory limit, default the
+    one rule)."""
     from asmplan import pipeline
     from asp.concurrent.rules import concurrent_rules
 
     if source.is_file() and source.suffix.lower() in pipeline.GRAPH_SUFFIXES:
         raise ValueError(f"{source}: {what} needs an assembly, not a game DAG file")
     assembly = pipeline.load(source)
-    return concurrent_rules(assembly.spec, pipeline.state_graph(assembly))
+    memory = None if max_memory_gb is None else int(max_memory_gb * 2**30)
+    return concurrent_rules(assembly.spec, pipeline.state_graph(assembly, max_memory=memory))
 
 
 def _certified_text(certified: dict) -> str:
@@ -90,11 +92,13 @@ def _certified_text(certified: dict) -> str:
 
 
 def _train_concurrent(
-    source, turn_model, config, seed, output, max_cycles, progress, **pace
+    source, turn_model, config, seed, output, max_cycles, progress, max_memory, **pace
 ) -> None:
     """``train --config concurrent``: alternating PPO on the assembly's concurrent game played
     from its rules (:func:`arl.concurrent_trainer.train_concurrent`; ``pace``: the cycle
-    limit, the estimate's and the heartbeat's lines, as for the alternating trainer)."""
+    limit, the estimate's and the heartbeat's lines, as for the alternating trainer;
+    ``max_memory``: ``--max-memory``, GB, for the state graph, the learners and the
+    certificates' policy games)."""
     from arl.concurrent_trainer import get_config as concurrent_config
     from arl.concurrent_trainer import train_concurrent
 
@@ -105,9 +109,16 @@ def _train_concurrent(
     cfg = concurrent_config(config)
     if max_cycles is not None:
         cfg = cfg.replace(cycles=max_cycles)
-    rules = _concurrent_rules(source, f"--config {config}")
+    rules = _concurrent_rules(source, f"--config {config}", max_memory)
     result = train_concurrent(
-        rules, cfg, seed=seed, budgets=CERTIFIED_BUDGETS, output=output, progress=progress, **pace
+        rules,
+        cfg,
+        seed=seed,
+        budgets=CERTIFIED_BUDGETS,
+        output=output,
+        progress=progress,
+        max_memory_gb=max_memory,
+        **pace,
     )
     typer.echo(
         f"trained {result.steps:,} steps in {result.seconds:.1f} s; the robot of cycle "
@@ -178,7 +189,8 @@ def train_command(
         min=0.001,
         max=1e6,
         help="Refuse a game whose training needs more GB than this, before any work "
-        "(default: 3/4 of the memory available; arl/memory.py).",
+        "(default: 3/4 of the memory available; arl/memory.py); --config concurrent: the "
+        "state graph, the learners and each certificate's policy game within it.",
     ),
     max_cycle_seconds: float | None = typer.Option(
         None,
@@ -203,7 +215,9 @@ def train_command(
     if config in CONCURRENT_CONFIGS:
         if not resume:  # (train() checks its own folder)
             refuse_existing_run(output, force=force)
-        _train_concurrent(graph, turn_model, config, seed, output, max_cycles, progress, **pace)
+        _train_concurrent(
+            graph, turn_model, config, seed, output, max_cycles, progress, max_memory, **pace
+        )
         return
     get_config(config)  # a bad name fails before any work
     dag = load_training_game(graph, turn_model)

@@ -54,21 +54,36 @@ def game_bytes(n_nodes: int, n_edges: int, *, compiled: bool = True) -> int:
     return int(n_nodes) * PY_NODE_BYTES + int(n_edges) * PY_EDGE_BYTES
 
 
-def memory_limit_error(where: str, counts: tuple, limit: int, *, compiled: bool = True):
+BUILD_ADVICE = (
+    "coarsen the human duration grid (--duration-step), bound the deviation budget "
+    "(--max-k), or raise --max-memory"
+)
+"""What makes a compiled concurrent game smaller or its limit larger (:func:`build_game`)."""
+
+
+def memory_limit_error(
+    where: str,
+    counts: tuple,
+    limit: int,
+    *,
+    compiled: bool = True,
+    what: str = "the concurrent game",
+    advice: str = BUILD_ADVICE,
+):
     """The :class:`asp.errors.GameLimit` of a build stopped at ``limit`` bytes: what it had
     built (``counts``: nodes expanded, nodes, edges) and its estimate (:func:`game_bytes`,
     a lower bound of the whole game's: the build was still growing), the limit and the
-    memory available, and the flags that make the game smaller or the limit larger."""
+    memory available, and the flags that make the game smaller or the limit larger
+    (``advice``; ``what``: the game built, e.g. a policy game,
+    :func:`asp.concurrent.certify.certify`)."""
     _, nodes, edges = (int(x) for x in counts)
     now = game_bytes(nodes, edges, compiled=compiled)
     gb = 2**30
     free = available_memory() / gb
     return GameLimit(
-        f"{where}: the concurrent game needs more than {now / gb:.2f} GB (estimated from the "
+        f"{where}: {what} needs more than {now / gb:.2f} GB (estimated from the "
         f"{nodes:,} nodes and {edges:,} edges built when it passed the limit), over the "
-        f"--max-memory limit of {limit / gb:.2f} GB ({free:.1f} GB available); coarsen the "
-        "human duration grid (--duration-step), bound the deviation budget (--max-k), or "
-        "raise --max-memory"
+        f"--max-memory limit of {limit / gb:.2f} GB ({free:.1f} GB available); {advice}"
     )
 
 

@@ -106,8 +106,14 @@ def certify(
     budgets: list[int | None],
     *,
     max_nodes: int = DEFAULT_MAX_NODES,
+    max_memory: int | None = None,
 ) -> Certificate:
     """The exact best response of the human side to the robot policy ``choose``.
+
+    The policy game's memory is bounded like every compiled game's
+    (:func:`asp.concurrent.build.game_bytes` of the Python builder, the nodes and edges
+    walked so far), checked before each node is added: past ``max_memory`` the walk stops
+    with one line naming ``--max-memory``, the estimate and the memory available.
 
     Parameters
     ----------
@@ -118,17 +124,25 @@ def certify(
         The deviation budgets to certify (``None``: the fully adversarial human).
     max_nodes : int
         The policy game's largest size.
+    max_memory : int, optional
+        Bytes the policy game may use (default
+        :func:`asp.concurrent.build.default_memory`: :func:`asp.heap.memory_budget`, the one
+        rule).
 
     Raises
     ------
     asp.errors.GameError
         ``choose`` gave no valid index, or a negative budget.
     asp.errors.GameLimit
-        The policy game has more than ``max_nodes`` nodes.
+        The policy game has more than ``max_nodes`` nodes, or its estimate passes
+        ``max_memory`` bytes.
     """
+    from asp.concurrent.build import default_memory, game_bytes, memory_limit_error
     from asp.errors import GameError, GameLimit
     from asp.game.solve import solve
 
+    limit = default_memory() if max_memory is None else int(max_memory)
+    where = rules.model.spec.source or rules.model.spec.name
     t0 = time.perf_counter()
     T = rules.tables
     nw = rules.n_workers
@@ -144,9 +158,15 @@ def certify(
         v = index.get(key)
         if v is None:
             if len(nodes) >= max_nodes:
-                raise GameLimit(
-                    f"{rules.model.spec.source or rules.model.spec.name}: the policy game "
-                    f"exceeds {max_nodes:,} nodes"
+                raise GameLimit(f"{where}: the policy game exceeds {max_nodes:,} nodes")
+            if game_bytes(len(nodes) + 2, len(src), compiled=False) > limit:
+                raise memory_limit_error(
+                    where,
+                    (0, len(nodes), len(src)),
+                    limit,
+                    compiled=False,
+                    what="the policy game of the robot policy (its exact best response)",
+                    advice="raise --max-memory",
                 )
             v = index[key] = len(nodes)
             nodes.append(node_row(row, 0, none, nw))

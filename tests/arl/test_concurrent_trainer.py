@@ -71,7 +71,7 @@ def test_a_cycle_is_both_phases_and_a_certification(monkeypatch):
     1/k s, the certification (which reads no clock here) 1 s."""
     ticks = itertools.count()
     monkeypatch.setattr(concurrent_trainer.time, "perf_counter", lambda: float(next(ticks)))
-    monkeypatch.setattr(concurrent_trainer, "certify", lambda *_: None)
+    monkeypatch.setattr(concurrent_trainer, "certify", lambda *_, **__: None)
     cfg = get_config("concurrent-tiny")
     est = concurrent_trainer.estimate_cycle(small_rules(), cfg, budgets=[0, None])
     k = min(cfg.n_steps, pace.SAMPLE_STEPS)
@@ -118,3 +118,27 @@ def test_the_estimate_changes_no_result_and_the_heartbeat_says_each_step(monkeyp
         *(f"training: cycle {c} of 2: the {s}'s phase" for c in (1, 2) for s in ("robot", "human")),
         *(f"training: cycle {c} of 2: a certification (exact best response)" for c in (1, 2)),
     }, said
+
+
+def test_the_memory_limit_reaches_the_state_graph_learners_and_certificates(monkeypatch):
+    """Issue 26 item 3: train_concurrent refuses learners over max_memory_gb before any
+    work, and hands each certificate's policy game the bytes left."""
+    import arl.memory as memory
+    from arl.concurrent_env import Encoder
+
+    rules = small_rules()
+    cfg = get_config("concurrent-tiny")
+    with pytest.raises(GameError, match="--max-memory limit of 0.5 GB") as info:
+        train_concurrent(rules, cfg, max_memory_gb=0.5)
+    assert "\n" not in str(info.value)
+    room = memory.concurrent_training_room(Encoder(rules).size, cfg, 2.0)
+    assert 0 < room < 2 << 30
+    given = []
+
+    def spy(*args, max_memory=None, **kwargs):
+        given.append(max_memory)
+        return certify(*args, max_memory=max_memory, **kwargs)
+
+    monkeypatch.setattr(concurrent_trainer, "certify", spy)
+    train_concurrent(rules, cfg.replace(cycles=1), budgets=[0], max_memory_gb=2.0)
+    assert given == [room]

@@ -124,15 +124,37 @@ def test_train_config_concurrent_needs_the_concurrent_game_of_an_assembly(tmp_pa
         assert message in capsys.readouterr().err
 
 
-def test_train_config_concurrent_refuses_a_cycle_over_the_flag(tmp_path, capsys):
-    """Issue 26 item 11: the concurrent trainer is estimated and limited as the alternating
-    one is (the same --max-cycle-seconds, the same line)."""
+@pytest.mark.parametrize(
+    ("flag", "value", "said"),
+    [
+        # Issue 26 item 11: the concurrent trainer is estimated and limited as the
+        # alternating one is (the same --max-cycle-seconds, the same line).
+        (
+            "--max-cycle-seconds",
+            "0.001",
+            ("over --max-cycle-seconds 0.001", "a certification (exact best response)"),
+        ),
+        # Issue 26 item 3: --max-memory bounds it too (the state graph, the learners, the
+        # certificates' policy games): a tiny limit is refused before any work, naming
+        # --max-memory, the estimate and the memory available.
+        ("--max-memory", "0.001", ("--max-memory limit of 0.001 GB", "needs about", "available")),
+    ],
+)
+def test_train_config_concurrent_refuses_a_run_over_the_flag(tmp_path, capsys, flag, value, said):
     run = tmp_path / "run"
     argv = f"train {PUMP} --turn-model concurrent --config concurrent-tiny --no-progress"
     with pytest.raises(SystemExit) as exit_info:
-        main([*argv.split(), "--max-cycle-seconds", "0.001", "--output", str(run)])
+        main([*argv.split(), flag, value, "--output", str(run)])
     assert exit_info.value.code == 2
     err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "over --max-cycle-seconds 0.001" in err[0], err
-    assert "a certification (exact best response)" in err[0]
+    assert len(err) == 1 and all(text in err[0] for text in said), err
     assert not run.exists() or not any(run.iterdir())
+
+
+def test_the_concurrent_trainers_state_graph_takes_the_memory_limit():
+    from asmplan.cli.train import _concurrent_rules
+    from asp.errors import StateLimit
+
+    with pytest.raises(StateLimit, match="the state graph needs more memory than it may use"):
+        _concurrent_rules(PUMP, "--config concurrent", 1e-7)
+    assert _concurrent_rules(PUMP, "--config concurrent", 1.0).model.n_ops > 0

@@ -116,6 +116,34 @@ def test_bad_choice_and_limits_are_errors():
     assert cert.nodes == cert.game.dag.n_nodes
 
 
+def test_the_policy_game_is_refused_past_its_memory_limit(monkeypatch):
+    """Issue 26 item 3: the policy game is bounded like every compiled game (the one rule,
+    asp.heap.memory_budget, by default): past the limit, one line naming --max-memory, the
+    estimate and the memory available, before the node over it is added."""
+    from asp import heap
+    from asp.concurrent.build import PY_NODE_BYTES
+
+    spec, graph = job(
+        [
+            {"id": "a", "agents": {"H1": 2, "R1": 3}, "after": []},
+            {"id": "b", "agents": {"H1": 2, "R1": 1}, "after": ["a"]},
+            {"id": "c", "agents": {"H1": 2, "R1": 2}, "after": ["a"]},
+        ],
+        agents={"H1": {"side": "human"}, "R1": {"side": "robot"}},
+    )
+    rules = concurrent_rules(spec, graph)
+    whole = certify(rules, lambda pos, commits: 0, [0, None])
+    assert whole.nodes > 4
+    with pytest.raises(GameLimit) as info:
+        certify(rules, lambda pos, commits: 0, [0, None], max_memory=4 * PY_NODE_BYTES)
+    text = str(info.value)
+    assert "\n" not in text and "--max-memory limit of 0.00 GB" in text, text
+    assert "the policy game" in text and "GB available" in text and "needs more than" in text
+    monkeypatch.setattr(heap, "available_memory", lambda: 16 * PY_NODE_BYTES)  # the default
+    with pytest.raises(GameLimit, match="--max-memory"):
+        certify(rules, lambda pos, commits: 0, [0, None])
+
+
 @SETTINGS
 @given(random_jobs(humans=(1, 2), ranges=True), st.sampled_from(["greedy", "schedule", "hybrid"]))
 def test_value_only_best_response_is_the_compiled_one(data, policy):
