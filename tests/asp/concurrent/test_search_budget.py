@@ -50,7 +50,7 @@ def test_two_stopped_curves_are_the_same(rules):
 def test_the_wall_clock_safety_net_stops_it_and_says_so(rules, monkeypatch):
     monkeypatch.setattr(search_module, "wall_safety", lambda seconds: 0.0)
     curve = solve_curve(rules, max_k=2, limits=Limits(time_limit=100))
-    # W*(0) = W*(inf) = 297 (flat) in 23,407 positions; the robust policy's game searches on
+    # W*(0) = W*(inf) = 297 (flat) in 23,379 positions; the robust policy's game searches on
     # and is stopped at the first look at the clock (TICK + 1 positions): another policy
     assert curve.wall_stop == 0.0 and curve.nodes == 32_768
     assert curve.stopped is None and all(curve.exact) and curve.policy != "robust"
