@@ -92,7 +92,10 @@ Every rule that cuts the search, with its proof:
    value at ``b`` is at most its value at ``b'``, at most ``hi(s, b') <= v <= W(s, b)``,
    and no move does better than ``W(s, b)``. (The commitments do not depend on the budget,
    rule 8, so ``m`` is the same commitment at both.) The policy is still optimal at every
-   state it reaches; where two moves are optimal it may take the other one.
+   state it reaches; where two moves are optimal it may take the other one. By the same
+   argument a ``hi`` taken from a higher budget (rule 3) is stored with that budget's move,
+   which achieves it (rule 1's invariant), and a position met again is narrowed to what
+   the other budgets' entries prove by then (rules 9 and 10) before it is expanded.
 
 The values ``W*(k)`` for ``k = 0, 1, ...`` and ``W*(inf)`` (the budget at its cap) share one
 table; a curve stops when ``W*(k) = W*(inf)`` (flat), at ``max_k``, or when a limit is hit.
@@ -301,9 +304,11 @@ def _new_bounds(T, H, row, key, lb):  # pragma: no cover - compiled
     """The interval a new entry of the position ``row`` (its key ``key``) starts with:
     ``lo`` its lower bound (``lb`` when given, >= 0), raised to the best ``lo`` the table has
     proved for the same position at any lower budget (rule 9), and ``hi`` its one budget
-    higher's or the cap's (rule 3), never below ``lo``."""
+    higher's or the cap's (rule 3), never below ``lo``; and the move stored with that ``hi``
+    (-1 for none), which achieves it at ``row``'s budget too (rule 10)."""
     lo = lb if lb >= 0 else lower_bound_of(T, row)
     hi = INF
+    mv = -1
     b = row[1]
     for nb in range(b - 1, -1, -1):  # fewer deviations left: W never rises (rule 9)
         j = _find(H, _at_budget(T, key, b, nb))
@@ -315,12 +320,13 @@ def _new_bounds(T, H, row, key, lb):  # pragma: no cover - compiled
             j = _find(H, _at_budget(T, key, b, nb))
             if j >= 0 and H.hi[j] < hi:
                 hi = H.hi[j]
-    return lo, max(hi, lo)
+                mv = H.move[j]
+    return lo, max(hi, lo), mv
 
 
 @numba.njit(cache=True)
 def _entry(T, H, row, st, lb):  # pragma: no cover - compiled
-    """The slot of the position ``row``, made when new with the interval of
+    """The slot of the position ``row``, made when new with the interval and move of
     :func:`_new_bounds`. -1 (and the stop flag) when the table is full."""
     key = key_of(T, row)
     i = _slot(H, key)
@@ -329,14 +335,27 @@ def _entry(T, H, row, st, lb):  # pragma: no cover - compiled
     if st[ENTRIES] >= st[MAX_ENTRIES]:
         st[ABORT] = STOP_MEMORY
         return -1
-    lo, hi = _new_bounds(T, H, row, key, lb)
+    lo, hi, mv = _new_bounds(T, H, row, key, lb)
     i = _slot(H, key)  # (the probes above did not write)
     H.keys[i] = key
     H.lo[i] = lo
     H.hi[i] = hi
-    H.move[i] = -1
+    H.move[i] = mv
     st[ENTRIES] += 1
     return i
+
+
+@numba.njit(cache=True)
+def _refresh(T, H, row, key, i):  # pragma: no cover - compiled
+    """The entry ``i`` of ``row`` narrowed to what the table now proves at the other budgets
+    (rules 9 and 10: ``lo`` from every lower budget, ``hi`` with its move from one higher or
+    the cap), for a position met again after those entries improved."""
+    lo, hi, mv = _new_bounds(T, H, row, key, H.lo[i])
+    if lo > H.lo[i]:
+        H.lo[i] = lo
+    if mv >= 0 and hi < H.hi[i]:
+        H.hi[i] = max(hi, H.lo[i])
+        H.move[i] = mv
 
 
 @numba.njit(cache=True)
@@ -656,10 +675,15 @@ def _search(T, H, root, alpha, beta, st, prefs, n_prefs):  # pragma: no cover - 
         p = phase[d]
         if p == ENTER:
             row = rows[d]
+            made = st[ENTRIES]
             s_ = _entry(T, H, row, st, lbh[d])
             if s_ < 0:
                 return 0
             lo, hi = H.lo[s_], H.hi[s_]
+            if lo < win_b[d] and lo < hi and hi > win_a[d] and st[ENTRIES] == made:
+                # met again: the other budgets' entries may prove more by now (rules 9, 10)
+                _refresh(T, H, row, key_of(T, row), s_)
+                lo, hi = H.lo[s_], H.hi[s_]
             if lo >= win_b[d] or lo == hi:
                 ret = lo
                 d -= 1
@@ -813,9 +837,11 @@ def _choose(T, H, row, commits, kind, prefs, n_prefs, st):  # pragma: no cover -
     if kind == ROBUST:
         key = key_of(T, row)
         i = _find(H, key)
-        if i >= 0 and H.lo[i] == H.hi[i] and H.move[i] >= 0:
-            return H.move[i]  # exact with its move: what the search below would return
-        if i >= 0:  # a higher budget's move proving at most the proven floor (rule 10)
+        if i >= 0:
+            _refresh(T, H, row, key, i)  # what the other budgets prove (rules 9, 10)
+            if H.lo[i] == H.hi[i] and H.move[i] >= 0:
+                return H.move[i]  # exact with its move: what the search below would return
+            # a higher budget's move proving at most the proven floor (rule 10)
             f = _move_above(T, H, row, key, H.lo[i], m)
             if f >= 0:
                 return f
@@ -1228,7 +1254,7 @@ class Search:
         i = _find(self.table, key)
         if i >= 0:
             return int(self.table.lo[i]), int(self.table.hi[i])
-        lo, hi = _new_bounds(t, self.table, row, key, -1)
+        lo, hi, _ = _new_bounds(t, self.table, row, key, -1)
         return int(lo), int(hi)
 
     def policy_game(
