@@ -24,7 +24,8 @@ without such a pair is as before), and removes no way the rest can be assembled.
 
 Its id is the innermost group's when the part is that whole group, else its first
 member's; its mesh is the members' meshes together, its source ``file#a+b+c`` (how a spec
-names such a part: :mod:`cad.loading`).
+names such a part: :mod:`cad.loading`), every node of the file it holds (a part joined of
+parts joined before lists their nodes, so a spec written from it reads the same mesh).
 One warning names every part made so. Overlapping parts of no common group stay parts
 (the relations then report them, with the spec line that joins them).
 """
@@ -131,9 +132,10 @@ def _joined(assembly: Assembly, joined: list[list[int]], file_name: str, why: st
         taken.add(pid)
         mesh = trimesh.util.concatenate([parts[k].mesh for k in members])
         file = parts[members[0]].source.partition("#")[0]
+        nodes = [parts[k].source.partition("#")[2] or parts[k].id for k in members]
         name = " + ".join(dict.fromkeys(parts[k].name for k in members))
         made[members[0]] = replace(
-            parts[members[0]], id=pid, name=name, mesh=mesh, source=f"{file}#{'+'.join(ids)}"
+            parts[members[0]], id=pid, name=name, mesh=mesh, source=f"{file}#{'+'.join(nodes)}"
         )
         new_id.update({m: pid for m in ids})
         said.append(f"{pid} ({len(ids)} parts)")

@@ -253,6 +253,25 @@ def test_locking_parts_of_one_sub_assembly_are_one_rigid_part(tmp_path):
         assert load_assembly(apart).ids == ("link_a", "link_b", "plate")
 
 
+def test_a_part_joined_of_joined_parts_names_every_node_it_holds(tmp_path):
+    """A bead sunk into one link (joined by overlap first), the links then locking each
+    other (joined second): the part's source lists the bead's node too, so a spec naming
+    the part by its source reads the same mesh (the two-cylinder engine's block lost the
+    19 pieces joined into one of its members, and a plate no longer touched it)."""
+    rings = linked_rings()
+    bead = trimesh.creation.icosphere(subdivisions=2, radius=1.5).apply_translation((-10, 0, 1.5))
+    loose = {"plate": box([60, 30, 2], [5, 0, -13])}
+    path = write_grouped_glb(tmp_path / "chain.glb", {**rings, "bead": bead}, loose)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assembly = load_assembly(path)
+        assert assembly.ids == ("plate", "spring")
+        chain = assembly.parts[1]
+        assert sorted(chain.source.partition("#")[2].split("+")) == ["bead", "link_a", "link_b"]
+        again = load_parts([PartRecord(id="c", name="c", file=chain.source)], tmp_path)
+    assert len(again.parts[0].mesh.faces) == len(chain.mesh.faces)
+
+
 def brep_patches(mesh: trimesh.Trimesh) -> trimesh.Trimesh:
     """``mesh`` as OCCT tessellates a B-rep: each planar face (facet) a patch of its own
     vertices, the patches one after the other."""
