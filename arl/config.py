@@ -37,6 +37,7 @@ from dataclasses import dataclass
 
 from arl.envs import OBSERVATIONS
 from arl.moves import REWARDS, check_choice
+from asp.game.turns import CONCURRENT
 
 ALGOS = ("ppo", "maskable_ppo")
 STOPS = ("rewards", "policy")
@@ -182,7 +183,7 @@ FAST = TrainConfig(
 
 CONFIGS: dict[str, TrainConfig] = {"paper": PAPER, "fast": FAST}
 
-TURN_MODEL_CHANGES: dict[tuple[str, str], dict] = {("fast", "concurrent"): {"n_steps": 32}}
+TURN_MODEL_CHANGES: dict[tuple[str, str], dict] = {("fast", CONCURRENT.name): {"n_steps": 32}}
 """What a named configuration changes on a game of a turn model. ``fast`` on the concurrent
 game: ``n_steps`` 32 (robust-optimal on the pump for 10 of 10 seeds, against 7 of 10 with 16;
 ``benchmarks/arl_concurrent_pump.py --n-steps``)."""

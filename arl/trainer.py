@@ -47,6 +47,7 @@ from asp.game import rules
 from asp.game.dag import HUMAN, ROBOT, GameDAG
 from asp.game.metrics import is_robust_optimal
 from asp.game.solve import certified_worst_case, play, solve
+from asp.game.turns import turn_of
 from asp.numbers import plain
 
 LOG_VERSION = 1
@@ -423,7 +424,7 @@ def _start_run(
     dag: GameDAG, cfg: TrainConfig, seed: int, folder: RunFolder | None, resume: bool
 ) -> _Run:
     """A new run, or the run saved in ``folder`` restored from its checkpoint in force."""
-    if cfg.reward == "paper" and dag.metadata.get("turn_model") == "concurrent":
+    if cfg.reward == "paper" and turn_of(dag.metadata.get("turn_model")).simultaneous:
         raise ValueError(
             "reward: the paper's rewards charge the robot its own moves only, and in the "
             "concurrent game time passes on the human's replies; use the fast config "

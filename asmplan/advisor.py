@@ -52,6 +52,7 @@ from dataclasses import asdict, dataclass, field, replace
 from asmplan.errors import GameError
 from asmplan.planfile import check_plan, line_moves, move_starts, worst_move
 from asp.game.alike import AlikeMap
+from asp.game.turns import ALTERNATE, CONCURRENT, TurnModel
 
 EVENT_KINDS = ("started", "finished")
 
@@ -235,7 +236,7 @@ class Advice:
     bound: float
     finished: bool
     deviations: int = 0
-    turn_model: str = "alternate"
+    turn_model: str = ALTERNATE.name
     instructions: list = field(default_factory=list)
     finishes: list = field(default_factory=list)
     budget: int | None = None
@@ -270,14 +271,17 @@ class Advisor:
         A plan document (``asmplan-plan/2``), as read by :func:`asmplan.planfile.read_plan`.
     """
 
+    TURN_MODEL: TurnModel = ALTERNATE
+    """The turn model of the plans it follows (:data:`ADVISORS`)."""
+
     def __new__(cls, plan: dict):
         turn = plan.get("policy", {}).get("turn_model") if isinstance(plan, dict) else None
-        if cls is Advisor and turn == "concurrent":
-            return super().__new__(ConcurrentAdvisor)
+        if cls is Advisor and isinstance(turn, str):
+            return super().__new__(ADVISORS.get(turn, Advisor))
         return super().__new__(cls)
 
     def __init__(self, plan: dict):
-        self._read(plan, "alternate")
+        self._read(plan, self.TURN_MODEL.name)
         self._cursor = _Cursor(self._policy["start"])
         self._cursor.state = self._skip_passes(self._cursor.state)
 
@@ -677,8 +681,10 @@ class ConcurrentAdvisor(Advisor):
     """The runtime advisor of a concurrent plan (module docstring); ``Advisor(plan)`` returns
     one for a plan of turn model ``concurrent``."""
 
+    TURN_MODEL = CONCURRENT
+
     def __init__(self, plan: dict):
-        self._read(plan, "concurrent")
+        self._read(plan, self.TURN_MODEL.name)
         sides = plan.get("agents", {})
         self._robot = [_worker_side(a, sides) == "robot" for a in self._agents]
         self._events: list[Event] = []
@@ -746,7 +752,7 @@ class ConcurrentAdvisor(Advisor):
             bound=total - b.elapsed,
             finished=self.finished,
             deviations=self._deviations,
-            turn_model="concurrent",
+            turn_model=self.TURN_MODEL.name,
             instructions=instructions,
             finishes=self._finishes(explain),
             budget=states["budget"][i],
@@ -1037,6 +1043,11 @@ class ConcurrentAdvisor(Advisor):
 
     def _description(self, o: int) -> str:
         return self._operations.get(self._ops[o], {}).get("description", "")
+
+
+ADVISORS: dict[str, type[Advisor]] = {c.TURN_MODEL.name: c for c in (Advisor, ConcurrentAdvisor)}
+"""The advisor class of each turn model (:data:`asp.game.turns.TURNS`): ``Advisor(plan)`` is
+one of the plan's."""
 
 
 def _move(j: int) -> int | None:

@@ -769,12 +769,13 @@ def plan(
     release_memory()  # the meshes and collision objects of the relations
     say("[2/5] building the assembly state graph ...")
     turn = assembly.spec.turn_model if turn_model is None else turn_model
+    from asp.game.turns import CONCURRENT, expected_names
     from asp.spec import TURN_MODELS
 
     if turn not in TURN_MODELS:
         from asp.errors import GraphError
 
-        raise GraphError(f"--turn-model: expected alternate or concurrent, got {turn!r}")
+        raise GraphError(f"--turn-model: expected {expected_names()}, got {turn!r}")
     # Alike parts in a fixed order for both turn models: the concurrent rules undo it
     # exactly (:mod:`asp.concurrent.rules`), and the loose order's graph is larger.
     graph = state_graph(assembly, progress=True, max_states=max_states, on_step=on_step)
@@ -785,7 +786,7 @@ def plan(
         assembly = Assembly(graph.spec, assembly.relations)
     sequences = graph.count_sequences()
     release_memory()  # the layers and tables of the build
-    if turn == "concurrent":  # CP-SAT first: its optimum bounds the concurrent game's W*(k)
+    if turn == CONCURRENT.name:  # CP-SAT first: its optimum bounds the concurrent game's W*(k)
         from asp.concurrent.plan import plan_concurrent
         from asp.concurrent.robustness import DEFAULT_MAX_K
 
@@ -960,10 +961,11 @@ def build_plan(
     comparison included.
     """
     from asmplan.planfile import alternate_states, plan_document
+    from asp.game.turns import CONCURRENT
 
     loaded = load(assembly)
-    if (turn_model or loaded.spec.turn_model) == "concurrent":
-        return plan(loaded, cost=cost, turn_model="concurrent").to_dict()
+    if (turn_model or loaded.spec.turn_model) == CONCURRENT.name:
+        return plan(loaded, cost=cost, turn_model=CONCURRENT.name).to_dict()
     graph = state_graph(loaded)
     dag = game(graph, cost=cost)
     solution = solve_game(dag)

@@ -48,6 +48,7 @@ from asp.game.policy import (
     policy_table,
 )
 from asp.game.solve import Solution
+from asp.game.turns import CONCURRENT, turn_of
 
 FORMAT = "asmplan-plan/2"
 MAIN = "main"
@@ -320,7 +321,7 @@ def _concurrent_policy(game, solution: Solution, table: PolicyTable) -> dict:
     states.update(robots=robots, instruction=instruction, budget=budget)
     return {
         **_policy_head(
-            "concurrent", dag.cost_model, table, op_names, agent_names, states.pop("_tools")
+            CONCURRENT.name, dag.cost_model, table, op_names, agent_names, states.pop("_tools")
         ),
         "states": {"node": table.node.tolist(), **states},
         "moves": {
@@ -918,8 +919,7 @@ def check_plan(doc: dict, where: str = "plan") -> None:
             raise FormatError(f"{where}: policy.states.{key}: expected {n} entries")
     if len(policy["moves"]["ptr"]) != n + 1:
         raise FormatError(f"{where}: policy.moves.ptr: expected {n + 1} entries")
-    concurrent = policy.get("turn_model") == "concurrent"
-    keys = ("starts", "deviations") if concurrent else ("operation", "agent")
+    keys = turn_of(policy.get("turn_model")).move_columns
     for key in (*keys, "cost", "next"):
         if len(policy["moves"].get(key, ())) != m:
             raise FormatError(f"{where}: policy.moves.{key}: expected {m} entries")

@@ -78,6 +78,7 @@ import networkx as nx
 from asp.cad_keys import parse_flex, parse_overlap_ok
 from asp.game.dag import MAX_COST
 from asp.game.rules import COST_MODELS
+from asp.game.turns import DEFAULT_TURN, TURNS, expected_names
 from cad.bom import PartRecord, part_records, refuse_unknown_keys
 from cad.directions import DIRECTIONS
 from cad.frame import parse_frame
@@ -88,7 +89,8 @@ from cad.units import unit_scale
 from cad.yamlfile import read_yaml
 
 SIDES = ("human", "robot", "any")
-TURN_MODELS = ("alternate", "concurrent")
+TURN_MODELS = tuple(TURNS)
+"""The turn models' names (:data:`asp.game.turns.TURNS`, where each says what differs)."""
 CONSTRAINT_KEYS = ("topological", "stability", "functional")
 SPEC_FILE = "assembly.yaml"
 TOP_KEYS = (
@@ -203,7 +205,7 @@ class AssemblySpec:
     gravity: str = "-z"
     gripper_approach: tuple[str, ...] = DIRECTIONS
     constraints: Constraints = field(default_factory=Constraints)
-    turn_model: str = "alternate"
+    turn_model: str = DEFAULT_TURN.name
     cost: str = "steps"
     source: str = ""
     units: str | None = None
@@ -425,9 +427,9 @@ class _Parser:
             if not isinstance(value, bool):
                 raise self.fail(f"constraints.{key}", f"expected true or false, got {value!r}")
             flags[key] = value
-        turn = str(data.get("turn_model", "alternate"))
+        turn = str(data.get("turn_model", DEFAULT_TURN.name))
         if turn not in TURN_MODELS:
-            raise self.fail("turn_model", f"expected 'alternate' or 'concurrent', got {turn!r}")
+            raise self.fail("turn_model", f"expected {expected_names(quote=True)}, got {turn!r}")
         cost = str(data.get("cost", "steps"))
         if cost not in COST_MODELS:
             raise self.fail("cost", f"expected 'steps' or 'time', got {cost!r}")

@@ -16,9 +16,12 @@ from asmplan.cli.options import (
     seed_option,
     turn_model_option,
 )
+from asp.game.turns import ALTERNATE, CONCURRENT, DEFAULT_TURN, TURNS
 
 if TYPE_CHECKING:  # pragma: no cover - types only
     from asp.game.dag import GameDAG
+    from asp.graph.state_graph import StateGraph
+    from asp.spec import AssemblySpec
 
 
 SOURCE_HELP = (
@@ -38,21 +41,35 @@ def load_training_game(source: Path, turn_model: TurnModel | None = None) -> Gam
     from asmplan import pipeline
 
     if source.is_file() and source.suffix.lower() in pipeline.GRAPH_SUFFIXES:
-        if turn_model is TurnModel.concurrent:
+        if turn_model is not None and not TURNS[turn_model.value].game_file:
             raise ValueError(
-                f"{source}: --turn-model concurrent needs an assembly (a game DAG file is "
-                "an alternating game)"
+                f"{source}: --turn-model {turn_model.value} needs an assembly (a game DAG "
+                "file is an alternating game)"
             )
         return pipeline.load_game(source).dag
     assembly = pipeline.load(source)
     graph = pipeline.state_graph(assembly)
-    chosen = turn_model or TurnModel(getattr(assembly.spec, "turn_model", "alternate"))
-    if chosen is TurnModel.alternate:
-        return pipeline.game(graph)
+    chosen = turn_model or TurnModel(getattr(assembly.spec, "turn_model", DEFAULT_TURN.name))
+    return TRAINING_GAMES[chosen.value](assembly.spec, graph)
+
+
+def _alternating_game(spec: AssemblySpec, graph: StateGraph) -> GameDAG:
+    from asmplan import pipeline
+
+    return pipeline.game(graph)
+
+
+def _concurrent_game(spec: AssemblySpec, graph: StateGraph) -> GameDAG:
+    """The concurrent game against the unbounded adversary (``W*(inf)``)."""
     from asp.concurrent.build import build_game
     from asp.concurrent.model import concurrent_model
 
-    return build_game(concurrent_model(assembly.spec, graph), None).dag
+    return build_game(concurrent_model(spec, graph), None).dag
+
+
+TRAINING_GAMES = {ALTERNATE.name: _alternating_game, CONCURRENT.name: _concurrent_game}
+"""The game DAG ``train`` and ``evaluate`` play on an assembly, by turn model
+(:data:`asp.game.turns.TURNS`)."""
 
 
 def _stderr_line(progress: bool):
@@ -102,7 +119,7 @@ def _train_concurrent(
     from arl.concurrent_trainer import get_config as concurrent_config
     from arl.concurrent_trainer import train_concurrent
 
-    if turn_model is TurnModel.alternate:
+    if turn_model is not None and turn_model.value != CONCURRENT.name:
         raise ValueError(
             f"--config {config} trains the concurrent game: use --turn-model concurrent"
         )

@@ -21,6 +21,7 @@ import html
 from pathlib import Path
 
 from asmplan.report.steps import assembly_steps
+from asp.game.turns import turn_of
 
 
 def _img(uri: str, alt: str, width: int | None = None) -> str:
@@ -32,7 +33,7 @@ def _img(uri: str, alt: str, width: int | None = None) -> str:
 
 
 def _concurrent(doc: dict) -> bool:
-    return doc.get("turn_model") == "concurrent"
+    return turn_of(doc.get("turn_model")).plan_curve
 
 
 def concurrent_part(doc: dict) -> dict:

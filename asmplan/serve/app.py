@@ -55,6 +55,7 @@ from asmplan.serve.sessions import (
     UnknownSession,
 )
 from asmplan.study.questionnaire import AnswerError, check_answers, items_from_data
+from asp.game.turns import turn_of
 
 MAX_BODY = 16 * 1024
 """Largest request body accepted, bytes."""
@@ -107,7 +108,7 @@ def plan_id(plan: dict) -> str:
     """A URL-safe id from the assembly's name (``vacuum pump`` -> ``vacuum-pump``; a plan of
     the concurrent game: ``vacuum-pump-concurrent``)."""
     name = re.sub(r"[^a-z0-9]+", "-", str(plan.get("assembly", "plan")).lower()).strip("-")
-    return f"{name}-concurrent" if plan.get("turn_model") == "concurrent" else name
+    return name + turn_of(plan.get("turn_model")).plan_id_suffix
 
 
 def _plotly_js() -> Path:

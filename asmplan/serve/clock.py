@@ -19,6 +19,8 @@ from the same place. :func:`clock_view` is the session's ``clock`` in the API.
 
 from __future__ import annotations
 
+from asp.game.turns import turn_of
+
 
 def _anchor(session) -> tuple[float, float]:
     """(wall-clock time, game time) of the session's last event (its creation at first)."""
@@ -32,7 +34,7 @@ def _next(session) -> tuple[dict | None, float | None, bool]:
     advice = session.current()
     if advice.finished:
         return None, None, False
-    if advice.turn_model == "concurrent":
+    if turn_of(advice.turn_model).simultaneous:  # the game advances by completions
         if not advice.finishes:
             return None, None, bool(advice.options)
         f = min(advice.finishes, key=lambda x: (x["time"], x["operation"], x["agent"]))

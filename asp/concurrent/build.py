@@ -24,6 +24,7 @@ import numpy as np
 from asp.concurrent.model import UNBOUNDED, WAIT, ConcurrentModel
 from asp.errors import GameError, GameLimit
 from asp.game.dag import HUMAN, ROBOT, GameDAG, from_arrays
+from asp.game.turns import CONCURRENT
 from asp.heap import available_memory, memory_budget
 
 DEFAULT_MAX_NODES = 3_000_000
@@ -267,7 +268,7 @@ def game_of(
             "generator": generator,
             "assembly": model.spec.name,
             "source": model.spec.source,
-            "turn_model": "concurrent",
+            "turn_model": CONCURRENT.name,
             "budgets": [None if b == UNBOUNDED else b for b in levels],
             "workers": {w.name: ("robot" if w.side == ROBOT else "human") for w in model.workers},
         },

@@ -31,6 +31,7 @@ from asp.concurrent.model import concurrent_model
 from asp.concurrent.robustness import DEFAULT_MAX_K, Robustness, robustness
 from asp.concurrent.rules import concurrent_rules
 from asp.concurrent.search import Limits
+from asp.game.turns import CONCURRENT
 from asp.numbers import json_number
 from asp.schedule.assembly_makespan import assembly_makespan
 
@@ -264,7 +265,7 @@ def plan_entries(plan: ConcurrentPlan) -> dict:
     curve = plan.curve
     game = curve.game
     return {
-        "turn_model": "concurrent",
+        "turn_model": CONCURRENT.name,
         "schedule": {**plan.schedule.to_dict(), "lower_bound": plan.lower_bound},
         "robustness": curve.to_list(),
         "concurrent": {

@@ -51,6 +51,7 @@ from pathlib import Path
 import numpy as np
 
 from asp.errors import SpecError
+from asp.game.turns import ALTERNATE
 from asp.numbers import json_number
 from asp.spec import (
     SPEC_FILE,
@@ -338,7 +339,7 @@ def spec_data(
         **({"frame": frame_record(frame)} if frame is not None else {}),
         "gripper_approach": ["+x", "-x", "+y", "-y", "+z", "-z"],
         "constraints": {"topological": True, "stability": True, "functional": True},
-        "turn_model": "alternate",
+        "turn_model": ALTERNATE.name,
         "cost": "time",
         "operations": operations,
     }

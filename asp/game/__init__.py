@@ -5,8 +5,9 @@ array-backed DAG), :mod:`~asp.game.io` (its JSON and GraphML files),
 :mod:`~asp.game.synth` (synthetic DAGs), :mod:`~asp.game.solve` (the exact solver),
 :mod:`~asp.game.metrics` (the paper's metrics, exact), :mod:`~asp.game.plan` (the robust
 plan as steps), :mod:`~asp.game.policy` (the robust policy as a table of states and
-moves), :mod:`~asp.game.play` (a person playing one side) and
-:mod:`~asp.game.alike` (alike operations at run time).
+moves), :mod:`~asp.game.play` (a person playing one side),
+:mod:`~asp.game.alike` (alike operations at run time) and :mod:`~asp.game.turns` (the turn
+models, one entry each: what differs between them).
 """
 
 from asp.lazy import lazy_exports
@@ -48,5 +49,14 @@ __all__, __getattr__ = lazy_exports(
         ),
         "solve": ("Solution", "certified_worst_case", "evaluate_policy", "node_order", "solve"),
         "synth": ("synthetic_dag",),
+        "turns": (
+            "ALTERNATE",
+            "CONCURRENT",
+            "DEFAULT_TURN",
+            "TURNS",
+            "TurnModel",
+            "expected_names",
+            "turn_of",
+        ),
     },
 )

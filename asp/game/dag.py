@@ -31,6 +31,7 @@ import numpy as np
 from asp.errors import GraphError
 from asp.game import rules
 from asp.game.rules import ANY, HUMAN, PLAYERS, ROBOT, SIDE_NAMES, side_from_name
+from asp.game.turns import ALTERNATE
 
 INT32_NODES = 2**30
 """Up to this many nodes, node indices (``targets``, ``sources``) are stored as int32."""
@@ -243,7 +244,7 @@ class GameDAG:
     agents: tuple[str, ...] | None = None
     node_labels: tuple[str, ...] | None = None
     cost_model: str = "steps"
-    turn_model: str = "alternate"
+    turn_model: str = ALTERNATE.name
     metadata: dict = field(default_factory=dict)
 
     # ------------------------------------------------------------------ sizes
@@ -601,7 +602,7 @@ def validate_dag(dag: GameDAG) -> None:
     if dag.n_nodes == 0:
         raise GraphError("empty graph: expected at least one node")
     rules.check_cost_model(dag.cost_model)
-    if dag.turn_model != "alternate":
+    if dag.turn_model != ALTERNATE.name:  # a DAG's form: the concurrent game is compiled to it
         raise GraphError(f"turn_model: expected 'alternate', got {dag.turn_model!r}")
     if dag.n_edges:
         bad = np.flatnonzero(~np.isfinite(dag.costs) | (dag.costs < 0) | (dag.costs > MAX_COST))

@@ -33,6 +33,7 @@ import networkx as nx
 from asp.atomic import write_bytes, write_text
 from asp.errors import FormatError, GraphError
 from asp.game.dag import MAX_COST, SIDE_NAMES, GameDAG, from_edges, from_networkx, side_from_name
+from asp.game.turns import ALTERNATE
 from asp.numbers import json_number, plain
 from cad.numbers import plain_number
 from cad.texts import bounded
@@ -88,7 +89,7 @@ def dag_from_dict(data: dict, source: str = "<dict>") -> GameDAG:
     for key in ("nodes", "edges"):
         if not isinstance(data.get(key), list):
             raise FormatError(f"{source}: key {key!r} must be a list")
-    if data.get("turn_model", "alternate") != "alternate":
+    if data.get("turn_model", ALTERNATE.name) != ALTERNATE.name:
         raise GraphError(f"{source}: turn_model must be 'alternate', got {data['turn_model']!r}")
     try:
         ids = [n["id"] if isinstance(n, dict) else n for n in data["nodes"]]

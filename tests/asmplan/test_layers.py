@@ -254,3 +254,69 @@ def test_asmplan_and_arl_use_the_public_names_of_asp_and_cad():
                     if a.name not in public and a.name not in modules
                 ]
     assert not wrong, f"not in the room's __all__ (its __init__.py, or the module's): {wrong}"
+
+
+# --------------------------------------------------------------------------- turn models
+
+TURN_REGISTRY = REPO / "asp" / "game" / "turns.py"
+"""The one module that spells the turn models' names (:data:`asp.game.turns.TURNS`)."""
+
+
+def turn_name_comparisons(path: Path, names) -> list[int]:
+    """Lines of ``path`` that compare a value with a turn model's name written as a string
+    (``x == "concurrent"``, ``"alternate" != x``, ``case "concurrent":``)."""
+    tree = ast.parse(path.read_text(encoding="utf-8"), filename=str(path))
+
+    def named(node) -> bool:
+        return isinstance(node, ast.Constant) and node.value in names
+
+    lines = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Compare):
+            sides = [node.left, *node.comparators]
+            if any(isinstance(op, ast.Eq | ast.NotEq) for op in node.ops) and any(
+                named(s) for s in sides
+            ):
+                lines.append(node.lineno)
+        elif isinstance(node, ast.MatchValue) and named(node.value):
+            lines.append(node.lineno)
+    return lines
+
+
+def test_turn_models_are_compared_through_the_registry():
+    """Issue 22, "no seams": code that behaves by turn model looks it up in
+    :data:`asp.game.turns.TURNS` (or compares with ``ALTERNATE.name``), never with the name
+    spelled out, so a new game model is one entry there plus its modules."""
+    from asp.game.turns import TURNS
+
+    wrong = [
+        f"{path.relative_to(REPO)}:{line}"
+        for pkg in ("asp", "arl", "asmplan")
+        for path in sources(pkg)
+        if path != TURN_REGISTRY
+        for line in turn_name_comparisons(path, set(TURNS))
+    ]
+    assert not wrong, f"compare with asp.game.turns (TURNS, ALTERNATE, ...): {wrong}"
+
+
+def test_the_turn_name_reader_sees_each_form(tmp_path):
+    probe = tmp_path / "probe.py"
+    probe.write_text(
+        'a = x == "concurrent"\nb = "alternate" != y\nc = "concurrent" in d\n'
+        'match z:\n    case "concurrent":\n        pass\n'
+    )
+    assert turn_name_comparisons(probe, {"alternate", "concurrent"}) == [1, 2, 5]
+
+
+def test_every_turn_model_has_its_lookups():
+    """Each lookup above asp that names a turn model's classes or functions has an entry for
+    every model of the registry."""
+    from asmplan.advisor import ADVISORS
+    from asmplan.cli.train import TRAINING_GAMES
+    from asp.game.turns import TURNS
+    from asp.spec import TURN_MODELS
+
+    assert list(TURN_MODELS) == list(TURNS)
+    for lookup in (ADVISORS, TRAINING_GAMES):
+        assert sorted(lookup) == sorted(TURNS)
+    assert all(cls.TURN_MODEL is TURNS[name] for name, cls in ADVISORS.items())
