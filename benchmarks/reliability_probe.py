@@ -26,6 +26,9 @@ restart against the acknowledged events, a re-planned folder), ``disk`` (a full 
 small tmpfs when ``mount -t tmpfs`` works, else a file-size limit, RLIMIT_FSIZE; the
 table says which).
 
+Every child runs the packages as they were at the start (:func:`snapshot`: a copy, numba's
+caches kept), never a checkout that changes under the run.
+
 Prints the table of families x classes and every case outside ``clean`` with its reason.
 Exit status 1 when any case is outside ``clean``. ``--quick`` takes a sample of each family
 (about ten minutes on a loaded 2-core machine); the full run takes every case, more kills
@@ -65,6 +68,7 @@ CLI = [
     "-c",
     "import sys; from asmplan.cli import main; sys.exit(main(sys.argv[1:]))",
 ]
+PACKAGES = ("cad", "asp", "arl", "asmplan")
 ENV = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")])}
 ENV.pop("COLUMNS", None)
 ENV["XDG_DATA_HOME"] = tempfile.mkdtemp(prefix="probe-xdg-")  # never the user's own folder
@@ -110,6 +114,22 @@ class Probe:
             tempfile.mkdtemp(prefix=re.sub(r"[^\w.-]+", "_", name)[:40] + "-", dir=self.tmp)
         )
         return path
+
+
+def snapshot(tmp: Path) -> Path:
+    """The packages copied into ``tmp/code`` with numba's caches beside them (modification
+    times kept, so the caches stay valid), and every child run from the copy: a probe tests
+    one code version however the checkout changes while it runs. (A commit landing under a
+    running probe changed ``asp/concurrent/search.py``; numba then recompiled its kernels
+    in the next ``plan``, 88 s of CPU where the pump takes 6, judged a hang; from a cold
+    cache the pump's plan takes 137 s of CPU, 193 s of a profiled run's compiling in the
+    concurrent search's kernels.) A cold cache is warmed by the reference plan in
+    :func:`prepare`."""
+    code = tmp / "code"
+    for package in PACKAGES:
+        shutil.copytree(REPO / package, code / package, ignore=shutil.ignore_patterns("*.pyc"))
+    ENV["PYTHONPATH"] = os.pathsep.join([str(code), os.environ.get("PYTHONPATH", "")])
+    return code
 
 
 def run(args: list[str], timeout: float = 120, stdin: str = "", preexec=None, cwd=None) -> Run:
@@ -1518,6 +1538,7 @@ def main(argv: list[str]) -> int:
     started, cpu0 = time.monotonic(), _children_cpu()
     with tempfile.TemporaryDirectory(prefix="reliability-probe-") as tmp:
         probe = Probe(Path(tmp), ns.quick, random.Random(ns.seed))
+        snapshot(probe.tmp)
         shared = prepare(probe)
         print(
             f"prepared in {time.monotonic() - started:.0f} s "
