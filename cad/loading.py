@@ -179,7 +179,7 @@ def warn_part_scales(assembly: Assembly) -> None:
 def _record_mesh(row: PartRecord, base: Path, units: str | None):
     """``(mesh in file units, unit, source text)`` of one record (``file#node``: one node
     of a scene, unless a file of that whole name exists: ``bearing#1.stl``)."""
-    whole = (base / str(row.file)).is_file()
+    whole = _is_file(base / str(row.file))
     name, _, node = (str(row.file), "", "") if whole else str(row.file).partition("#")
     file = base / name
     if not file.exists():
@@ -202,6 +202,15 @@ def _record_mesh(row: PartRecord, base: Path, units: str | None):
     meshes = scene.meshes
     mesh = meshes[0] if len(meshes) == 1 else trimesh.util.concatenate(list(meshes))
     return mesh, unit, str(file)
+
+
+def _is_file(path: Path) -> bool:
+    """``path.is_file()``, False for a name the system cannot hold (a ``file#node`` whose
+    node list is longer than a file name may be: ENAMETOOLONG)."""
+    try:
+        return path.is_file()
+    except OSError:
+        return False
 
 
 def _scene_assembly(path: Path, units: str | None) -> Assembly:

@@ -250,3 +250,23 @@ def test_a_step_that_only_references_other_files_says_so(tmp_path):
     )
     with pytest.raises(ValueError, match=r"references external files \(FOOT_FRONT.stp, FOOT_BACK"):
         load_assembly(path)
+
+
+def test_a_node_name_longer_than_a_file_name_is_read_from_its_scene(tmp_path):
+    # `file#node` is first tried as one file name: past 255 bytes the system refuses the
+    # name (ENAMETOOLONG) and the record is the node of its scene, as any other
+    long_id = "bottom_" + "x" * 300
+    scene = trimesh.Scene()
+    for part in shapes.stacked_cubes().parts:
+        scene.add_geometry(part.mesh, node_name=long_id if part.id == "bottom" else part.id)
+    scene.export(tmp_path / "asm.glb")
+    spec = tmp_path / "assembly.yaml"
+    spec.write_text(
+        "agents: {H: human}\n"
+        "operations: [{id: '1.1', agents: {H: 1}}]\n"
+        "parts:\n"
+        f"  - {{id: B, file: 'asm.glb#{long_id}'}}\n"
+        "  - {id: T, file: 'asm.glb#top'}\n"
+    )
+    assembly = load_geometry(spec)
+    assert assembly.ids == ("B", "T")
