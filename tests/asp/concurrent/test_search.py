@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 
 from asp.concurrent.curve import solve_curve
 from asp.concurrent.model import UNBOUNDED
-from asp.concurrent.rules import concurrent_rules
+from asp.concurrent.rules import commit_rows, concurrent_rules
 from asp.concurrent.search import (
     GREEDY,
     HYBRID,
@@ -270,3 +270,38 @@ def test_deviation_aware_bounds_hold_every_exact_value(data, rnd, slack):
         for pos, w in exact.values():
             lo, hi = search.interval(pos)
             assert lo <= w <= hi, (pos, lo, w, hi)
+
+
+@SETTINGS
+@given(random_jobs(humans=(1, 2), ranges=True), st.randoms(use_true_random=False))
+def test_the_robust_move_is_optimal_at_every_position(data, rnd):
+    """Rule 10: after searches of the budgets in any order, the robust policy's move at
+    every position of the game (a higher budget's move where the table proves it, else the
+    search's) achieves the position's exact value against every reply."""
+    from asp.concurrent.search import ROBUST, policy_choice
+
+    ops, agents = data
+    spec, graph = job(ops, agents=agents)
+    rules = concurrent_rules(spec, graph)
+    top = top_budget(agents, ops)
+    exact: dict = {}
+    want = [every_position(rules, rules.start(k), exact) for k in range(top + 1)]
+    search = Search(rules)
+    budgets = list(range(top + 1))
+    rnd.shuffle(budgets)
+    for k in budgets:
+        assert search.value(k) == want[k]
+    items = list(exact.values())
+    rnd.shuffle(items)
+    t = rules.tables
+    for pos, w in items:
+        commits = rules.commits(pos)
+        rows = commit_rows(t, pos.row())
+        i = policy_choice(
+            t, search.table, pos.row(), rows, ROBUST, search.prefs, search.n_prefs, search.stats
+        )
+        got = max(
+            r.delta + (0 if rules.is_end(nxt) else exact[rules.key(nxt)][1])
+            for r, nxt in rules.replies(pos, commits[i])
+        )
+        assert got == w, (pos, i, got, w)
