@@ -820,7 +820,9 @@ def plan(
     line = [step.operation for step in steps if step.operation]
     sched = schedule(assembly, graph, time_limit=time_limit, seed=seed, sequence=line)
     release_memory()  # CP-SAT's model and the replay tables
-    preview = alternate_preview(loaded, graph, schedule=(sched.result, sched.lower_bound))
+    preview = alternate_preview(
+        loaded, graph, schedule=(sched.result, sched.lower_bound), progress=on_step is not None
+    )
     return AssemblyPlan(
         assembly,
         graph,
@@ -838,7 +840,7 @@ def plan(
 
 
 def alternate_preview(
-    assembly: Assembly, graph: StateGraph, *, schedule: tuple | None = None
+    assembly: Assembly, graph: StateGraph, *, schedule: tuple | None = None, progress: bool = False
 ) -> dict:
     """``plan.json``'s ``concurrent_preview`` of an alternate plan: the concurrent game that
     ``--turn-model concurrent`` would play, on the state graph that plan would use.
@@ -861,6 +863,8 @@ def alternate_preview(
         The plan's CP-SAT schedule and its lower bound (its value is the same on either
         graph: :mod:`asp.graph.fixed_order`); not used when the concurrent graph's
         operations differ (other subassemblies), CP-SAT then runs again.
+    progress : bool
+        Say the search's progress (and a first run's compile of its kernels) on stderr.
 
     Returns
     -------
@@ -883,7 +887,7 @@ def alternate_preview(
         return {"why": str(exc).splitlines()[0]}
     if loose.spec.op_ids != graph.spec.op_ids:
         schedule = None
-    return concurrent_preview(loose.spec, loose, schedule=schedule)
+    return concurrent_preview(loose.spec, loose, schedule=schedule, progress=progress)
 
 
 def _too_large(what: str) -> str:
@@ -906,7 +910,9 @@ def search_limits(
     return Limits(**given)
 
 
-def concurrent_preview(spec: AssemblySpec, graph: StateGraph, *, schedule=None) -> dict:
+def concurrent_preview(
+    spec: AssemblySpec, graph: StateGraph, *, schedule=None, progress: bool = False
+) -> dict:
     """The concurrent game of ``spec`` on ``graph``, solved for the report when the graph
     is small (:func:`alternate_preview` gives it the graph the concurrent plan would use).
 
@@ -916,6 +922,8 @@ def concurrent_preview(spec: AssemblySpec, graph: StateGraph, *, schedule=None) 
     graph : asp.graph.state_graph.StateGraph
     schedule : (BaselineResult, float), optional
         The plan's CP-SAT schedule and its lower bound (spares solving it again).
+    progress : bool
+        Say the search's progress (and a first run's compile of its kernels) on stderr.
 
     Returns
     -------
@@ -933,7 +941,11 @@ def concurrent_preview(spec: AssemblySpec, graph: StateGraph, *, schedule=None) 
 
     try:
         preview = plan_concurrent(
-            spec, graph, limits=search_limits(None, PREVIEW_MAX_POSITIONS, None), schedule=schedule
+            spec,
+            graph,
+            limits=search_limits(None, PREVIEW_MAX_POSITIONS, None),
+            schedule=schedule,
+            progress=progress,
         )
     except (ValueError, MemoryError) as exc:
         return {"why": str(exc).splitlines()[0]}

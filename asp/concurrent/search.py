@@ -134,7 +134,9 @@ handed to the cell being the one certified at ``U``. ``W*(k)`` lies in ``[L(k), 
 
 from __future__ import annotations
 
+import functools
 import sys
+import threading
 import time
 from dataclasses import dataclass, field
 from typing import NamedTuple
@@ -1053,6 +1055,32 @@ def _policy_game(T, H, P, starts, kind, prefs, n_prefs, st, max_nodes):  # pragm
 # --------------------------------------------------------------------------- Python side
 
 
+COMPILE_NOTE_AFTER = 5.0
+"""Seconds the kernels may take to load from numba's cache before :data:`COMPILE_NOTE` is
+said (loading takes well under a second; compiling them, on the first run after an install
+or an update of the code, minutes of CPU)."""
+COMPILE_NOTE = (
+    "  compiling the concurrent search's kernels (the first run after an install or an "
+    "update: a few minutes of CPU, cached for the runs after it) ..."
+)
+
+
+def with_note(work, after: float, say) -> None:
+    """Run ``work()``; if it is still running ``after`` seconds on, ``say(COMPILE_NOTE)``
+    once (from a timer thread; the note never waits for ``work``)."""
+    timer = threading.Timer(after, say, (COMPILE_NOTE,))
+    timer.daemon = True
+    timer.start()
+    try:
+        work()
+    finally:
+        timer.cancel()
+
+
+def _say(line: str) -> None:
+    print(line, file=sys.stderr, flush=True)
+
+
 def _compile_kernels(rules: Rules, prefs: np.ndarray, n_prefs: np.ndarray) -> None:
     """Compile (or load from numba's cache) the search and policy-game kernels for these
     argument types, so that a time limit counts search, not compilation (the first run on
@@ -1128,7 +1156,12 @@ class Search:
         self.wall_stop: float | None = None  # the net that stopped a phase, when one did
         self.stats[NODE_LIMIT] = self._cap(self.budget)
         self.stats[PROGRESS] = int(progress)
-        _compile_kernels(rules, self.prefs, self.n_prefs)  # before the clock starts
+        # before the clock starts; a first run's compile is said when progress is shown
+        compile_kernels = functools.partial(_compile_kernels, rules, self.prefs, self.n_prefs)
+        if progress:
+            with_note(compile_kernels, COMPILE_NOTE_AFTER, _say)
+        else:
+            compile_kernels()
         self.t0 = time.perf_counter()
         self.stats[T0] = int(self.t0 * 1000)
         if limit is not None:
