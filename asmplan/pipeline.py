@@ -36,14 +36,14 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:  # pragma: no cover - types only
-    from asmplan.planfile import AlternateStates
     from asmplan.report.plot import DagFigure
     from asp.concurrent.plan import ConcurrentPlan
     from asp.concurrent.search import Limits
     from asp.game.dag import GameDAG
     from asp.game.plan import PlanStep
-    from asp.game.policy import PlayedPolicy
+    from asp.game.policy import PlayedPolicy, StateDescriber
     from asp.game.solve import Solution
+    from asp.graph.game_states import AlternateStates
     from asp.graph.state_graph import StateGraph
     from asp.schedule.cpsat import BaselineResult
     from asp.spec import AssemblySpec
@@ -158,7 +158,7 @@ class PlayedGame:
     ----------
     policy : asp.game.policy.PlayedPolicy
         The robust policy's table, named, with the game's sizes, TCT and W*.
-    describe : asmplan.planfile.AlternateStates
+    describe : asp.graph.game_states.AlternateStates
         Names the game's states (done operations and tools).
     figure : asmplan.report.plot.DagFigure
         The game DAG (or its layers) with the robust plan's path.
@@ -249,15 +249,9 @@ class AssemblyPlan:
     def _documents(self) -> tuple[dict[str, Any], dict[str, Any]]:
         from asmplan.planfile import split_timings
 
-        doc, timings = split_timings(self._document())
-        wall = None if self.concurrent is None else self.concurrent.curve.wall_stop
-        if wall is not None:  # the concurrent search's safety net stopped it: load-dependent
-            timings.setdefault("concurrent", {})["wall_stop"] = wall
-        return doc, timings
+        return split_timings(self._document())
 
     def _document(self) -> dict[str, Any]:
-        from asmplan.planfile import plan_document, played_document
-
         extra = {
             "relations": self.relations_summary,
             "states": self.graph.n_states,
@@ -291,10 +285,105 @@ class AssemblyPlan:
         from asp.concurrent.plan import plan_entries
 
         doc.update(plan_entries(self.concurrent))
+        wall = self.concurrent.curve.wall_stop
+        if wall is not None:  # the concurrent search's safety net stopped it: load-dependent
+            doc["concurrent"]["wall_stop"] = wall  # a timing (split off to timings.json)
         doc["schedule"].update(
             chain_bound=self.schedule.chain_bound, load_bound=self.schedule.load_bound
         )
         return doc
+
+
+# --------------------------------------------------------------------------- the plan document
+def plan_document(
+    *,
+    spec,
+    dag: GameDAG,
+    solution: Solution,
+    describe: StateDescriber | None = None,
+    extra: dict | None = None,
+    game=None,
+    relations=None,
+    interchangeable=(),
+) -> dict:
+    """The whole plan file of a solved game: policy, lines, metrics, operations and parts,
+    plus ``extra`` (written by :func:`asmplan.planfile.document`).
+
+    ``extra`` holds the keys computed elsewhere (relations, state graph sizes, ``schedule``);
+    they are kept as given. ``game``: the :class:`asp.concurrent.build.ConcurrentGame` whose
+    DAG ``dag`` is (turn model ``concurrent``; ``solution`` its exact solution, the policy
+    that of its start, the largest budget). ``relations``: the part relations (``cad``
+    ``Relations``, None without geometry): each line step's ``insertions`` then name the
+    direction each body goes in along, and ``geometry`` the unit, scale and tolerances.
+    ``interchangeable``: the classes of interchangeable blocks of operations the state
+    graph's reduction used (``graph.model.interchangeable``, :mod:`asp.graph.symmetry`).
+    """
+    from asmplan.planfile import concurrent_policy_object
+    from asp.concurrent.describe import policy_names
+    from asp.game.dag import ROBOT
+    from asp.game.policy import played_policy, policy_table
+
+    if game is None:
+        played = played_policy(dag, solution, describe)
+        return played_document(
+            spec,
+            played,
+            describe,
+            extra=extra,
+            relations=relations,
+            interchangeable=interchangeable,
+        )
+    table = policy_table(dag, solution)
+    policy = concurrent_policy_object(policy_names(game, table), table)
+    sizes = (dag.cost_model, dag.n_nodes, dag.n_edges)
+    values = (solution.tct, solution.minimax, float(solution.expected[dag.start, ROBOT]))
+    return _plan_document(spec, policy, sizes, values, extra, relations, interchangeable)
+
+
+def played_document(
+    spec,
+    played: PlayedPolicy,
+    describe: StateDescriber | None = None,
+    *,
+    extra: dict | None = None,
+    relations=None,
+    interchangeable=(),
+) -> dict:
+    """The whole plan file of a solved ``alternate`` game from its
+    :class:`asp.game.policy.PlayedPolicy` (the game itself no longer needed; arguments as
+    :func:`plan_document`'s)."""
+    from asmplan.planfile import played_policy_object
+
+    policy = played_policy_object(played, describe)
+    sizes = (played.cost_model, played.n_nodes, played.n_edges)
+    values = (played.tct, played.minimax, played.avg_random)
+    return _plan_document(spec, policy, sizes, values, extra, relations, interchangeable)
+
+
+def _plan_document(spec, policy, sizes, values, extra, relations, interchangeable) -> dict:
+    """The plan file around its ``policy``: each line replayed by the relation checker
+    (:func:`asp.graph.checker.line_directions`), then :func:`asmplan.planfile.document`."""
+    from asmplan import planfile
+    from asp.graph.checker import line_directions
+
+    operations = planfile.operation_records(spec)
+    lines = planfile.policy_lines(policy, operations)
+    checks = {
+        name: line_directions(spec, relations, planfile.line_operations(steps))
+        for name, steps in lines.items()
+    }
+    return planfile.document(
+        spec,
+        policy,
+        sizes,
+        values,
+        operations,
+        lines,
+        checks,
+        extra=extra,
+        relations=relations,
+        interchangeable=interchangeable,
+    )
 
 
 # --------------------------------------------------------------------------- steps
@@ -606,10 +695,10 @@ def solve_game(dag: GameDAG) -> Solution:
 
 def played_game(graph: StateGraph, game: Game, solution: Solution) -> PlayedGame:
     """What the outputs of a plan take from its solved game (:class:`PlayedGame`)."""
-    from asmplan.planfile import alternate_states
     from asmplan.report.plot import dag_figure
     from asp.game.policy import played_policy
     from asp.game.solve import play
+    from asp.graph.game_states import alternate_states
 
     dag = game.dag
     every_state = alternate_states(graph, dag)
@@ -968,12 +1057,12 @@ def build_plan(
     service that plans on start.
 
     Turn model ``alternate``: the relations, state graph, game and exact solution, then
-    :func:`asmplan.planfile.plan_document`, without the CP-SAT schedule. ``concurrent``
+    :func:`plan_document`, without the CP-SAT schedule. ``concurrent``
     (``turn_model``, default the spec's): :func:`plan`, the curve ``W*(k)`` and the CP-SAT
     comparison included.
     """
-    from asmplan.planfile import alternate_states, plan_document
     from asp.game.turns import CONCURRENT
+    from asp.graph.game_states import alternate_states
 
     loaded = load(assembly)
     if (turn_model or loaded.spec.turn_model) == CONCURRENT.name:

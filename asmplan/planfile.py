@@ -32,23 +32,20 @@ import os
 import time
 from importlib import resources
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from asp.atomic import write_text
 from asp.errors import FormatError
-from asp.game import rules
-from asp.game.dag import ROBOT, GameDAG
+from asp.game.dag import ROBOT
 from asp.game.metrics import adversarial_tax
-from asp.game.policy import (
-    PlayedPolicy,
-    PolicyTable,
-    StateDescriber,
-    played_policy,
-    policy_table,
-)
-from asp.game.solve import Solution
+from asp.game.policy import PlayedPolicy, PolicyTable, StateDescriber
 from asp.game.turns import CONCURRENT, turn_of
+from asp.graph.game_states import AlternateStates
+
+if TYPE_CHECKING:  # pragma: no cover - types only
+    from asp.concurrent.describe import PolicyNames
 
 FORMAT = "asmplan-plan/2"
 MAIN = "main"
@@ -57,110 +54,7 @@ SCHEMA_FILE = "plan-2.schema.json"
 TURN_NAMES = ("robot", "human")
 
 
-# --------------------------------------------------------------------------- state names
-
-
-def alternate_states(graph, dag: GameDAG) -> AlternateStates:
-    """The structured state of each node of ``game_dag(graph)`` (turn model ``alternate``).
-
-    Node ``i < n - 1`` is the ``i``-th state that can still be completed and is not
-    complete (the numbering of :func:`asp.graph.game_dag.game_dag`); the last node is the complete
-    assembly. No operation runs between turns, so ``running`` is always empty.
-    """
-    alive = graph.coreachable()
-    complete = graph.complete
-    ends = np.flatnonzero(alive & complete)
-    alive &= ~complete  # the inner states
-    del complete
-    n_inner = int(np.count_nonzero(alive))
-    if n_inner + 1 != dag.n_nodes:
-        raise ValueError(
-            f"state names: the game has {dag.n_nodes} nodes, the state graph "
-            f"{n_inner + 1} (was the game built from this graph?)"
-        )
-    # Complete states come after every inner one (they are the last layer): the inner
-    # states and the first complete one, in order, without a second copy of the array.
-    alive[ends[:1]] = True
-    state_of = np.flatnonzero(alive)
-    if ends.size and state_of[-1] != ends[0]:  # pragma: no cover - another layout
-        alive[ends[:1]] = False
-        state_of = np.append(np.flatnonzero(alive), ends[:1])
-    return AlternateStates(graph, state_of)
-
-
-class AlternateStates:
-    """A :data:`StateDescriber` of the nodes of an ``alternate`` game of a state graph, that
-    also names the done operations of many nodes at once (:meth:`done_matrix`).
-
-    Attributes
-    ----------
-    graph : asp.graph.state_graph.StateGraph
-    state_of : (n,) int64
-        The state graph state of each game node (of each of ``nodes``, when given).
-    nodes : (k,) int64 or None
-        The game nodes named, sorted (:meth:`only`); None: every node.
-    """
-
-    def __init__(self, graph, state_of: np.ndarray, nodes: np.ndarray | None = None):
-        self.graph = graph
-        self.state_of = state_of
-        self.nodes = nodes
-
-    def states(self, nodes) -> np.ndarray:
-        """The state graph states of the game nodes ``nodes`` (an int or an index array)."""
-        if self.nodes is None:
-            return self.state_of[nodes]
-        at = np.searchsorted(self.nodes, nodes)
-        if not np.all(self.nodes[np.minimum(at, self.nodes.size - 1)] == nodes):
-            raise KeyError(f"state names: game node(s) {nodes} not among those kept")
-        return self.state_of[at]
-
-    def only(self, nodes: np.ndarray) -> AlternateStates:
-        """The same names for the game nodes ``nodes`` alone: a table of their size, not
-        the game's."""
-        nodes = np.unique(np.asarray(nodes, dtype=np.int64))
-        return AlternateStates(self.graph, self.states(nodes), nodes)
-
-    def __call__(self, v: int) -> dict:
-        model = self.graph.model
-        key = self.graph.keys[int(self.states(v))]
-        return {"done": model.done_ops(key), "tools": model.tool_state(key), "running": []}
-
-    @property
-    def op_ids(self) -> tuple[str, ...]:
-        """The operation ids, in the order of :meth:`done_matrix`'s columns."""
-        return self.graph.spec.op_ids
-
-    @property
-    def has_tools(self) -> bool:
-        return bool(self.graph.model.tool_names)
-
-    def done_matrix(self, nodes: np.ndarray) -> np.ndarray:
-        """(k, n_ops) bool: the operations done at each of the game nodes ``nodes``."""
-        return self.graph.model.done_matrix(self.graph.keys[self.states(nodes)])
-
-
 # --------------------------------------------------------------------------- policy table
-
-
-def policy_document(
-    dag: GameDAG,
-    solution: Solution,
-    describe: StateDescriber | None,
-    table: PolicyTable,
-    *,
-    game=None,
-) -> dict:
-    """The ``policy`` object of the plan file (columnar, see the module docstring).
-
-    ``game``: the :class:`asp.concurrent.build.ConcurrentGame` whose DAG ``dag`` is (turn model
-    ``concurrent``); its states and moves are named by :mod:`asp.concurrent`
-    (``state_description``, ``commit_description``, ``move_starts``) and ``describe`` is
-    not used.
-    """
-    if game is not None:
-        return _concurrent_policy(game, solution, table)
-    return played_policy_object(played_policy(dag, solution, describe), describe)
 
 
 def played_policy_object(played: PlayedPolicy, describe: StateDescriber | None) -> dict:
@@ -267,8 +161,10 @@ def _done_masks(describe: AlternateStates, nodes: np.ndarray, op_index: dict) ->
     return [texts[k] for k in inverse.ravel().tolist()]
 
 
-def _concurrent_policy(game, solution: Solution, table: PolicyTable) -> dict:
-    """The policy of the concurrent game (turn model ``concurrent``, module docstring).
+def concurrent_policy_object(names: PolicyNames, table: PolicyTable) -> dict:
+    """The ``policy`` object of the concurrent game (turn model ``concurrent``, module
+    docstring) from its table and the names :func:`asp.concurrent.describe.policy_names`
+    gave it.
 
     A robot state's one move is the robot side's commitment (``robots``: the operations the
     robots start; ``instruction``: what each free person is told); a human state's moves are
@@ -276,29 +172,16 @@ def _concurrent_policy(game, solution: Solution, table: PolicyTable) -> dict:
     the durations they take; ``moves.deviations``), each followed by the wait for the next
     completion (``moves.cost``, the time until it).
     """
-    from asp.concurrent.describe import commit_description, move_starts, state_description
-
-    dag = game.dag
-    op_names = list(game.model.spec.op_ids)
+    op_names = list(names.operations)
     op_index = {op: k for k, op in enumerate(op_names)}
-    agent_names = [w.name for w in game.model.workers]
+    agent_names = list(names.agents)
     agent_index = {a: k for k, a in enumerate(agent_names)}
-    described: dict[int, dict] = {}
-
-    def describe(v: int) -> dict:
-        if v not in described:
-            described[v] = state_description(game, v)
-        return described[v]
+    describe = names.states.__getitem__
 
     states = _state_columns(table, describe, op_index, agent_index)
     edges = table.edge.tolist()
     starts_col, deviations = [], []
-    for e in edges:
-        if e < 0:
-            starts_col.append([])
-            deviations.append(0)
-            continue
-        starts, dev = move_starts(game, e)
+    for starts, dev in names.starts:
         starts_col.append([[op_index[o], agent_index[a], _number(d)] for o, a, d in starts])
         deviations.append(dev)
 
@@ -314,21 +197,21 @@ def _concurrent_policy(game, solution: Solution, table: PolicyTable) -> dict:
         budget.append(state.get("budget"))
         if t == ROBOT and hi > lo and edges[lo] >= 0:
             robots.append([s[:2] for s in starts_col[lo]])
-            instruction.append(told(commit_description(game, edges[lo])["instruct"]))
+            instruction.append(told(names.commits[edges[lo]]))
         else:
             robots.append([])
             instruction.append(told(state.get("instructions", {})))
     states.update(robots=robots, instruction=instruction, budget=budget)
     return {
         **_policy_head(
-            CONCURRENT.name, dag.cost_model, table, op_names, agent_names, states.pop("_tools")
+            CONCURRENT.name, names.cost_model, table, op_names, agent_names, states.pop("_tools")
         ),
         "states": {"node": table.node.tolist(), **states},
         "moves": {
             "ptr": table.ptr.tolist(),
             "starts": starts_col,
             "deviations": deviations,
-            "cost": _numbers(rules.move_costs(dag, np.maximum(table.edge, 0)) * (table.edge >= 0)),
+            "cost": _numbers(names.cost),
             "next": table.next.tolist(),
         },
     }
@@ -490,78 +373,56 @@ def _instruction_move(policy: dict, i: int) -> int:
 # --------------------------------------------------------------------------- the document
 
 
-def plan_document(
-    *,
+def policy_lines(policy: dict, operations: dict[str, dict]) -> dict[str, list[dict]]:
+    """The plan file's two lines of a ``policy`` object: ``robust_plan`` (both sides follow
+    the plan) and ``worst_line`` (the robust robot against a delaying human), as
+    :func:`line_steps` gives them (without their ``insertions`` yet)."""
+    return {
+        "robust_plan": line_steps(policy, "plan", operations),
+        "worst_line": line_steps(policy, "worst", operations),
+    }
+
+
+def line_operations(steps: list[dict]) -> list[str]:
+    """The operations a line starts, in order."""
+    return [s["operation"] for step in steps for s in step["starts"]]
+
+
+def document(
     spec,
-    dag: GameDAG,
-    solution: Solution,
-    describe: StateDescriber | None = None,
-    extra: dict | None = None,
-    game=None,
-    relations=None,
-    interchangeable=(),
-) -> dict:
-    """The whole plan file: policy, lines, metrics, operations and parts, plus ``extra``.
-
-    ``extra`` holds the keys computed elsewhere (relations, state graph sizes, ``schedule``);
-    they are kept as given. ``game``: the :class:`asp.concurrent.build.ConcurrentGame` whose DAG
-    ``dag`` is (turn model ``concurrent``; ``solution`` its exact solution, the policy that
-    of its start, the largest budget). ``relations``: the part relations (``cad``
-    ``Relations``, None without geometry): each line step's ``insertions`` then name the
-    direction each body goes in along, and ``geometry`` the unit, scale and tolerances.
-    ``interchangeable``: the classes of interchangeable blocks of operations the state
-    graph's reduction used (``graph.model.interchangeable``, :mod:`asp.graph.symmetry`), written
-    as the plan's ``interchangeable`` for the runtime advisor.
-    """
-    if game is None:
-        played = played_policy(dag, solution, describe)
-        return played_document(
-            spec,
-            played,
-            describe,
-            extra=extra,
-            relations=relations,
-            interchangeable=interchangeable,
-        )
-    policy = _concurrent_policy(game, solution, policy_table(dag, solution))
-    sizes = (dag.cost_model, dag.n_nodes, dag.n_edges)
-    values = (solution.tct, solution.minimax, float(solution.expected[dag.start, ROBOT]))
-    return _document(spec, policy, sizes, values, extra, relations, interchangeable)
-
-
-def played_document(
-    spec,
-    played: PlayedPolicy,
-    describe: StateDescriber | None = None,
+    policy: dict,
+    sizes: tuple,
+    values: tuple,
+    operations: dict[str, dict],
+    lines: dict[str, list[dict]],
+    checks: dict[str, tuple[dict, str | None]],
     *,
     extra: dict | None = None,
     relations=None,
     interchangeable=(),
 ) -> dict:
-    """The whole plan file of a solved ``alternate`` game from its :class:`PlayedPolicy`
-    (the game itself no longer needed; arguments as :func:`plan_document`'s)."""
-    policy = played_policy_object(played, describe)
-    sizes = (played.cost_model, played.n_nodes, played.n_edges)
-    values = (played.tct, played.minimax, played.avg_random)
-    return _document(spec, policy, sizes, values, extra, relations, interchangeable)
-
-
-def _document(
-    spec, policy: dict, sizes: tuple, values: tuple, extra, relations, interchangeable=()
-) -> dict:
-    """The plan file around its ``policy``: lines, metrics, operations, parts, ``extra``.
+    """The whole plan file around its ``policy``: lines, metrics, operations, parts, ``extra``.
 
     ``sizes``: the game's cost model, node and edge counts; ``values``: TCT, W* and the
-    expected cost against a random person, from the start."""
+    expected cost against a random person, from the start. ``operations``: the
+    :func:`operation_records` of ``spec``; ``lines``: the :func:`policy_lines` of ``policy``;
+    ``checks``: each line's :func:`asp.graph.checker.line_directions` (its steps then get
+    their ``insertions``, :func:`add_insertions`; its error is the line's ``line_check``).
+    ``extra`` holds the keys computed elsewhere (relations, state graph sizes,
+    ``schedule``); they are kept as given. ``relations``: the part relations (``cad``
+    ``Relations``, None without geometry): ``geometry`` then names the unit, scale and
+    tolerances. ``interchangeable``: the classes of interchangeable blocks of operations the
+    state graph's reduction used (``graph.model.interchangeable``,
+    :mod:`asp.graph.symmetry`), written as the plan's ``interchangeable`` for the runtime
+    advisor.
+    """
     cost_model, n_nodes, n_edges = sizes
     tct, minimax, avg_random = values
-    operations = operation_records(spec)
-    principal = line_steps(policy, "plan", operations)
-    worst = line_steps(policy, "worst", operations)
-    line_check = {
-        "robust_plan": add_insertions(principal, spec, relations, operations),
-        "worst_line": add_insertions(worst, spec, relations, operations),
-    }
+    principal, worst = lines["robust_plan"], lines["worst_line"]
+    line_check = {}
+    for name, steps in lines.items():
+        checked, line_check[name] = checks[name]
+        add_insertions(steps, spec, checked, operations)
     w0 = principal[-1]["elapsed"] if principal else 0.0
     doc = {
         "format": FORMAT,
@@ -647,7 +508,7 @@ def operation_records(spec) -> dict[str, dict]:
     return out
 
 
-def add_insertions(steps: list[dict], spec, relations, operations: dict) -> str | None:
+def add_insertions(steps: list[dict], spec, checked: dict, operations: dict) -> None:
     """Give each step ``insertions``: the bodies it puts in, in order, each with its way in.
 
     An insertion is ``{operation, parts, workspace, unit, held, free_along, insert_along,
@@ -656,20 +517,10 @@ def add_insertions(steps: list[dict], spec, relations, operations: dict) -> str 
     from everything already in the workspace (the body can leave along ``d``),
     ``insert_along`` is ``-d``: the body moves along it to go in; ``insert_vector_file`` is
     that direction as a unit vector in the file's coordinates. They are null for the first
-    body of a workspace and without geometry. The line is replayed by
-    :func:`asp.graph.checker.check_line`; returns None when it accepts the line, else its error
-    (the insertions then carry no directions).
+    body of a workspace and without geometry. ``checked``: the bodies and directions of the
+    line replayed by :func:`asp.graph.checker.line_directions` (empty when the checker
+    refused the line: the insertions then carry no directions).
     """
-    from asp.graph.checker import check_line
-
-    ops = [s["operation"] for step in steps for s in step["starts"]]
-    error = None
-    checked: dict[str, list] = {}
-    try:
-        for c in check_line(spec, relations, ops):
-            checked.setdefault(c.operation, []).append((list(c.parts), c.direction or None))
-    except (ValueError, KeyError) as exc:
-        error, checked = str(exc).strip("'\""), {}
     for step in steps:
         step["insertions"] = []
         for start in step["starts"]:
@@ -692,7 +543,6 @@ def add_insertions(steps: list[dict], spec, relations, operations: dict) -> str 
                         "insert_vector_file": file_vector(spec, _opposite(free)) if free else None,
                     }
                 )
-    return error
 
 
 def _opposite(direction: str) -> str:
@@ -928,12 +778,12 @@ def check_plan(doc: dict, where: str = "plan") -> None:
 TIMINGS_FORMAT = "asmplan-timings/1"
 TIMING_KEYS = {
     "schedule": ("wall_s", "stage_s", "improvements", "wall_stop"),
-    "concurrent": ("seconds",),
+    "concurrent": ("seconds", "wall_stop"),
 }
 """The keys of a plan document's objects that measure time (``improvements``: ``[seconds,
 makespan]`` of each better CP-SAT schedule; ``wall_stop``: the wall-clock seconds at which
-the CP-SAT stage's safety net stopped it, only when it did, :mod:`asp.schedule.cpsat`); they
-go to ``timings.json``, not ``plan.json``."""
+the CP-SAT stage's safety net, or the concurrent search's, stopped it, only when it did,
+:mod:`asp.schedule.cpsat`); they go to ``timings.json``, not ``plan.json``."""
 
 
 def split_timings(doc: dict) -> tuple[dict, dict]:

@@ -14,9 +14,11 @@ import tempfile
 import time
 from pathlib import Path
 
-from asmplan.planfile import alternate_states, plan_document, read_plan, write_plan
+from asmplan.pipeline import plan_document
+from asmplan.planfile import read_plan, write_plan
 from asp.game.solve import solve
 from asp.graph.game_dag import game_dag
+from asp.graph.game_states import alternate_states
 from asp.graph.state_graph import build_state_graph
 
 REPO = Path(__file__).resolve().parents[1]

@@ -116,7 +116,7 @@ def _fixed_solution(dag, solution, policy: np.ndarray):
 
 
 def _alternate_plan(result, condition: Condition) -> dict:
-    from asmplan.planfile import alternate_states
+    from asp.graph.game_states import alternate_states
 
     dag, solution = result.game.dag, result.solution
     describe = alternate_states(result.graph, dag)

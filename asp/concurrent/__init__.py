@@ -47,7 +47,14 @@ __all__, __getattr__ = lazy_exports(
     __name__,
     {
         "build": ("build_game",),
-        "describe": ("Bar", "commit_description", "move_starts", "state_description"),
+        "describe": (
+            "Bar",
+            "PolicyNames",
+            "commit_description",
+            "move_starts",
+            "policy_names",
+            "state_description",
+        ),
         "model": ("WAIT", "concurrent_model"),
         "plan": (
             "ConcurrentPlan",

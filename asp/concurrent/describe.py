@@ -10,6 +10,7 @@ import numpy as np
 
 from asp.concurrent.build import Commit, ConcurrentGame
 from asp.concurrent.model import UNBOUNDED, WAIT
+from asp.game import rules
 from asp.game.dag import ROBOT
 from asp.game.solve import evaluate_policy
 from asp.numbers import json_number
@@ -112,6 +113,63 @@ def move_starts(game: ConcurrentGame, e: int) -> tuple[list[tuple[str, str, floa
         if o is not None and o != WAIT
     ]
     return starts, int(action.deviations)
+
+
+@dataclass(frozen=True, eq=False)
+class PolicyNames:
+    """A concurrent game's robust policy table named: what the plan file writes of it.
+
+    Attributes
+    ----------
+    operations, agents : tuple of str
+        The operation ids and worker names.
+    cost_model : str
+        The game's cost model.
+    states : dict of int to dict
+        Each game node of the table -> :func:`state_description`.
+    starts : list of (list of (op id, worker name, duration), int)
+        Each move of the table -> :func:`move_starts` (``([], 0)`` for a pass).
+    commits : dict of int to dict
+        Each robot state's planned edge -> its ``instruct`` (:func:`commit_description`).
+    cost : (n_moves,) float64
+        Each move's cost (0 for a pass).
+    """
+
+    operations: tuple[str, ...]
+    agents: tuple[str, ...]
+    cost_model: str
+    states: dict
+    starts: list
+    commits: dict
+    cost: np.ndarray
+
+
+def policy_names(game: ConcurrentGame, table) -> PolicyNames:
+    """The states, moves and commitments of a policy table (:class:`asp.game.policy.PolicyTable`)
+    of ``game``, named once (:class:`PolicyNames`)."""
+    dag = game.dag
+    states: dict[int, dict] = {}
+    for v in table.node.tolist():
+        if v not in states:
+            states[v] = state_description(game, v)
+    edges = table.edge.tolist()
+    starts = [([], 0) if e < 0 else move_starts(game, e) for e in edges]
+    commits: dict[int, dict] = {}
+    ptr = table.ptr.tolist()
+    for i, t in enumerate(table.turn.tolist()):
+        lo, hi = ptr[i], ptr[i + 1]
+        if t == ROBOT and hi > lo and edges[lo] >= 0 and edges[lo] not in commits:
+            commits[edges[lo]] = commit_description(game, edges[lo])["instruct"]
+    cost = rules.move_costs(dag, np.maximum(table.edge, 0)) * (table.edge >= 0)
+    return PolicyNames(
+        operations=tuple(game.model.spec.op_ids),
+        agents=tuple(w.name for w in game.model.workers),
+        cost_model=dag.cost_model,
+        states=states,
+        starts=starts,
+        commits=commits,
+        cost=cost,
+    )
 
 
 @dataclass(frozen=True)

@@ -167,7 +167,7 @@ class PlayedPolicy:
 
     Its size is the policy's (the states the robust robot reaches against any human), not
     the game's: once it is made (:func:`played_policy`), the game DAG and its solution can be
-    let go, and :func:`asmplan.planfile.played_document` writes the plan file from it.
+    let go, and :func:`asmplan.pipeline.played_document` writes the plan file from it.
 
     Attributes
     ----------

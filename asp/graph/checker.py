@@ -165,3 +165,18 @@ def _check_body(spec, relations, body, assembled, held, where, unit="", gravity=
 def plan_operations(plan: Mapping) -> list[str]:
     """The operations of a ``plan.json`` object's principal line (``robust_plan``), in order."""
     return [str(s["operation"]) for s in plan["robust_plan"] if s.get("operation")]
+
+
+def line_directions(
+    spec, relations, operations: Iterable[str]
+) -> tuple[dict[str, list[tuple[list[str], str | None]]], str | None]:
+    """The bodies each operation of a line puts in, in order, with the direction each leaves
+    along (None for the first body of a workspace), and None; or ``({}, error)`` when
+    :func:`check_line` refuses the line (its message, without quotes)."""
+    checked: dict[str, list[tuple[list[str], str | None]]] = {}
+    try:
+        for c in check_line(spec, relations, operations):
+            checked.setdefault(c.operation, []).append((list(c.parts), c.direction or None))
+    except (ValueError, KeyError) as exc:
+        return {}, str(exc).strip("'\"")
+    return checked, None

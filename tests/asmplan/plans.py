@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-from asmplan.planfile import alternate_states, plan_document
+from asmplan.pipeline import plan_document
 from asp.game.solve import solve
 from asp.graph.game_dag import game_dag
+from asp.graph.game_states import alternate_states
 from asp.graph.state_graph import build_state_graph
 from asp.spec import spec_from_dict
 from tests.asp.helpers_assembly import CELL

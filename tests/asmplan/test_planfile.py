@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 
-import numpy as np
 import pytest
 
 from asmplan.pipeline import build_plan
@@ -158,22 +157,3 @@ def test_concurrent_policy_is_the_games_robust_policy(data):
     assert curve.bounds[0] - 1e-9 <= doc["metrics"]["w0"] <= doc["minimax"] + 1e-9
     ops = [s["operation"] for line in (doc["robust_plan"],) for st in line for s in st["starts"]]
     assert sorted(ops) == sorted(doc["operations"])
-
-
-def test_state_names_kept_for_some_nodes_are_those_of_every_node():
-    """``AlternateStates.only``: the plan's states keep their names (and no other's)."""
-    from asmplan import pipeline
-    from asmplan.planfile import alternate_states
-    from tests.conftest import REPO
-
-    graph = pipeline.state_graph(pipeline.load(REPO / "examples" / "vacuum_pump"))
-    dag = pipeline.game(graph)
-    every = alternate_states(graph, dag)
-    nodes = np.array([dag.end, 0, 3, 3])
-    some = every.only(nodes)
-    assert some.state_of.size == 3
-    for v in nodes.tolist():
-        assert some(v) == every(v)
-    assert np.array_equal(some.done_matrix(nodes), every.done_matrix(nodes))
-    with pytest.raises(KeyError, match="not among"):
-        some(1)

@@ -274,9 +274,10 @@ def test_sessions_that_no_longer_replay_are_set_aside(tmp_path):
 
 def _replanned() -> dict:
     """The cell planned again after an edit: operation a is now the person's only."""
-    from asmplan.planfile import alternate_states, plan_document
+    from asmplan.pipeline import plan_document
     from asp.game.solve import solve
     from asp.graph.game_dag import game_dag
+    from asp.graph.game_states import alternate_states
     from asp.graph.state_graph import build_state_graph
     from asp.spec import spec_from_dict
 

@@ -13,12 +13,13 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from asmplan.planfile import alternate_states, plan_document
+from asmplan.pipeline import plan_document
 from asp.game import rules
 from asp.game.dag import ANY, HUMAN, ROBOT, GameDAG, compact_costs, from_arrays, ids_topological
 from asp.game.solve import evaluate_policy, node_order, solve
 from asp.graph.feasibility import load_relations
 from asp.graph.game_dag import game_dag
+from asp.graph.game_states import alternate_states
 from asp.graph.state_graph import build_state_graph
 from asp.spec import load_spec
 from tests.asp.random_games import random_game
