@@ -381,9 +381,123 @@ def _plan_document(spec, policy, sizes, values, extra, relations, interchangeabl
         lines,
         checks,
         extra=extra,
-        relations=relations,
+        geometry=geometry_record(spec, relations),
+        part_sources={p.file: part_source(spec, p.file) for p in spec.parts if p.file},
         interchangeable=interchangeable,
     )
+
+
+def geometry_record(spec, relations) -> dict | None:
+    """``plan.json``'s ``geometry``: the length unit, scale, frame, tolerances and mesh
+    rules of the geometry (None without it): what a checker replaying a line from the
+    meshes alone needs (the part files are read for their scale, :func:`file_scale`).
+
+    Coordinates: the source file's own frame (its node transforms applied, no axis
+    changed) times ``scale`` (millimetres per coordinate as trimesh reads the files, a
+    file's millimetre numbers under a wrong unit label included; null when the files
+    differ, each part's ``source.scale`` then says), turned by ``build_rotation`` into the
+    build frame (below); tolerances are in millimetres; a
+    pair ``(i, j)`` tolerates an overlap of ``part_shrink[i] + part_shrink[j]``
+    (:mod:`cad.tolerances`), and counts a gap of ``min(contact_reach[i],
+    contact_reach[j])`` as touching (``contact_tol`` for every pair when ``contact_reach``
+    is null). ``step_chord``: a STEP source is tessellated to within this many mm of its
+    surfaces (:data:`cad.scene.STEP_CHORD_MM`, OCCT's ``tol_linear``), so a checker reads
+    the same meshes. ``merge_vertices``: each mesh's coincident
+    vertices are merged before anything (a STEP or 3DXML tessellation gives every face its
+    own vertices; eroding such a mesh leaves its edges where they were). ``erosion``: how a
+    part is shrunk. ``fits``: pairs whose inner part is shrunk further for that pair only
+    (:mod:`cad.fits`). ``support_travel_factor``: a part is supported if a fall of that
+    many times the pair's tolerance meets a part below; ``support``: the rules a part is
+    supported by (:data:`cad.support.SUPPORT_RULES`). ``open_parts``: parts not closed after
+    merging (their relations are approximate: a closed part has an inside, a part lying
+    wholly in it collides with it; an open one has none).
+    ``frame``: ``"file"`` (the file's own axes) or ``"build"`` (the parts turned as the
+    product is fixtured, :mod:`cad.frame`); ``build_rotation``: the 3x3 rotation ``R``, row
+    by row, taking file coordinates (times ``scale``) to build coordinates, ``x_build = R @
+    x_file`` (the identity for ``"file"``). Directions, gravity and every tolerance are in
+    the build frame.
+    """
+    if relations is None:
+        return None
+    from asmplan.planfile import build_rotation
+    from cad.relations import replay_rules
+    from cad.scene import STEP_CHORD_MM
+    from cad.units import unit_scale
+
+    file_unit = str(getattr(relations, "units", "mm"))
+    shrink = tuple(getattr(relations, "part_shrink", ()))
+    if len(shrink) != len(relations.parts):
+        shrink = (float(relations.penetration_tol) / 2,) * len(relations.parts)
+    scales = {file_scale(spec, p.file) for p in spec.parts if p.file}
+    if len(scales) == 1 and None not in scales:
+        scale = scales.pop()  # millimetre numbers under a wrong unit label included
+    else:
+        try:
+            scale = unit_scale(file_unit)
+        except ValueError:
+            scale = None  # "mixed": the files declare different units
+    return {
+        "unit": "mm",
+        "file_unit": file_unit,
+        "scale": scale,
+        "step_chord": STEP_CHORD_MM,
+        "frame": "file" if spec.frame is None else "build",
+        "build_rotation": [list(row) for row in build_rotation(spec)],
+        "contact_tol": float(relations.contact_tol),
+        "penetration_tol": float(relations.penetration_tol),
+        "part_shrink": dict(zip(map(str, relations.parts), map(float, shrink), strict=True)),
+        **replay_rules(relations),
+    }
+
+
+def part_source(spec, file: str | None) -> dict | None:
+    """Where a part's mesh is: ``file`` (relative to :func:`source_folder`),
+    ``node`` (the part's scene-graph node, as trimesh names it, in a scene file; else
+    null), ``path`` (absolute, when it exists), ``scale`` (millimetres per coordinate as
+    trimesh reads the file, :func:`file_scale`)."""
+    from asmplan.planfile import source_folder, split_file
+
+    if not file:
+        return None
+    name, node = split_file(file)
+    folder = source_folder(spec.source)
+    path = (folder / name).resolve()
+    if node is not None and path.is_file():
+        node = _scene_node(path, node)
+    return {
+        "file": name,
+        "node": node,
+        "path": str(path) if path.is_file() else None,
+        "scale": file_scale(spec, file),
+    }
+
+
+def file_scale(spec, file: str) -> float | None:
+    """Millimetres per coordinate of a part's file as trimesh reads it (its declared unit,
+    else the spec's; millimetre numbers under a wrong label read as mm); None when the
+    file cannot be read."""
+    from asmplan.planfile import source_folder, split_file
+    from cad.scene import coordinate_scale
+
+    path = (source_folder(spec.source) / split_file(file)[0]).resolve()
+    if not path.is_file():
+        return None
+    try:
+        return coordinate_scale(path, spec.units)
+    except (OSError, ValueError):
+        return None
+
+
+def _scene_node(path: Path, part: str) -> str:
+    """The scene-graph node (as trimesh names it) of the part ``part`` of a scene file."""
+    from cad.scene import read_scene
+
+    try:
+        scene = read_scene(path)
+    except (OSError, ValueError):
+        return part
+    k = scene.find(part)
+    return scene.nodes[k] if k is not None and k < len(scene.nodes) else part
 
 
 # --------------------------------------------------------------------------- steps

@@ -398,7 +398,8 @@ def document(
     checks: dict[str, tuple[dict, str | None]],
     *,
     extra: dict | None = None,
-    relations=None,
+    geometry: dict | None = None,
+    part_sources: dict | None = None,
     interchangeable=(),
 ) -> dict:
     """The whole plan file around its ``policy``: lines, metrics, operations, parts, ``extra``.
@@ -409,9 +410,11 @@ def document(
     ``checks``: each line's :func:`asp.graph.checker.line_directions` (its steps then get
     their ``insertions``, :func:`add_insertions`; its error is the line's ``line_check``).
     ``extra`` holds the keys computed elsewhere (relations, state graph sizes,
-    ``schedule``); they are kept as given. ``relations``: the part relations (``cad``
-    ``Relations``, None without geometry): ``geometry`` then names the unit, scale and
-    tolerances. ``interchangeable``: the classes of interchangeable blocks of operations the
+    ``schedule``); they are kept as given. ``geometry``: the unit, scale, frame and
+    tolerances of the part meshes (:func:`asmplan.pipeline.geometry_record`, None without
+    geometry); ``part_sources``: each part file's ``source`` record
+    (:func:`asmplan.pipeline.part_source`), by the file as the spec names it.
+    ``interchangeable``: the classes of interchangeable blocks of operations the
     state graph's reduction used (``graph.model.interchangeable``,
     :mod:`asp.graph.symmetry`), written as the plan's ``interchangeable`` for the runtime
     advisor.
@@ -447,7 +450,7 @@ def document(
         "agents": {a.name: a.side for a in spec.agents},
         "gravity": spec.gravity,
         "base_part": spec.base_part,
-        "geometry": geometry_record(spec, relations),
+        "geometry": geometry,
         "sources": list(dict.fromkeys(split_file(p.file)[0] for p in spec.parts if p.file)),
         "parts": [
             {
@@ -455,7 +458,7 @@ def document(
                 "name": p.name,
                 "file": p.file,
                 "quantity": p.quantity,
-                "source": part_source(spec, p.file),
+                "source": (part_sources or {}).get(p.file) if p.file else None,
             }
             for p in spec.parts
         ],
@@ -564,67 +567,6 @@ def file_vector(spec, direction: str) -> list[float]:
     return [round(sign * x, 9) + 0.0 for x in build_rotation(spec)[k]]
 
 
-def geometry_record(spec, relations) -> dict | None:
-    """The length unit, scale, frame, tolerances and mesh rules of the geometry (None
-    without it): what a checker replaying a line from the meshes alone needs.
-
-    Coordinates: the source file's own frame (its node transforms applied, no axis
-    changed) times ``scale`` (millimetres per coordinate as trimesh reads the files, a
-    file's millimetre numbers under a wrong unit label included; null when the files
-    differ, each part's ``source.scale`` then says), turned by ``build_rotation`` into the
-    build frame (below); tolerances are in millimetres; a
-    pair ``(i, j)`` tolerates an overlap of ``part_shrink[i] + part_shrink[j]``
-    (:mod:`cad.tolerances`), and counts a gap of ``min(contact_reach[i],
-    contact_reach[j])`` as touching (``contact_tol`` for every pair when ``contact_reach``
-    is null). ``step_chord``: a STEP source is tessellated to within this many mm of its
-    surfaces (:data:`cad.scene.STEP_CHORD_MM`, OCCT's ``tol_linear``), so a checker reads
-    the same meshes. ``merge_vertices``: each mesh's coincident
-    vertices are merged before anything (a STEP or 3DXML tessellation gives every face its
-    own vertices; eroding such a mesh leaves its edges where they were). ``erosion``: how a
-    part is shrunk. ``fits``: pairs whose inner part is shrunk further for that pair only
-    (:mod:`cad.fits`). ``support_travel_factor``: a part is supported if a fall of that
-    many times the pair's tolerance meets a part below; ``support``: the rules a part is
-    supported by (:data:`cad.support.SUPPORT_RULES`). ``open_parts``: parts not closed after
-    merging (their relations are approximate: a closed part has an inside, a part lying
-    wholly in it collides with it; an open one has none).
-    ``frame``: ``"file"`` (the file's own axes) or ``"build"`` (the parts turned as the
-    product is fixtured, :mod:`cad.frame`); ``build_rotation``: the 3x3 rotation ``R``, row
-    by row, taking file coordinates (times ``scale``) to build coordinates, ``x_build = R @
-    x_file`` (the identity for ``"file"``). Directions, gravity and every tolerance are in
-    the build frame.
-    """
-    if relations is None:
-        return None
-    from cad.relations import replay_rules
-    from cad.scene import STEP_CHORD_MM
-    from cad.units import unit_scale
-
-    file_unit = str(getattr(relations, "units", "mm"))
-    shrink = tuple(getattr(relations, "part_shrink", ()))
-    if len(shrink) != len(relations.parts):
-        shrink = (float(relations.penetration_tol) / 2,) * len(relations.parts)
-    scales = {file_scale(spec, p.file) for p in spec.parts if p.file}
-    if len(scales) == 1 and None not in scales:
-        scale = scales.pop()  # millimetre numbers under a wrong unit label included
-    else:
-        try:
-            scale = unit_scale(file_unit)
-        except ValueError:
-            scale = None  # "mixed": the files declare different units
-    return {
-        "unit": "mm",
-        "file_unit": file_unit,
-        "scale": scale,
-        "step_chord": STEP_CHORD_MM,
-        "frame": "file" if spec.frame is None else "build",
-        "build_rotation": [list(row) for row in build_rotation(spec)],
-        "contact_tol": float(relations.contact_tol),
-        "penetration_tol": float(relations.penetration_tol),
-        "part_shrink": dict(zip(map(str, relations.parts), map(float, shrink), strict=True)),
-        **replay_rules(relations),
-    }
-
-
 def split_file(file: str) -> tuple[str, str | None]:
     """``"model.step#nut_2"`` -> ``("model.step", "nut_2")``; a plain file has no node."""
     name, sep, node = file.partition("#")
@@ -636,53 +578,6 @@ def source_folder(source: str) -> Path:
     meshes, else the folder holding it."""
     path = Path(source) if source else Path()
     return path if path.is_dir() else path.parent
-
-
-def part_source(spec, file: str | None) -> dict | None:
-    """Where a part's mesh is: ``file`` (relative to :func:`source_folder`),
-    ``node`` (the part's scene-graph node, as trimesh names it, in a scene file; else
-    null), ``path`` (absolute, when it exists), ``scale`` (millimetres per coordinate as
-    trimesh reads the file, :func:`file_scale`)."""
-    if not file:
-        return None
-    name, node = split_file(file)
-    folder = source_folder(spec.source)
-    path = (folder / name).resolve()
-    if node is not None and path.is_file():
-        node = _scene_node(path, node)
-    return {
-        "file": name,
-        "node": node,
-        "path": str(path) if path.is_file() else None,
-        "scale": file_scale(spec, file),
-    }
-
-
-def file_scale(spec, file: str) -> float | None:
-    """Millimetres per coordinate of a part's file as trimesh reads it (its declared unit,
-    else the spec's; millimetre numbers under a wrong label read as mm); None when the
-    file cannot be read."""
-    from cad.scene import coordinate_scale
-
-    path = (source_folder(spec.source) / split_file(file)[0]).resolve()
-    if not path.is_file():
-        return None
-    try:
-        return coordinate_scale(path, spec.units)
-    except (OSError, ValueError):
-        return None
-
-
-def _scene_node(path: Path, part: str) -> str:
-    """The scene-graph node (as trimesh names it) of the part ``part`` of a scene file."""
-    from cad.scene import read_scene
-
-    try:
-        scene = read_scene(path)
-    except (OSError, ValueError):
-        return part
-    k = scene.find(part)
-    return scene.nodes[k] if k is not None and k < len(scene.nodes) else part
 
 
 def workspace_records(spec, operations: dict, principal: list[dict]) -> list[dict]:

@@ -320,3 +320,16 @@ def test_every_turn_model_has_its_lookups():
     for lookup in (ADVISORS, TRAINING_GAMES):
         assert sorted(lookup) == sorted(TURNS)
     assert all(cls.TURN_MODEL is TURNS[name] for name, cls in ADVISORS.items())
+
+
+DOCUMENT_MODULES = ("asmplan/planfile.py",)
+"""Modules that only write and read documents: they never open CAD (cad) nor compute (the
+pipeline hands them computed values)."""
+
+
+@pytest.mark.parametrize("path", DOCUMENT_MODULES)
+def test_the_plan_document_module_reads_no_cad(path):
+    cad_imports = [
+        (line, name) for line, name in imports(REPO / path) if name.split(".")[0] == "cad"
+    ]
+    assert cad_imports == [], f"{path} imports cad at {cad_imports}: compute in asmplan.pipeline"
