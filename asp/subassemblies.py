@@ -146,7 +146,7 @@ def build_with_units(
 
     say = on_unit or (lambda _line: None)
 
-    def build(with_units: AssemblySpec):
+    def build(with_units: AssemblySpec, **more):
         if reduce:
             from asp.graph.precedences import refutation
             from asp.graph.symmetry import reduced_state_graph
@@ -154,10 +154,12 @@ def build_with_units(
             proof = refutation(with_units, relations)
             if proof is not None:  # no complete sequence: known without a graph
                 raise _Proved(with_units, proof)
-            graph = reduced_state_graph(with_units, relations, concurrent=concurrent, **kwargs)
+            graph = reduced_state_graph(
+                with_units, relations, concurrent=concurrent, **kwargs, **more
+            )
             if graph is not None:
                 return graph
-        return build_state_graph(with_units, relations, **kwargs)
+        return build_state_graph(with_units, relations, **kwargs, **more)
 
     def next_units(with_units: AssemblySpec, proof, base, found, optional, drop: set[str]):
         """The round's new units (:func:`_new_units`; ``drop`` filled instead when a unit of
@@ -204,11 +206,12 @@ def build_with_units(
         graph_rounds = proved_rounds = 0
         while graph_rounds <= MAX_ROUNDS and proved_rounds <= len(spec.operations):
             current = prepared_units(current, relations, say)
-            try:
-                return build(current)
+            fastened = _fastener_fallback(current, relations, first_error)
+            try:  # with a sound answer past the limit, a graph sure to go over stops sooner
+                return build(current, **({"projection_margin": 1} if fastened else {}))
             except StateLimit:
                 if not isinstance(first_error, _Proved):
-                    graph = _fasteners_in_order(build, current, relations, say)
+                    graph = fastened and _fasteners_in_order(build, current, *fastened, say)
                     if graph is None:
                         raise
                     return graph
@@ -270,16 +273,24 @@ def build_with_units(
         )
 
 
-def _fasteners_in_order(build, spec: AssemblySpec, relations, say):
-    """The state graph of ``spec`` with its joining parts (screws, pins) in one order after
-    the parts they join (:func:`asp.graph.fasteners.fastener_order`: sound, and complete
-    whenever some complete sequence places each after its two parts), or None when it has
-    none of them or that graph also fails (the caller's error stands)."""
+def _fastener_fallback(spec: AssemblySpec, relations, first_error):
+    """``(ordered, found)`` of :func:`asp.graph.fasteners.fastener_order` when ``spec`` has
+    joining parts and a state-limit failure of its full graph may fall back on them (not in
+    a round guessed for a proved failure), else None: decided before the full graph is
+    built, so that it is built with the tighter projection margin."""
+    if relations is None or isinstance(first_error, _Proved):
+        return None
     from asp.graph.fasteners import fastener_order
 
     ordered, found = fastener_order(spec, relations)
-    if not found:
-        return None
+    return (ordered, found) if found else None
+
+
+def _fasteners_in_order(build, spec: AssemblySpec, ordered: AssemblySpec, found, say):
+    """The state graph of ``ordered``: ``spec`` with its joining parts ``found`` (screws,
+    pins) in one order after the parts they join (:func:`asp.graph.fasteners.fastener_order`:
+    sound, and complete whenever some complete sequence places each after its two parts),
+    or None when that graph also fails (the caller's error stands)."""
 
     def listed(ids: list[str]) -> str:
         return ", ".join(ids[:6]) + (f" and {len(ids) - 6} more" if len(ids) > 6 else "")

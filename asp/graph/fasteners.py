@@ -39,7 +39,12 @@ reduced graph has no complete sequence, the full graph's answer stands
 **Where it applies.** Only where the full graph exceeds its state limit (it is not built
 otherwise): screws and pins that touch nothing but their two parts and go in along a way
 nothing else closes. A screw whose head a later cover would stop (blocked by it along its
-only way) is not one: it stays free.
+only way) is not one: it stays free. The joining parts are found before the full graph is
+built, and with them at hand it is built with a projection margin of 1
+(:func:`asp.graph.state_graph.build_state_graph`): a graph sure to go over is given up as
+soon as its cautious projection passes the limit (the toy truck: after layer 12, 5.2 M
+states, instead of layer 13, 11.9 M states and 2.2 GB; the whole plan 48 s CPU and 1.2 GB
+from 77 s and 2.2 GB, plan.json byte for byte the same).
 
 **What it changes.** The game is played over the sequences with the joining parts in that
 order, each after its two parts: TCT and W* are those of that game (TCT no lower than the

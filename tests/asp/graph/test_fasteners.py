@@ -133,6 +133,52 @@ def test_the_state_limit_builds_the_graph_again_with_the_order_and_says_so():
         build_with_units(spec, rel, max_states=ordered - 1)
 
 
+def _stopped_after(exc: StateLimit) -> tuple[int, bool]:
+    """The layer after which a state-limit error stopped, and whether by projection."""
+    text = str(exc)
+    layer = int(text.split("after layer ")[1].split()[0])
+    return layer, "projected" in text
+
+
+def test_a_margin_of_one_gives_up_a_graph_sure_to_go_over_a_layer_sooner():
+    """Six brackets of two screws (262,144 states) under a limit of a fifth of that: the
+    cautious projection stops the build after layer 6 at margin 1, after layer 7 at the
+    default margin 2 (which first builds a layer it does not need)."""
+    spec, rel = screwed_brackets(n_brackets=6, screws=2)
+    limit = 52_428
+    stopped = {}
+    for margin in (1, 2):
+        with pytest.raises(StateLimit) as info:
+            build_state_graph(spec, rel, max_states=limit, projection_margin=margin)
+        stopped[margin] = _stopped_after(info.value)
+    assert stopped[1] == (6, True)
+    assert stopped[2][0] == 7
+
+
+@pytest.mark.parametrize(
+    ("brackets", "screws", "margin"),
+    [(3, 2, 1), (1, 1, 2)],  # joining parts: the fallback stands behind; one screw: none
+)
+def test_the_full_graph_is_tried_at_margin_one_only_with_joining_parts_to_fall_back_on(
+    monkeypatch, brackets, screws, margin
+):
+    """The APLAN toy truck: its full graph was built to 11.9 M states (2.2 GB, 54 s) before
+    the joining parts were put in order; with them known first, it stops a layer sooner."""
+    import asp.graph.state_graph as state_graph
+
+    spec, rel = screwed_brackets(n_brackets=brackets, screws=screws)
+    real = state_graph.build_state_graph
+    margins = []
+
+    def recording(*args, **kwargs):
+        margins.append(kwargs.get("projection_margin", state_graph.PROJECTION_MARGIN))
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(state_graph, "build_state_graph", recording)
+    build_with_units(spec, rel, reduce=False)
+    assert margins[0] == margin
+
+
 def test_no_joining_parts_no_change():
     spec, rel = screwed_brackets(n_brackets=1, screws=1)
     assert fastener_order(spec, rel) == (spec, [])
