@@ -207,11 +207,23 @@ def build_with_units(
         while graph_rounds <= MAX_ROUNDS and proved_rounds <= len(spec.operations):
             current = prepared_units(current, relations, say)
             fastened = _fastener_fallback(current, relations, first_error)
-            try:  # with a sound answer past the limit, a graph sure to go over stops sooner
+            over = fastened and fastener_projection(
+                current, relations, fastened[1], concurrent, kwargs
+            )
+            try:
+                if over:  # sure to go over: the order first, the full graph only if it fails
+                    graph = _fasteners_in_order(build, current, *fastened, say, over)
+                    if graph is not None:
+                        return graph
+                # with a sound answer past the limit, a graph sure to go over stops sooner
                 return build(current, **({"projection_margin": 1} if fastened else {}))
             except StateLimit:
                 if not isinstance(first_error, _Proved):
-                    graph = fastened and _fasteners_in_order(build, current, *fastened, say)
+                    graph = (
+                        None
+                        if not fastened or over
+                        else _fasteners_in_order(build, current, *fastened, say)
+                    )
                     if graph is None:
                         raise
                     return graph
@@ -286,11 +298,44 @@ def _fastener_fallback(spec: AssemblySpec, relations, first_error):
     return (ordered, found) if found else None
 
 
-def _fasteners_in_order(build, spec: AssemblySpec, ordered: AssemblySpec, found, say):
+def fastener_projection(
+    spec: AssemblySpec, relations, found, concurrent: bool, kwargs
+) -> str | None:
+    """Why the full state graph of ``spec`` is not even tried first: its joining parts
+    ``found`` alone multiply its states past the limit
+    (:func:`asp.graph.fasteners.joining_states`), or None. ``concurrent`` and ``kwargs`` as
+    :func:`build_with_units` has them.
+
+    The limit is the build's (``max_states``, else the spec's, else
+    :data:`asp.graph.state_graph.DEFAULT_MAX_STATES`); the count is that of the graph the
+    full build makes (:func:`asp.graph.symmetry.reduced_state_graph`: alike joining parts
+    in a fixed order count as one chain). Not trying it never makes a plan unsound (the
+    ordered graph's plans are checked like any); when the ordered graph fails, the full
+    graph is built as before and its answer stands."""
+    from asp.graph.fasteners import joining_states
+    from asp.graph.state_graph import DEFAULT_MAX_STATES
+    from asp.graph.symmetry import symmetry_reduction
+
+    limit = kwargs.get("max_states") or spec.max_states or DEFAULT_MAX_STATES
+    if len(found) < 2 or 2 ** len(found) <= limit:  # a chain only lowers the count
+        return None
+    states = joining_states(found, symmetry_reduction(spec, relations, concurrent=concurrent)[3])
+    if states <= limit:
+        return None
+    return (
+        f"the {len(found)} joining parts alone give at least {states:,} states, over the "
+        f"limit of {limit:,}: the full graph is not built"
+    )
+
+
+def _fasteners_in_order(
+    build, spec: AssemblySpec, ordered: AssemblySpec, found, say, projected: str = ""
+):
     """The state graph of ``ordered``: ``spec`` with its joining parts ``found`` (screws,
     pins) in one order after the parts they join (:func:`asp.graph.fasteners.fastener_order`:
     sound, and complete whenever some complete sequence places each after its two parts),
-    or None when that graph also fails (the caller's error stands)."""
+    or None when that graph also fails (the caller's error stands). ``projected`` says why
+    the full graph was not tried first (:func:`fastener_projection`)."""
 
     def listed(ids: list[str]) -> str:
         return ", ".join(ids[:6]) + (f" and {len(ids) - 6} more" if len(ids) > 6 else "")
@@ -301,7 +346,8 @@ def _fasteners_in_order(build, spec: AssemblySpec, ordered: AssemblySpec, found,
         if op.held > was.held
     ]
     say(
-        f"too many states: {len(found)} joining parts (each touches only the two parts it "
+        f"too many states ({projected or 'the full graph exceeds the limit'}): "
+        f"{len(found)} joining parts (each touches only the two parts it "
         "joins and goes in whatever else is there: screws, pins) placed in one order, each "
         f"after the two parts it joins ({listed([j.part for j in found])}; "
         "asp/graph/fasteners.py)"

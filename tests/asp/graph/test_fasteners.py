@@ -8,9 +8,11 @@ import numpy as np
 import pytest
 
 from asp.errors import StateLimit
+from asp.graph import state_graph
 from asp.graph.checker import PlanCheckError, check_line
-from asp.graph.fasteners import fastener_order, joining_parts
+from asp.graph.fasteners import fastener_order, joining_parts, joining_states
 from asp.graph.state_graph import build_state_graph
+from asp.graph.symmetry import reduced_state_graph, symmetry_reduction
 from asp.spec import spec_from_dict
 from asp.subassemblies import build_with_units
 from tests.asp.helpers_assembly import LATERAL, relations
@@ -184,3 +186,50 @@ def test_no_joining_parts_no_change():
     assert fastener_order(spec, rel) == (spec, [])
     rel = type(rel)(rel.parts, np.zeros_like(rel.tc), rel.tt)
     assert joining_parts(spec, rel) == []
+
+
+@pytest.mark.parametrize("brackets, screws", [(1, 2), (2, 2), (3, 2), (2, 3), (4, 1)])
+def test_the_joining_states_are_at_most_the_full_graphs(brackets, screws):
+    spec, rel = screwed_brackets(n_brackets=brackets, screws=screws)
+    found = joining_parts(spec, rel)
+    classes = symmetry_reduction(spec, rel)[3]
+    states = joining_states(found, classes)
+    assert states >= 2 ** len(found) // 2 ** len(classes)  # counts every joining part
+    assert states <= build_state_graph(spec, rel).n_states
+    assert states <= reduced_state_graph(spec, rel).n_states  # the graph the build makes
+
+
+def test_over_the_projection_the_full_graph_is_never_built(monkeypatch):
+    spec, rel = screwed_brackets(n_brackets=3, screws=2)
+    found = joining_parts(spec, rel)
+    assert joining_states(found, symmetry_reduction(spec, rel)[3]) == 64
+    built: list = []
+    real = state_graph.build_state_graph
+
+    def counting(spec_built, *args, **kwargs):
+        built.append(spec_built)
+        return real(spec_built, *args, **kwargs)
+
+    monkeypatch.setattr(state_graph, "build_state_graph", counting)
+    said: list[str] = []
+    graph = build_with_units(spec, rel, reduce=True, max_states=40, on_unit=said.append)
+    ordered, chain = fastener_order(spec, rel)
+    assert built  # and each time with the screws in their chain, never the full graph
+    for s in built:
+        for j in chain:
+            assert set(ordered.operation(j.operation).after) <= set(s.operation(j.operation).after)
+    assert any("the full graph is not built" in line for line in said)
+    sequences = graph.sequences(limit=20)
+    assert sequences
+    for seq in sequences:
+        check_line(spec, rel, seq)
+
+
+def test_under_the_projection_the_full_graph_is_built_first():
+    spec, rel = screwed_brackets(n_brackets=3, screws=2)  # 64 joining states, 125 in all
+    full = reduced_state_graph(spec, rel).n_states
+    assert build_with_units(spec, rel, reduce=True, max_states=full).n_states == full
+    said: list[str] = []
+    graph = build_with_units(spec, rel, reduce=True, max_states=100, on_unit=said.append)
+    assert graph.n_states < 64  # the full graph went over: then the order
+    assert any("the full graph exceeds the limit" in line for line in said)
