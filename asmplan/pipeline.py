@@ -259,6 +259,7 @@ class AssemblyPlan:
             "sequences": self.sequences,
             "schedule": self.schedule.to_dict(),
             "units": self.units,
+            "fasteners_in_order": [list(f) for f in self.graph.model.fasteners_in_order],
         }
         if self.concurrent is None:
             if self.concurrent_preview is not None:

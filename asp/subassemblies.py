@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -354,10 +354,12 @@ def _fasteners_in_order(
         + (f"; held while its joining parts go in: {listed(held)}" if held else "")
     )
     try:
-        return build(ordered)
+        graph = build(ordered)
     except (StateLimit, InfeasibleAssembly) as exc:
         say(f"with the joining parts in one order: {exc}")
         return None
+    chain = tuple((j.part, *j.joins) for j in found)  # for the plan (fasteners_in_order)
+    return replace(graph, model=replace(graph.model, fasteners_in_order=chain))
 
 
 def refuted_units(

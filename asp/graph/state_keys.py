@@ -75,6 +75,10 @@ class OperationModel:
         ``spec``, ``symmetric`` or ``loose``): each transposition of two blocks of a class
         (position by position) is a symmetry of the game. Recorded for the runtime
         (``plan.json``'s ``interchangeable``); the model's moves do not read it.
+    fasteners_in_order : tuple of (part, joined part, joined part)
+        The joining parts (screws, pins) the spec puts in one order, each after the two
+        parts it joins (:mod:`asp.graph.fasteners`), in that order; recorded for the plan
+        (``plan.json``'s ``fasteners_in_order``); the model's moves do not read it.
     fixed : tuple of classes of blocks of operation indices
         Interchangeable blocks the spec puts in a fixed order: at every position ``i``, the
         ``i``-th operations of the blocks are chained in block order by ``after``
@@ -106,6 +110,7 @@ class OperationModel:
     loose: tuple[tuple[int, tuple[int, ...]], ...] = ()
     interchangeable: tuple[tuple[tuple[str, ...], ...], ...] = ()
     fixed: tuple[tuple[tuple[int, ...], ...], ...] = ()
+    fasteners_in_order: tuple[tuple[str, str, str], ...] = ()
 
     @property
     def n_ops(self) -> int:

@@ -200,3 +200,21 @@ def test_relations_of_a_folder_read_its_assembly_yaml(tmp_path):
     result = CliRunner().invoke(app, ["relations", str(folder)])
     assert result.exit_code == 2
     assert "assembly.yaml" in result.output
+
+
+def test_the_plan_says_which_joining_parts_it_put_in_order(monkeypatch):
+    """Issue 24: screws put in one order past the state limit are a rule of the cell; the
+    plan says so (``fasteners_in_order``, in the schema), and says nothing without it."""
+    from asmplan.planfile import validate_plan
+    from asp.graph.fasteners import fastener_order
+    from tests.asp.graph.test_fasteners import screwed_brackets
+
+    monkeypatch.setattr(pipeline, "geometry_record", lambda *_: None)  # table relations
+    spec, rel = screwed_brackets(n_brackets=3, screws=2)  # 125 states in all, 22 ordered
+    doc = pipeline.plan(pipeline.Assembly(spec, rel), max_states=40, time_limit=5).to_dict()
+    validate_plan(doc)
+    chain = [[j.part, *j.joins] for j in fastener_order(spec, rel)[1]]
+    assert len(chain) == 6
+    assert doc["fasteners_in_order"] == chain
+    free = pipeline.plan(pipeline.Assembly(spec, rel), time_limit=5).to_dict()
+    assert free["fasteners_in_order"] == []
