@@ -233,3 +233,32 @@ def test_under_the_projection_the_full_graph_is_built_first():
     graph = build_with_units(spec, rel, reduce=True, max_states=100, on_unit=said.append)
     assert graph.n_states < 64  # the full graph went over: then the order
     assert any("the full graph exceeds the limit" in line for line in said)
+
+
+def stacked_links(n_links):
+    """``n_links`` links stacked on a base, a cap on the top one (each link rests on the
+    one below and touches the one above; nothing but the one below stops it): merged coil
+    links or a chain standing up."""
+    links = [f"link{k}" for k in range(n_links)]
+    parts = ("base", *links, "cap")
+    column = ["base", *links, "cap"]
+    pairs = list(zip(column[1:], column[:-1], strict=True))  # (upper, lower)
+    rel = relations(parts, [(u, lo, "-z") for u, lo in pairs], [(u, lo, "-z") for u, lo in pairs])
+    ops = [{"id": p, "agents": {"H": 2, "R": 3}, "part": p} for p in parts[1:]]
+    data = {
+        "parts": [{"id": p, "file": f"{p}.stl"} for p in parts],
+        "agents": {"H": {"side": "human"}, "R": {"side": "robot"}},
+        "base_part": "base",
+        "operations": ops,
+    }
+    return spec_from_dict(data, source="links.yaml"), rel
+
+
+@pytest.mark.parametrize("n_links, joining", [(1, ["link0"]), (2, []), (3, []), (6, [])])
+def test_links_in_a_chain_are_no_joining_parts(n_links, joining):
+    """One link between the base and the cap touches those two only: a pin joining them.
+    Links in a chain touch each other: each would join a link that is itself a joining
+    part (condition 1), so none is one and none is put in an order."""
+    spec, rel = stacked_links(n_links)
+    assert [j.part for j in joining_parts(spec, rel)] == joining
+    assert fastener_order(spec, rel) == (spec, [])  # fewer than two: nothing ordered
