@@ -158,3 +158,19 @@ CELL = {
         {"id": "f", "description": "inspect", "agents": {"R2": 1, "H": 1}, "after": ["e"]},
     ],
 }
+
+
+def parts_spec(parts, source, durations=None):
+    """A spec placing each part but the first (the base) alone, agents H and R
+    (``durations(k, part)`` -> ``{"H": s, "R": s}``; default 2 s and 3 s)."""
+    ops = [
+        {"id": p, "agents": durations(k, p) if durations else {"H": 2, "R": 3}, "part": p}
+        for k, p in enumerate(parts[1:])
+    ]
+    data = {
+        "parts": [{"id": p, "file": f"{p}.stl"} for p in parts],
+        "agents": {"H": {"side": "human"}, "R": {"side": "robot"}},
+        "base_part": parts[0],
+        "operations": ops,
+    }
+    return spec_from_dict(data, source=source)

@@ -13,9 +13,8 @@ from asp.graph.checker import PlanCheckError, check_line
 from asp.graph.fasteners import fastener_order, joining_parts, joining_states
 from asp.graph.state_graph import build_state_graph
 from asp.graph.symmetry import reduced_state_graph, symmetry_reduction
-from asp.spec import spec_from_dict
 from asp.subassemblies import build_with_units
-from tests.asp.helpers_assembly import LATERAL, relations
+from tests.asp.helpers_assembly import LATERAL, parts_spec, relations
 
 
 def screwed_brackets(n_brackets=3, screws=2):
@@ -31,16 +30,7 @@ def screwed_brackets(n_brackets=3, screws=2):
         contacts += [c for s in ss for c in ((s, b, "-z"), (s, "base", "-z"))]
         blocks += [(s, q, d) for s in ss for q in (b, "base") for d in ("-z", *LATERAL)]
     rel = relations(parts, contacts, blocks)
-    ops = [
-        {"id": p, "agents": {"H": 2 + k % 3, "R": 3}, "part": p} for k, p in enumerate(parts[1:])
-    ]
-    data = {
-        "parts": [{"id": p, "file": f"{p}.stl"} for p in parts],
-        "agents": {"H": {"side": "human"}, "R": {"side": "robot"}},
-        "base_part": "base",
-        "operations": ops,
-    }
-    return spec_from_dict(data, source="brackets.yaml"), rel
+    return parts_spec(parts, "brackets.yaml", lambda k, _: {"H": 2 + k % 3, "R": 3}), rel
 
 
 def done_sets(graph) -> set[frozenset[str]]:
@@ -244,14 +234,7 @@ def stacked_links(n_links):
     column = ["base", *links, "cap"]
     pairs = list(zip(column[1:], column[:-1], strict=True))  # (upper, lower)
     rel = relations(parts, [(u, lo, "-z") for u, lo in pairs], [(u, lo, "-z") for u, lo in pairs])
-    ops = [{"id": p, "agents": {"H": 2, "R": 3}, "part": p} for p in parts[1:]]
-    data = {
-        "parts": [{"id": p, "file": f"{p}.stl"} for p in parts],
-        "agents": {"H": {"side": "human"}, "R": {"side": "robot"}},
-        "base_part": "base",
-        "operations": ops,
-    }
-    return spec_from_dict(data, source="links.yaml"), rel
+    return parts_spec(parts, "links.yaml"), rel
 
 
 @pytest.mark.parametrize("n_links, joining", [(1, ["link0"]), (2, []), (3, []), (6, [])])
