@@ -50,6 +50,7 @@ from pathlib import Path
 
 import numpy as np
 
+from asp.cad_keys import with_flex
 from asp.errors import SpecError
 from asp.game.turns import ALTERNATE
 from asp.numbers import json_number
@@ -743,7 +744,7 @@ def spec_text(
         )
     lines += _alike_lines(assembly)
     folder = spec_folder or (path if path.is_dir() else path.parent)
-    lines += _hierarchy_lines(data, assembly, relations, folder, decide_units)
+    lines += _hierarchy_lines(data, assembly, relations, folder, decide_units, flexing)
     lines += [
         "",
         "agents:   # name -> side (human, robot); add R2, H2, ... as the cell has them",
@@ -820,9 +821,17 @@ def _alike_lines(assembly) -> list[str]:
     return lines
 
 
-def _hierarchy_lines(data: dict, assembly, relations, spec_folder, decide) -> list[str]:
+def _hierarchy_lines(
+    data: dict, assembly, relations, spec_folder, decide, flex: tuple = ()
+) -> list[str]:
     """The ``subassemblies:`` of a written spec: the file's sub-assemblies that ``decide``
-    accepts, and the others commented with the reason."""
+    accepts, and the others commented with the reason.
+
+    ``relations`` accept the file's overlaps and ``flex`` names the parts of the commented
+    ``flex:`` line: the units are decided for the spec as it plans once those lines are
+    uncommented (without them the file has no complete sequence at all, so no unit could be
+    judged by it; the FM1 satellite's XBee with its adapter, free of the base plate only
+    while the XBee's pins flex in, was written commented and never planned)."""
     if not assembly.groups:
         return []
     if decide is None:
@@ -839,7 +848,8 @@ def _hierarchy_lines(data: dict, assembly, relations, spec_folder, decide) -> li
             {**record, "file": os.path.normpath(os.path.join(folder, file)) + hash_ + node}
         )
     spec = spec_from_dict({**data, "parts": parts}, source=os.path.join(folder, SPEC_FILE))
-    spec = replace(spec, generated=True, hierarchy=file_hierarchy(assembly))
+    spec = replace(spec, generated=True, hierarchy=file_hierarchy(assembly), flex=tuple(flex))
+    relations = with_flex(relations, spec.flex)  # as the plan reads them (spec_relations)
     spec, _ = hold_unsupported(spec, relations)
     choices = decide(spec, relations)
     used = [u for u in choices if u.used]

@@ -144,3 +144,37 @@ def test_one_message_names_every_line_the_file_needs_and_with_them_it_plans(tmp_
     spec_file.write_text(text.replace("# overlap_ok:", "overlap_ok:").replace("# flex:", "flex:"))
     planned = CliRunner().invoke(app, ["plan", str(spec_file), "-o", str(tmp_path / "out")])
     assert planned.exit_code == 0, planned.output
+
+
+def test_init_decides_the_file_groups_with_its_own_flex_line_applied(tmp_path):
+    """The FM1 satellite's XBee with its adapter is a unit only while the XBee's pins flex
+    in: ``init`` judged the file's groups without the ``flex:`` line it writes commented,
+    so the group was written commented and the spec, its lines uncommented, never planned.
+    The groups are now judged as the spec plans once the lines are uncommented: the
+    relations given to the decision let the flexing cube pass its cage."""
+    import numpy as np
+    import trimesh
+
+    from asp.fromcad.generate import spec_text
+
+    meshes = caged_cube()
+    scene = trimesh.Scene()
+    scene.graph.update(frame_to="module", frame_from=scene.graph.base_frame)
+    for name, mesh in meshes.items():
+        parent = "module" if name in ("block", "cage") else scene.graph.base_frame
+        scene.add_geometry(mesh, node_name=name, geom_name=name, parent_node_name=parent)
+    source = tmp_path / "caged.glb"
+    scene.export(source)
+    seen = []
+
+    def decide(spec, relations):
+        seen.append((spec.flex, relations))
+        return ()
+
+    text = spec_text(source, tmp_path, decide_units=decide)
+    assert "# flex: [cube]" in text
+    ((flex, relations),) = seen
+    ids = list(relations.parts)
+    assert flex == ("cube",)
+    assert relations.tt[ids.index("cube"), ids.index("cage")].all()  # it flexes past
+    assert not np.asarray(relations.tt)[ids.index("cage"), ids.index("cube")].any()
