@@ -215,8 +215,11 @@ def build_with_units(
                     graph = _fasteners_in_order(build, current, *fastened, say, over)
                     if graph is not None:
                         return graph
-                # with a sound answer past the limit, a graph sure to go over stops sooner
-                return build(current, **({"projection_margin": 1} if fastened else {}))
+                # with an answer past the limit (the joining parts' order; in a round
+                # guessed for a proved failure, the proof), a graph sure to go over stops
+                # sooner
+                behind = fastened or isinstance(first_error, _Proved)
+                return build(current, **({"projection_margin": 1} if behind else {}))
             except StateLimit:
                 if not isinstance(first_error, _Proved):
                     graph = (

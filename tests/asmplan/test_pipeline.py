@@ -218,3 +218,26 @@ def test_the_plan_says_which_joining_parts_it_put_in_order(monkeypatch):
     assert doc["fasteners_in_order"] == chain
     free = pipeline.plan(pipeline.Assembly(spec, rel), time_limit=5).to_dict()
     assert free["fasteners_in_order"] == []
+
+
+def test_a_round_guessed_for_a_proved_failure_stops_at_a_margin_of_one(monkeypatch):
+    """Issue 24: past the state limit, a round of units guessed for a proved failure
+    ends in the proof's error; its graph is given up as soon as the projection passes the
+    limit (margin 1; the toy truck without its flex: line built 8.6 M states, 26 s of its
+    54, in a layer it did not need). The first round, with nothing behind it, keeps 2."""
+    import asp.graph.state_graph
+    from cad import Assembly, compute_relations
+
+    rel = compute_relations(Assembly.from_meshes(rod_tower()))
+    real = asp.graph.state_graph.build_state_graph
+    margins = []
+
+    def recording(spec, *args, **kwargs):
+        margin = kwargs.get("projection_margin", asp.graph.state_graph.PROJECTION_MARGIN)
+        margins.append((bool(spec.subassemblies), kwargs.get("check", True), margin))
+        return real(spec, *args, **kwargs)
+
+    monkeypatch.setattr(asp.graph.state_graph, "build_state_graph", recording)
+    pipeline.state_graph(pipeline.Assembly(tower_spec(rel), rel))
+    assert (True, True, 1) in margins  # the round with the holders' units
+    assert all(m == 2 for units, check, m in margins if not units and check)
