@@ -183,7 +183,7 @@ def distance_contacts(assembly: Assembly, tols, tc: np.ndarray) -> list[tuple[in
 
     def obj(k: int):
         if k not in objects:
-            objects[k] = _fcl_object(parts[k].mesh)
+            objects[k] = fcl_object(parts[k].mesh)
         return objects[k]
 
     found = []
@@ -233,7 +233,7 @@ def nearest_contacts(assembly: Assembly, tc: np.ndarray) -> list[tuple[int, int,
     piece = connected_components(touches, directed=False)[1]
     if piece.max() == 0:
         return []
-    objects = [_fcl_object(p.mesh) for p in parts]
+    objects = [fcl_object(p.mesh) for p in parts]
     diagonal = [float(np.linalg.norm(np.ptp(p.bounds, axis=0))) for p in parts]
     pairs = []
     for a in range(n):
@@ -262,7 +262,7 @@ def nearest_contacts(assembly: Assembly, tc: np.ndarray) -> list[tuple[int, int,
     return found
 
 
-def _fcl_object(mesh):
+def fcl_object(mesh):
     """An FCL collision object of a mesh in place."""
     import fcl
 

@@ -23,6 +23,7 @@ the build frame once, here, after the unit conversion; None keeps the file's own
 
 from __future__ import annotations
 
+import os
 import warnings
 from collections.abc import Sequence
 from dataclasses import replace
@@ -205,12 +206,29 @@ def _record_mesh(row: PartRecord, base: Path, units: str | None):
 
 
 def _is_file(path: Path) -> bool:
-    """``path.is_file()``, False for a name the system cannot hold (a ``file#node`` whose
-    node list is longer than a file name may be: ENAMETOOLONG)."""
+    """Whether ``path`` is a file; a name that cannot be a file name on this system (a
+    ``file#node`` listing a joined part's nodes may be longer than a name may be) is never
+    asked of the system: it is no file."""
+    return could_be_file_name(path) and path.is_file()
+
+
+def could_be_file_name(path: Path) -> bool:
+    """Whether every component of ``path`` fits the system's longest file name and the
+    whole its longest path (``NAME_MAX``, ``PATH_MAX`` of the file system holding the
+    path's root, or the working folder for a relative path; 255 and 4096 bytes where the
+    system does not say): past them the system refuses the name (ENAMETOOLONG) rather
+    than saying no such file exists."""
+    folder = Path(path.anchor or ".")
+    name_max, path_max = _limit(folder, "PC_NAME_MAX", 255), _limit(folder, "PC_PATH_MAX", 4096)
+    parts = [os.fsencode(part) for part in path.parts]
+    return all(len(p) <= name_max for p in parts) and len(os.fsencode(str(path))) < path_max
+
+
+def _limit(folder: Path, name: str, default: int) -> int:
     try:
-        return path.is_file()
-    except OSError:
-        return False
+        return int(os.pathconf(folder, name))
+    except (OSError, ValueError, AttributeError):  # not a POSIX system, or no such limit
+        return default
 
 
 def _scene_assembly(path: Path, units: str | None) -> Assembly:

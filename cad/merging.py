@@ -6,13 +6,30 @@ an XBee module's pins inside its chip) or that lock each other (a patch cable's 
 moulded round its boot: each blocks the other along every direction). Those pieces are
 never assembled one by one.
 
-Rule (:func:`merge_overlapping`): two parts that lie in one group of the file's hierarchy
-(:attr:`cad.assembly.Assembly.groups`) and either overlap deeper than their tolerance
-(:func:`cad.freedom.overlaps`, the check the relations make) or, clear of each other,
-*lock* each other (each blocked by the other along all six directions,
-:func:`cad.freedom.translational_freedom` of the pair alone) are one rigid part; parts
-joined so, transitively, make one part, and the joined parts are checked again (a part
-joined of pieces may lock the next piece).
+Which groups: only the file's *innermost* groups, those holding no other group of the
+file (a component's own node: a spring, a valve's pieces), as the file is read. A group
+holding groups is a sub-assembly of components (a cylinder head with its valves), and its
+members overlapping each other is a press fit or a visual model's inaccuracy, for the
+relations to report with the spec line that accepts it; never a reason to weld the
+components into one. So a joined part never spans more than one innermost group, never
+the whole product (the node over every part is no group, :mod:`cad.scene`).
+
+Rule (:func:`merge_overlapping`), within each innermost group:
+
+1. *Chains*: a group whose pieces are all one shape (:func:`cad.identical.alike_labels`)
+   and touch each other in one chain (the pieces' surfaces within the pair's contact
+   tolerance, FCL distance, connect them all) is one part: a spring modelled as its coil
+   links (Khronos' ``2CylinderEngine``: each valve spring is ten links, touching end to
+   end, none locking its neighbour), a chain's links, a bead string. Identical copies of a
+   purchased part that are assembled one by one (screws, washers of one group) do not
+   touch each other in one chain; when they do (a stack of identical spacers), the spec's
+   parts name them one by one.
+2. *Overlaps and locks*: two parts of the group that either overlap deeper than their
+   tolerance (:func:`cad.freedom.overlaps`, the check the relations make) or, clear of each
+   other, *lock* each other (each blocked by the other along all six directions,
+   :func:`cad.freedom.translational_freedom` of the pair alone) are one rigid part; parts
+   joined so, transitively, make one part, and the joined parts are checked again (a part
+   joined of pieces may lock the next piece).
 
 Why locking pieces are one part: blocking is a relation of the pair alone (a third part
 never frees a direction), so of two parts locking each other whichever is placed second
@@ -26,8 +43,8 @@ Its id is the innermost group's when the part is that whole group, else its firs
 member's; its mesh is the members' meshes together, its source ``file#a+b+c`` (how a spec
 names such a part: :mod:`cad.loading`), every node of the file it holds (a part joined of
 parts joined before lists their nodes, so a spec written from it reads the same mesh).
-One warning names every part made so. Overlapping parts of no common group stay parts
-(the relations then report them, with the spec line that joins them).
+One warning names every part made so. Overlapping parts of no common innermost group stay
+parts (the relations then report them, with the spec lines that accept or join them).
 """
 
 from __future__ import annotations
@@ -45,15 +62,20 @@ from cad.tolerances import Tolerances, resolve_tolerances
 
 
 def merge_overlapping(assembly: Assembly, file_name: str) -> Assembly:
-    """``assembly`` with the overlapping parts of each file group joined (module rule)."""
+    """``assembly`` with the pieces of each innermost file group that make one component
+    joined (module rule: chains, then overlaps and locks)."""
     if not assembly.groups or len(assembly.parts) < 2:
         return assembly
-    grouped = _group_pairs([p.id for p in assembly.parts], assembly.groups)
-    if not grouped:
+    inner = innermost_groups(assembly.groups)
+    chains = chain_groups(assembly, inner)
+    if chains:
+        assembly = _joined(assembly, chains, file_name, "chain")
+    if not _group_pairs([p.id for p in assembly.parts], assembly.groups, inner):
         return assembly
     tols = resolve_tolerances(assembly)
     eroded = eroded_meshes(assembly, tols.shrink)
     overlapping = {(o.a, o.b) for o in overlaps(assembly, tols, eroded)}
+    grouped = _group_pairs([p.id for p in assembly.parts], assembly.groups, inner)
     why, joined = "overlap", _classes(len(assembly.parts), overlapping & grouped)
     for _ in range(len(assembly.parts)):  # each round joins parts: it ends
         if joined:
@@ -61,12 +83,54 @@ def merge_overlapping(assembly: Assembly, file_name: str) -> Assembly:
             tols = resolve_tolerances(assembly)
             eroded = eroded_meshes(assembly, tols.shrink)
             overlapping = {(o.a, o.b) for o in overlaps(assembly, tols, eroded)}
-        grouped = _group_pairs([p.id for p in assembly.parts], assembly.groups)
+        grouped = _group_pairs([p.id for p in assembly.parts], assembly.groups, inner)
         locked = _locked(assembly, tols, eroded, sorted(grouped - overlapping))
         if not locked:
             break
         why, joined = "lock", _classes(len(assembly.parts), locked)
     return assembly
+
+
+def innermost_groups(groups) -> frozenset[str]:
+    """Ids of the groups holding no other group (no group's members a proper subset of
+    theirs): the file's components (module docstring)."""
+    sets = [(gid, frozenset(members)) for gid, members in groups]
+    return frozenset(gid for gid, mine in sets if not any(other < mine for _, other in sets))
+
+
+def chain_groups(assembly: Assembly, inner: frozenset[str]) -> list[list[int]]:
+    """Part indices of each innermost group whose pieces are all one shape and touch each
+    other in one chain (module rule 1)."""
+    import fcl
+    from scipy.sparse.csgraph import connected_components
+
+    from cad.contact import fcl_object
+    from cad.identical import alike_labels
+
+    index = {p.id: k for k, p in enumerate(assembly.parts)}
+    chains = []
+    tols = None
+    for gid, group in assembly.groups:
+        members = [index[m] for m in group if m in index]
+        if gid not in inner or len(members) < 2:
+            continue
+        if len(set(alike_labels([assembly.parts[k].mesh for k in members]))) != 1:
+            continue
+        tols = tols or resolve_tolerances(assembly)
+        objects = [fcl_object(assembly.parts[k].mesh) for k in members]
+        touch = np.zeros((len(members), len(members)), bool)
+        for i, a in enumerate(members):
+            for j in range(i + 1, len(members)):
+                b, gap = members[j], tols.contact_pair(a, members[j])
+                if not bounds_overlap(assembly.parts[a].bounds, assembly.parts[b].bounds, pad=gap):
+                    continue
+                dist = fcl.distance(
+                    objects[i], objects[j], fcl.DistanceRequest(), fcl.DistanceResult()
+                )
+                touch[i, j] = dist <= gap
+        if connected_components(touch, directed=False)[0] == 1:
+            chains.append(members)
+    return chains
 
 
 def _locked(assembly: Assembly, tols, eroded, pairs) -> list[tuple[int, int]]:
@@ -108,11 +172,14 @@ def _classes(n: int, pairs) -> list[list[int]]:
     return [m for m in members.values() if len(m) > 1]
 
 
-def _group_pairs(ids: list[str], groups) -> set[tuple[int, int]]:
-    """Index pairs ``(a, b)``, ``a < b``, of parts that share a group of the file."""
+def _group_pairs(ids: list[str], groups, inner: frozenset[str]) -> set[tuple[int, int]]:
+    """Index pairs ``(a, b)``, ``a < b``, of parts that share an innermost group of the file
+    (``inner``: the groups' ids)."""
     index = {pid: k for k, pid in enumerate(ids)}
     pairs = set()
-    for _, group in groups:
+    for gid, group in groups:
+        if gid not in inner:
+            continue
         inside = sorted(index[m] for m in group if m in index)
         pairs |= {(a, b) for n, a in enumerate(inside) for b in inside[n + 1 :]}
     return pairs
@@ -120,7 +187,7 @@ def _group_pairs(ids: list[str], groups) -> set[tuple[int, int]]:
 
 def _joined(assembly: Assembly, joined: list[list[int]], file_name: str, why: str) -> Assembly:
     """The assembly with each list of part indices in ``joined`` made one part (``why``:
-    ``"overlap"`` or ``"lock"``, for the warning)."""
+    ``"chain"``, ``"overlap"`` or ``"lock"``, for the warning)."""
     parts = list(assembly.parts)
     new_id: dict[str, str] = {}
     made: dict[int, Part] = {}
@@ -147,11 +214,11 @@ def _joined(assembly: Assembly, joined: list[list[int]], file_name: str, why: st
         if len(renamed) >= 2:
             groups.append((gid, renamed))
     shown = ", ".join(said[:10]) + (f" and {len(said) - 10} more" if len(said) > 10 else "")
-    how = (
-        "overlap each other"
-        if why == "overlap"
-        else "lock each other (each blocks the other along every direction)"
-    )
+    how = {
+        "chain": "are one shape touching each other in a chain (a spring's coils, a chain)",
+        "overlap": "overlap each other",
+        "lock": "lock each other (each blocks the other along every direction)",
+    }[why]
     warnings.warn(
         f"{file_name}: parts of one sub-assembly of the file {how}, each set taken as one "
         f"rigid part (a component modelled in pieces; cad/merging.py): {shown}",

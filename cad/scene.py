@@ -216,6 +216,36 @@ class SceneParts:
         return trimesh.util.concatenate([self.meshes[k] for k in found])
 
 
+def gltf_buffer_problem(path: Path) -> str:
+    """Why a glTF's buffers cannot be read, in words (``""``: no such problem found): a
+    buffer's ``uri`` naming a file that is not beside it, or ``data:`` whose payload is not
+    the base64 of its declared ``byteLength`` (a reader asserts instead of saying so)."""
+    import base64
+    import binascii
+    import json
+
+    if path.suffix.lower() != ".gltf":
+        return ""
+    try:
+        buffers = json.loads(path.read_text(encoding="utf-8")).get("buffers", [])
+    except (OSError, UnicodeDecodeError, ValueError, AttributeError):
+        return ""
+    for k, buffer in enumerate(buffers if isinstance(buffers, list) else []):
+        uri = str(buffer.get("uri", "")) if isinstance(buffer, dict) else ""
+        size = buffer.get("byteLength") if isinstance(buffer, dict) else None
+        shown = uri if len(uri) <= 60 else uri[:57] + "..."
+        if uri.startswith("data:"):
+            try:
+                data = base64.b64decode(uri.partition(",")[2], validate=True)
+            except (binascii.Error, ValueError):
+                return f"buffer {k}'s uri {shown!r} is data that is not base64"
+            if isinstance(size, int) and len(data) < size:
+                return f"buffer {k}'s data holds {len(data)} bytes, its byteLength says {size}"
+        elif uri and not (path.parent / uri).is_file():
+            return f"buffer {k}'s file {shown!r} is not beside it"
+    return ""
+
+
 def load_scene_file(path: Path) -> trimesh.Scene:
     """Load a mesh or scene file as a trimesh scene (its reader, :mod:`cad.readers`);
     one-line errors for bad files."""
@@ -233,7 +263,8 @@ def load_scene_file(path: Path) -> trimesh.Scene:
     except Exception as exc:  # trimesh raises many types for bad files
         if external_references(path):
             raise empty_scene_error(path) from None
-        raise GeometryError(f"unreadable mesh file {path}: {type(exc).__name__}: {exc}") from None
+        why = gltf_buffer_problem(path) or f"{type(exc).__name__}: {exc}"
+        raise GeometryError(f"unreadable mesh file {path}: {why}") from None
     if not isinstance(scene, trimesh.Scene):  # pragma: no cover - force="scene"
         scene = trimesh.Scene(scene)
     return scene

@@ -300,3 +300,92 @@ def test_the_shells_a_step_declares_cut_a_fused_mesh_into_its_bodies():
     assert all(b.is_watertight for b in (trimesh.Trimesh(b.vertices, b.faces) for b in bodies))
     assert closed_bodies(mesh, shells=(5, 7)) is None  # no cut closes both: as before
     assert closed_bodies(mesh, shells=(6, 5)) is None  # not the faces declared
+
+
+def write_tree_glb(path, tree):
+    """A glTF in metres of a file tree: ``tree`` maps a name to a mesh (a part node) or to
+    a dict (a group node holding its own tree), all under a product node ``engine``."""
+    scene = trimesh.Scene()
+    scene.graph.update(frame_from="world", frame_to="engine")
+
+    def add(parent, items):
+        for name, item in items.items():
+            if isinstance(item, dict):
+                scene.graph.update(frame_from=parent, frame_to=name)
+                add(name, item)
+            else:
+                scene.add_geometry(
+                    item.copy().apply_scale(0.001),
+                    node_name=name,
+                    geom_name=name,
+                    parent_node_name=parent,
+                )
+
+    add("engine", tree)
+    scene.export(path)
+    return path
+
+
+def coil(turns: int, at=(0.0, 0.0, 0.0)) -> dict:
+    """A spring modelled as ``turns`` identical links: one 12 x 2 x 3 bar a turn, each
+    turned 36 degrees on the one below and standing on it (touching, overlapping nothing,
+    locking nothing)."""
+    links = {}
+    for k in range(turns):
+        bar = box([12, 2, 3], [0, 0, 0])
+        bar.apply_transform(trimesh.transformations.rotation_matrix(k * np.pi / 5, (0, 0, 1)))
+        links[f"link_{k}"] = bar.apply_translation(np.add(at, (0, 0, 3.0 * k)))
+    return links
+
+
+def cylinder_head() -> dict:
+    """A head holding a valve (its spring of 5 coil links on the cover, its cap on them)
+    and the block and cover, which overlap by 0.5 mm (a visual model's press fit)."""
+    valve = {"spring": coil(5, at=(0, 0, 15)), "cap": box([14, 14, 2], [0, 0, 29.5])}
+    return {
+        "head": {
+            "valve": valve,
+            "block": box([40, 40, 10], [0, 0, 5]),
+            "cover": box([40, 40, 4], [0, 0, 11.5]),
+        },
+        "base": box([60, 60, 4], [0, 0, -2]),
+    }
+
+
+def test_a_spring_of_identical_links_touching_in_one_innermost_group_is_one_part(tmp_path):
+    """The valve spring's five links (one shape, each touching the next, none overlapping
+    or locking another) are one part; the cap in the valve's group stays a part."""
+    path = write_tree_glb(tmp_path / "engine.glb", cylinder_head())
+    with pytest.warns(UserWarning, match=r"one shape touching each other in a chain.*spring"):
+        assembly = load_assembly(path)
+    spring = assembly.parts[assembly.ids.index("spring")]
+    assert spring.source.endswith("#" + "+".join(f"link_{k}" for k in range(5)))
+    assert set(assembly.ids) == {"spring", "cap", "block", "cover", "base"}
+
+
+def test_identical_pieces_of_a_group_that_do_not_touch_in_one_chain_stay_parts(tmp_path):
+    """Four identical screws in one group, apart from each other: assembled one by one."""
+    screws = {f"screw_{k}": box([3, 3, 12], [10.0 * k, 0, 6]) for k in range(4)}
+    path = write_tree_glb(
+        tmp_path / "plate.glb", {"screws": screws, "plate": box([50, 8, 2], [15, 0, -1])}
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assembly = load_assembly(path)
+    assert assembly.ids == ("plate", "screw_0", "screw_1", "screw_2", "screw_3")
+
+
+def test_overlapping_members_of_a_group_holding_groups_are_never_joined(tmp_path):
+    """The head holds the valve's group: it is a sub-assembly of components, so its block
+    and cover overlapping is reported by the relations (with the spec line accepting the
+    pair), never welded into one part, let alone with the rest of the product (the merge
+    joined the two-cylinder engine's block, crankshaft and valve gear into one part)."""
+    path = write_tree_glb(tmp_path / "engine.glb", cylinder_head())
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assembly = load_assembly(path)
+        assert {"block", "cover"} <= set(assembly.ids)
+        with pytest.raises(
+            GeometryError, match=r"'block' and 'cover'.*overlap_ok: \[\[block, cover\]\]"
+        ):
+            compute_relations(assembly)

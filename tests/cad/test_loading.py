@@ -270,3 +270,25 @@ def test_a_node_name_longer_than_a_file_name_is_read_from_its_scene(tmp_path):
     )
     assembly = load_geometry(spec)
     assert assembly.ids == ("B", "T")
+
+
+def test_a_name_longer_than_a_file_name_is_never_asked_of_the_system(tmp_path, monkeypatch):
+    """``could_be_file_name`` says no to a component past the longest file name (or a path
+    past the longest path) and the record's ``file#node`` is never stat'ed then."""
+    from cad.bom import PartRecord
+    from cad.loading import could_be_file_name, load_parts
+
+    assert could_be_file_name(tmp_path / ("a" * 255))
+    assert not could_be_file_name(tmp_path / ("a" * 256))
+    assert not could_be_file_name(tmp_path / "/".join(["b" * 200] * 30))  # 6,000 bytes
+    long_id = "bottom_" + "x" * 300
+    scene = trimesh.Scene()
+    for part in shapes.stacked_cubes().parts:
+        scene.add_geometry(part.mesh, node_name=long_id if part.id == "bottom" else part.id)
+    scene.export(tmp_path / "asm.glb")
+    asked = []
+    is_file = Path.is_file
+    monkeypatch.setattr(Path, "is_file", lambda self: asked.append(str(self)) or is_file(self))
+    records = [PartRecord(id="B", name="B", file=f"asm.glb#{long_id}")]
+    assert load_parts(records, tmp_path).ids == ("B",)
+    assert not [name for name in asked if long_id in name]

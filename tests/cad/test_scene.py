@@ -448,3 +448,26 @@ def test_generic_names_give_way_to_classes_of_alike_parts(tmp_path):
     alike = {unnamed: b((0, 0, 0), (4, 4, 4)), unnamed + " ": b((9, 0, 0), (13, 4, 4))}
     path = write_3dxml(tmp_path / "sat.3dxml", alike)
     assert read_scene(path).ids == ("alike_a_1", "alike_a_2")
+
+
+def test_a_gltf_whose_buffer_is_not_its_data_says_which_and_why(tmp_path):
+    """A glTF whose buffer uri is replaced by text that is no base64 (or names no file
+    beside it): the one-line error names the buffer and the cause, not a reader's bare
+    AssertionError."""
+    import json
+
+    from cad.errors import GeometryError
+    from cad.scene import load_scene_file
+
+    scene = trimesh.Scene(trimesh.creation.box(extents=[0.01, 0.01, 0.01]))
+    files = scene.export(file_type="gltf")
+    (tmp_path / "box.gltf").write_bytes(files["model.gltf"])
+    doc = json.loads(files["model.gltf"])
+    for uri, said in (
+        ("data:image/jpeg;base64,<img src=x onerror=alert(1)>", "is data that is not base64"),
+        ("box0.bin", "file 'box0.bin' is not beside it"),
+    ):
+        doc["buffers"][0]["uri"] = uri
+        (tmp_path / "box.gltf").write_text(json.dumps(doc))
+        with pytest.raises(GeometryError, match=f"box.gltf: buffer 0's .*{said}"):
+            load_scene_file(tmp_path / "box.gltf")
