@@ -324,7 +324,11 @@ def build_state_graph(
             at_least = total + found.at_least(layer + 1, max_states - total)
             if at_least > max_states:
                 raise _too_many(
-                    model, keys, max_states, _after(f"at least {at_least:,}", layer, n_ops)
+                    model,
+                    keys,
+                    max_states,
+                    _after(f"at least {at_least:,}", layer, n_ops),
+                    relations,
                 )
             sizes = (total + found.n_distinct, kept + found.n_transitions, found.n_transitions)
             if memory.over(*sizes):
@@ -334,7 +338,11 @@ def build_state_graph(
         si, oi, inv, uniq, new_parts = found.join()
         if total + uniq.shape[0] > max_states:
             raise _too_many(
-                model, uniq, max_states, _after(f"{total + uniq.shape[0]:,}", layer, n_ops)
+                model,
+                uniq,
+                max_states,
+                _after(f"{total + uniq.shape[0]:,}", layer, n_ops),
+                relations,
             )
         n_new = int(si.size)
         kept += n_new
@@ -361,7 +369,7 @@ def build_state_graph(
                 f"{total:,} states after layer {layer + 1} of {n_ops}, the last layer {growth:.1f}"
                 f" times the one before: about {projected:,} projected"
             )
-            raise _too_many(model, keys, max_states, reached)
+            raise _too_many(model, keys, max_states, reached, relations)
         rest = projected - total  # and as many transitions a state as the layer just built
         sizes = (projected, kept + rest * n_new // max(1, keys.shape[0]), 0)
         if memory.over(*sizes):
@@ -688,13 +696,18 @@ def _after(states: str, layer: int, n_ops: int) -> str:
     return f"{states} states after layer {layer + 1} of {n_ops}"
 
 
-def _too_many(model: OperationModel, keys: np.ndarray, limit: int, reached: str):
+def _too_many(model: OperationModel, keys: np.ndarray, limit: int, reached: str, relations=None):
     """The one-line error of a state graph over ``max_states``.
 
     ``keys`` is the last layer built (or about to be): the operations done in some but not
     all of its states are the free choices that multiply the states; the parts they place
     are named, the most balanced choices (done in about half the states) first. ``reached``
-    says how many states were reached (or projected) after which layer.
+    says how many states were reached (or projected) after which layer. When the derived
+    precedences prove that the spec has no complete sequence at all
+    (:func:`asp.graph.precedences.refutation`, with ``relations``; milliseconds), the error
+    says that proof last: no limit would give a plan, and the proof names the cause (the
+    two-cylinder engine with its lines: 46 M states projected, and a rocker's halves
+    resting only on the pins through them).
     """
     per_state = 8 * model.n_words + 8 * model.oracle.n_words + 8
     return StateLimit(
@@ -702,7 +715,23 @@ def _too_many(model: OperationModel, keys: np.ndarray, limit: int, reached: str)
         f"{reached}; {_free_choices(model, keys)}; raise max_states (the command line's "
         f"--max-states N or the spec key max_states: N) if memory allows (about {per_state} "
         f"bytes a state plus 10 a transition), or fix their order with precedences (after:) "
-        f"or build some of them as subassemblies"
+        f"or build some of them as subassemblies{_proved_infeasible(model.spec, relations)}"
+    )
+
+
+def _proved_infeasible(spec: AssemblySpec, relations) -> str:
+    """``"; but no complete sequence exists: <proof>"`` when the derived precedences of
+    ``spec`` prove it (:func:`asp.graph.precedences.refutation`), else ``""``."""
+    if relations is None:
+        return ""
+    from asp.graph.precedences import refutation
+
+    proof = refutation(spec, relations)
+    if proof is None:
+        return ""
+    return (
+        "; but no state limit gives a plan: no complete sequence exists, as the derived "
+        f"precedences prove ({proof.why})"
     )
 
 

@@ -118,3 +118,30 @@ def test_units_decide_by_type_not_by_text(monkeypatch):
     with pytest.raises(SpecError) as info:
         subassemblies.build_with_units(spec, rel, reduce=True)
     assert type(info.value) is SpecError
+
+
+def test_a_state_limit_says_the_proof_that_no_limit_gives_a_plan():
+    """Eight free parts on a base and one touching nothing: the graph goes over a limit of
+    20 states long before the dead end shows, and the derived precedences prove there is
+    no complete sequence; the error says so with the proof (raising the limit would
+    only build a larger graph to fail). A feasible spec's error says no such thing."""
+    free = [f"F{k}" for k in range(8)]
+    data = {
+        "parts": [{"id": p, "file": p.lower()} for p in ("B", *free, "K")],
+        "agents": {"R": {"side": "robot"}},
+        "base_part": "B",
+        "constraints": {"stability": False},
+        "operations": [{"id": p, "agents": {"R": 1}, "part": p} for p in (*free, "K")],
+    }
+    rel = relations(("B", *free, "K"), contacts=[(p, "B", "+z") for p in free])
+    with pytest.raises(StateLimit) as info:
+        build_state_graph(spec_from_dict(data, source="k.yaml"), rel, max_states=20)
+    said = str(info.value)
+    assert "raise max_states" in said and "no complete sequence exists" in said
+    assert "K" in said.rpartition("as the derived precedences prove")[2]
+    data["parts"] = data["parts"][:-1]
+    data["operations"] = data["operations"][:-1]
+    rel = relations(("B", *free), contacts=[(p, "B", "+z") for p in free])
+    with pytest.raises(StateLimit) as info:
+        build_state_graph(spec_from_dict(data, source="f.yaml"), rel, max_states=20)
+    assert "no complete sequence" not in str(info.value)
