@@ -11,9 +11,11 @@ The loop (:func:`train_concurrent`), per cycle:
    model as it is (frozen for the phase, sampling its policy);
 2. the human trains ``phase_steps`` steps against the robot model, frozen;
 3. the robot's greedy policy is certified: the exact best response of the human side to it
-   (:func:`asp.concurrent.certify.certify`) for every budget asked, in spec units. The
-   policy of least certified worst case so far (at the largest budget, ``k = inf``, then
-   the others) is the run's answer, saved as ``robot.zip``.
+   (:func:`asp.concurrent.certify.certify`) for every budget asked, in spec units; past
+   the exact solver's size the budgets whose policy game is too large to walk are dropped,
+   ``k = inf`` first (:func:`certify_fitting`). The policy of least certified worst case so
+   far (at the largest budget certified, then the others) is the run's answer, saved as
+   ``robot.zip``.
 
 The certificate is exact whatever the network learned: it is a third candidate for the
 upper bound ``U(k)`` beside the greedy and the CP-SAT schedule policies
@@ -227,6 +229,69 @@ def _learners(rules: Rules, cfg: ConcurrentConfig, seed: int):
 DEFAULT_BUDGETS = [0, 1, 2, None]
 """The budgets certified after every cycle unless told (None: ``k = inf``)."""
 
+CERTIFICATE_NODES = 500_000
+"""Nodes of a learned robot's policy game at most (:func:`certify_fitting`): past it the
+largest budget is left uncertified (the walk is Python, about 5,000 nodes a second with a
+network choosing)."""
+
+
+def budget_order(budgets) -> list:
+    """``budgets`` from the smallest to ``None`` (``k = inf``), each once."""
+    return sorted(set(budgets), key=lambda b: (b is None, b or 0))
+
+
+def certify_fitting(
+    rules: Rules,
+    choose,
+    budgets: list[int | None],
+    *,
+    max_memory: int | None = None,
+    max_nodes: int | None = None,
+    say: Callable[[str], None] | None = None,
+):
+    """:func:`asp.concurrent.certify.certify` at the budgets whose policy game fits.
+
+    Tried at every budget at once; while the policy game is over ``max_nodes`` nodes or
+    ``max_memory`` bytes (:class:`asp.errors.GameLimit`), the largest budget left is dropped
+    (``k = inf`` first: the fully adversarial human's replies are a superset of every
+    bounded one's, so its walk is the largest) and the rest tried again; ``say`` is told
+    each budget dropped, in one line (``max_nodes``: default :data:`CERTIFICATE_NODES`). A
+    product past the exact solver's size keeps the
+    budgets that can be certified instead of failing for size alone.
+
+    Returns
+    -------
+    (asp.concurrent.certify.Certificate, list)
+        The certificate and the budgets it holds (ordered, ``None`` last).
+
+    Raises
+    ------
+    asp.errors.GameLimit
+        Not even the smallest budget fits.
+    """
+    from asp.errors import GameLimit
+
+    most = CERTIFICATE_NODES if max_nodes is None else int(max_nodes)
+    kept = budget_order(budgets)
+    while True:
+        try:
+            cert = certify(rules, choose, kept, max_nodes=most, max_memory=max_memory)
+            return cert, kept
+        except GameLimit as err:
+            if len(kept) == 1:
+                raise
+            dropped = kept.pop()
+            if say is not None:
+                say(
+                    f"k = {'inf' if dropped is None else dropped} not certified ({err}); "
+                    f"certified at k = {', '.join(_k_name(b) for b in kept)}"
+                )
+
+
+def _k_name(budget) -> str:
+    return "inf" if budget is None else str(budget)
+
+
 CERTIFICATION = "a certification (exact best response)"
 """What a cycle's check is, in the words of :class:`arl.pace.CycleEstimate`."""
 
@@ -260,7 +325,7 @@ def estimate_cycle(
     robot.learn(k, reset_num_timesteps=False)
     step_s = (time.perf_counter() - t0) / k
     t0 = time.perf_counter()
-    certify(rules, learned_policy(rules, robot), budgets, max_memory=max_memory)
+    certify_fitting(rules, learned_policy(rules, robot), budgets, max_memory=max_memory)
     check_s = time.perf_counter() - t0
     return CycleEstimate(
         seconds=2 * phase_seconds(cfg.phase_steps, cfg.n_steps, step_s) + check_s,
@@ -297,7 +362,9 @@ def train_concurrent(
     ----------
     budgets : list of int or None
         The budgets certified after every cycle (default :data:`DEFAULT_BUDGETS`); the
-        last one ranks the cycles' robots.
+        largest ranks the cycles' robots. A budget whose policy game is over
+        :data:`CERTIFICATE_NODES` nodes or the memory left is dropped for the rest of the
+        run, said on stderr (:func:`certify_fitting`).
     output : Path, optional
         The run folder (written after every cycle).
     progress : bool
@@ -321,7 +388,7 @@ def train_concurrent(
         (:class:`asp.errors.GameLimit`), each one line naming ``--max-memory``.
     """
     cfg = get_config(config)
-    budgets = list(budgets) if budgets is not None else list(DEFAULT_BUDGETS)
+    budgets = budget_order(budgets if budgets is not None else DEFAULT_BUDGETS)
     room = concurrent_training_room(Encoder(rules).size, cfg, max_memory_gb)
     t0 = time.perf_counter()
     with Heartbeat(heartbeat, lambda: time.perf_counter() - t0) as beat:
@@ -352,7 +419,9 @@ def _train(rules, cfg, seed, budgets, output, progress, beat, room) -> Concurren
                 makespans = callback.makespans
         steps = int(robot.num_timesteps + human.num_timesteps)
         beat.doing = f"cycle {cycle} of {cfg.cycles}: {CERTIFICATION}"
-        cert = certify(rules, learned_policy(rules, robot), budgets, max_memory=room)
+        cert, budgets = certify_fitting(
+            rules, learned_policy(rules, robot), budgets, max_memory=room, say=_stderr
+        )
         record = {
             "cycle": cycle,
             "steps": steps,
@@ -385,6 +454,10 @@ def _train(rules, cfg, seed, budgets, output, progress, beat, room) -> Concurren
         seconds=time.perf_counter() - t0,
         config=cfg,
     )
+
+
+def _stderr(line: str) -> None:
+    print(f"  {line}", file=sys.stderr, flush=True)
 
 
 class _Makespans(BaseCallback):

@@ -33,6 +33,7 @@ certificates included):
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 import time
 from pathlib import Path
@@ -40,24 +41,21 @@ from pathlib import Path
 REPO = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(REPO))
 
-from asp.game.solve import solve  # noqa: E402
 
-BUDGETS = [0, 1, 2, None]
-
-
-def certified(game) -> dict:
-    """Budget -> the certified worst case at each start of a policy game."""
-    sol = solve(game.dag)
-    return {(None if b < 0 else b): float(sol.value[v, 0]) for b, v in game.starts.items()}
+def budgets_of(text: str) -> list:
+    """``"0,1,2,inf"`` -> ``[0, 1, 2, None]``."""
+    return [None if x.strip() == "inf" else int(x) for x in text.split(",")]
 
 
-def row(name: str, values: dict) -> str:
-    return f"{name:<22}" + "".join(f"{values.get(b, float('nan')):>9g}" for b in BUDGETS)
+def row(name: str, values: dict, budgets: list) -> str:
+    cells = (values.get(b) for b in budgets)
+    return f"{name:<22}" + "".join(f"{'-' if v is None else f'{v:g}':>9}" for v in cells)
 
 
 def main() -> None:
     from arl.concurrent_trainer import train_concurrent
     from asmplan import pipeline
+    from asp.concurrent.certify import best_response_values
     from asp.concurrent.curve import solve_curve
     from asp.concurrent.rules import concurrent_rules
     from asp.concurrent.search import GREEDY, SCHEDULE, Limits, Search
@@ -68,8 +66,14 @@ def main() -> None:
     parser.add_argument("--seeds", type=int, default=1, help="training seeds: how many")
     parser.add_argument("--first-seed", type=int, default=0, help="the first training seed")
     parser.add_argument("--config", default="concurrent", help="arl.concurrent_trainer config")
+    parser.add_argument("--cycles", type=int, default=None, help="cycles (default: the config's)")
+    parser.add_argument("--budgets", default="0,1,2,inf", help="budgets certified, e.g. 0,1,2,3")
     parser.add_argument("--time-limit", type=float, default=300.0, help="seconds of exact search")
+    parser.add_argument(
+        "--certify-time", type=float, default=60.0, help="search seconds per fixed policy's budget"
+    )
     args = parser.parse_args()
+    budgets = budgets_of(args.budgets)
     assembly = pipeline.load(Path(args.assembly))
     spec, graph = assembly.spec, pipeline.state_graph(assembly)
     rules = concurrent_rules(spec, graph)
@@ -81,45 +85,74 @@ def main() -> None:
     t0 = time.perf_counter()
     _, result = assembly_makespan(spec, graph, seed=0)
     rows = result.detail.get("schedule") or []
-    seconds = time.perf_counter() - t0
-    print(f"CP-SAT makespan {result.objective:g} ({result.status}, {seconds:.1f} s)")
+    print(
+        f"CP-SAT makespan {result.objective:g} ({result.status}, {time.perf_counter() - t0:.1f} s)"
+    )
     t0 = time.perf_counter()
-    curve = solve_curve(rules, max_k=2, min_k=2, limits=Limits(time_limit=args.time_limit))
-    exact = dict(zip(BUDGETS, [*curve.lower[:3], curve.lower[-1]], strict=True))
-    upper = dict(zip(BUDGETS, [*curve.upper[:3], curve.upper[-1]], strict=True))
-    exact_ok = all(curve.exact)
+    top = max([b for b in budgets if b is not None], default=0)
+    curve = solve_curve(
+        rules, max_k=top, min_k=top, limits=Limits(time_limit=args.time_limit), schedule=rows
+    )
+    ks = [*range(len(curve.lower) - 1), None]
+    lower = {b: v for b, v in zip(ks, curve.lower, strict=True) if math.isfinite(v)}
+    upper = {b: v for b, v in zip(ks, curve.upper, strict=True) if math.isfinite(v)}
+    exact = {b: e for b, e in zip(ks, curve.exact, strict=True)}
     print(
         f"exact search {time.perf_counter() - t0:.1f} s "
-        f"({'exact' if exact_ok else f'stopped by the {curve.stopped}'}, {curve.nodes:,} positions)"
+        f"({'exact' if all(curve.exact) else f'stopped by the {curve.stopped}'}, "
+        f"{curve.nodes:,} positions); exact at k = "
+        + ", ".join("inf" if b is None else str(b) for b in ks if exact[b])
     )
-    search = Search(rules)
-    greedy = certified(search.policy_game(BUDGETS, GREEDY))
-    schedule = certified(search.policy_game(BUDGETS, SCHEDULE, rows)) if rows else {}
-    print(f"{'certified worst case':<22}" + "".join(f"{'k=' + str(b):>9}" for b in BUDGETS))
-    print(row("W*(k)" if exact_ok else "L(k)", exact))
-    if not exact_ok:
-        print(row(f"U(k) ({curve.policy})", upper))
-    print(row("greedy", greedy))
-    print(row("CP-SAT schedule", schedule))
+
+    # The fixed policies: values only (no policy game), each budget in its own time.
+    search = Search(rules, schedule=rows)
+    fixed = {}
+    for name, kind in (("greedy", GREEDY), ("CP-SAT schedule", SCHEDULE)):
+        fixed[name] = {}
+        for b in budgets:
+            got = best_response_values(
+                search, kind, [b], schedule=rows if kind == SCHEDULE else None,
+                time_limit=args.certify_time,
+            )  # fmt: skip
+            if got is not None:
+                fixed[name][b] = got[b]
+    print(
+        f"{'certified worst case':<22}"
+        + "".join(f"{'k=' + ('inf' if b is None else str(b)):>9}" for b in budgets)
+    )
+    print(row("L(k) (search)", lower, budgets))
+    print(row(f"U(k) ({curve.policy})", upper, budgets))
+    for name, values in fixed.items():
+        print(row(name, values, budgets))
     for seed in range(args.first_seed, args.first_seed + args.seeds):
-        run = train_concurrent(rules, args.config, seed=seed, budgets=BUDGETS, progress=True)
-        print(row(f"ARL seed {seed}", run.certified), flush=True)
-        beats = [
-            name
-            for name, other in (("greedy", greedy), ("schedule", schedule))
-            if other and all(run.certified[b] <= other[b] for b in BUDGETS)
+        cfg = args.config
+        if args.cycles is not None:
+            from arl.concurrent_trainer import get_config
+
+            cfg = get_config(cfg).replace(cycles=args.cycles)
+        t0 = time.process_time()
+        run = train_concurrent(rules, cfg, seed=seed, budgets=budgets, progress=True)
+        cpu = time.process_time() - t0
+        print(row(f"ARL seed {seed}", run.certified, budgets), flush=True)
+        both = [b for b in run.certified]
+        verdict = []
+        for name, other in fixed.items():
+            common = [b for b in both if b in other]
+            if not common:
+                continue
+            better = [b for b in common if run.certified[b] < other[b]]
+            worse = [b for b in common if run.certified[b] > other[b]]
+            verdict.append(
+                f"{name}: better at {len(better)}, worse at {len(worse)} of {len(common)} budgets"
+            )
+        gaps = [
+            f"k={'inf' if b is None else b}: {100 * (run.certified[b] - lower[b]) / lower[b]:.1f} %"
+            for b in both
+            if b in lower
         ]
-        strictly = [
-            name
-            for name, other in (("greedy", greedy), ("schedule", schedule))
-            if other and any(run.certified[b] < other[b] for b in BUDGETS)
-        ]
-        gap = 100 * (run.certified[None] - exact[None]) / exact[None]
         print(
-            f"  {run.steps:,} steps in {run.seconds:.0f} s (best cycle {run.best_cycle}); "
-            f"no worse than {', '.join(beats) or 'neither'} at every k, better than "
-            f"{', '.join(strictly) or 'neither'} at some k; {gap:.1f} % above "
-            f"{'W*' if exact_ok else 'L'}(inf)",
+            f"  {run.steps:,} steps, {run.seconds:.0f} s wall, {cpu:.0f} s CPU "
+            f"(best cycle {run.best_cycle}); {'; '.join(verdict)}; above L: {', '.join(gaps)}",
             flush=True,
         )
 

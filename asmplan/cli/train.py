@@ -86,8 +86,6 @@ def _stderr_line(progress: bool):
 MAX_CYCLES = 100_000
 CONCURRENT_CONFIGS = ("concurrent", "concurrent-tiny")
 """The ``--config`` names of :mod:`arl.concurrent_trainer` (checked there)."""
-CERTIFIED_BUDGETS = [0, 1, 2, None]
-"""The budgets a concurrent run's robot is certified at (None: ``k = inf``)."""
 
 
 def _concurrent_rules(source: Path, what: str, max_memory_gb: float | None = None):
@@ -116,8 +114,8 @@ def _train_concurrent(
     limit, the estimate's and the heartbeat's lines, as for the alternating trainer;
     ``max_memory``: ``--max-memory``, GB, for the state graph, the learners and the
     certificates' policy games)."""
+    from arl.concurrent_trainer import DEFAULT_BUDGETS, train_concurrent
     from arl.concurrent_trainer import get_config as concurrent_config
-    from arl.concurrent_trainer import train_concurrent
 
     if turn_model is not None and turn_model.value != CONCURRENT.name:
         raise ValueError(
@@ -131,7 +129,7 @@ def _train_concurrent(
         rules,
         cfg,
         seed=seed,
-        budgets=CERTIFIED_BUDGETS,
+        budgets=DEFAULT_BUDGETS,
         output=output,
         progress=progress,
         max_memory_gb=max_memory,
@@ -145,15 +143,16 @@ def _train_concurrent(
 
 
 def _evaluate_concurrent(source: Path, folder: Path, fmt) -> None:
-    """``evaluate --model RUN`` of a concurrent run: its robot certified at every budget of
-    :data:`CERTIFIED_BUDGETS` by the exact best response
-    (:func:`asp.concurrent.certify.certify`)."""
-    from arl.concurrent_trainer import learned_policy, load_robot
-    from asp.concurrent.certify import certify
+    """``evaluate --model RUN`` of a concurrent run: its robot certified by the exact best
+    response at the budgets the run was certified at (``config.json``), those whose policy
+    game fits (:func:`arl.concurrent_trainer.certify_fitting`)."""
+    from arl.concurrent_trainer import DEFAULT_BUDGETS, certify_fitting, learned_policy, load_robot
 
     rules = _concurrent_rules(source, "a concurrent run (--model)")
     robot = load_robot(folder)
-    cert = certify(rules, learned_policy(rules, robot), CERTIFIED_BUDGETS)
+    budgets = json.loads((folder / "config.json").read_text()).get("budgets", DEFAULT_BUDGETS)
+    say = lambda line: typer.echo(line, err=True)  # noqa: E731
+    cert, _ = certify_fitting(rules, learned_policy(rules, robot), budgets, say=say)
     if fmt is OutputFormat.json:
         doc = {"certified": cert.to_list(), "policy_game_nodes": cert.nodes}
         typer.echo(json.dumps(doc, allow_nan=False))

@@ -142,3 +142,55 @@ def test_the_memory_limit_reaches_the_state_graph_learners_and_certificates(monk
     monkeypatch.setattr(concurrent_trainer, "certify", spy)
     train_concurrent(rules, cfg.replace(cycles=1), budgets=[0], max_memory_gb=2.0)
     assert given == [room]
+
+
+# ------------------------------------ past the exact size: the budgets that fit (issue 23 item 3)
+
+
+def test_a_policy_game_too_large_drops_the_largest_budgets_first(monkeypatch, tmp_path):
+    """certify_fitting: k = inf goes first, then the largest k; what is kept is exactly
+    certify's certificate at the budgets kept; nothing fitting is an error."""
+    from asp.errors import GameLimit
+
+    rules = small_rules()
+    robot, _ = concurrent_trainer._learners(rules, get_config("concurrent-tiny"), 0)
+    choose = learned_policy(rules, robot)
+    full = certify(rules, choose, [0, 1, None])
+
+    def fits(budgets, most):
+        try:
+            certify(rules, choose, budgets, max_nodes=most)
+        except GameLimit:
+            return False
+        return True
+
+    # The largest node limit at which all three budgets do not fit but k = 0 alone does.
+    most = max(m for m in range(1, full.nodes) if fits([0], m) and not fits([0, 1, None], m))
+    said = []
+    cert, kept = concurrent_trainer.certify_fitting(
+        rules, choose, [None, 1, 0], max_nodes=most, say=said.append
+    )
+    assert kept in ([0], [0, 1])
+    assert cert.worst == {b: full.worst[b] for b in kept}
+    assert said[0].startswith("k = inf not certified (") and "\n" not in said[0]
+    with pytest.raises(GameLimit):
+        concurrent_trainer.certify_fitting(rules, choose, [0, None], max_nodes=1)
+    # A run drops k = inf for good (here: a certificate refusing it), ranks by the largest
+    # budget left and saves those.
+    asked = []
+
+    def no_inf(rules, choose, budgets, **kwargs):
+        asked.append(list(budgets))
+        if None in budgets:
+            raise GameLimit("the policy game exceeds 1 nodes")
+        return certify(rules, choose, budgets, **kwargs)
+
+    monkeypatch.setattr(concurrent_trainer, "certify", no_inf)
+    run = train_concurrent(
+        rules, get_config("concurrent-tiny"), budgets=[0, 1, None], seed=1, output=tmp_path
+    )
+    assert asked == [[0, 1, None], [0, 1], [0, 1]]  # cycle 1 tries k = inf once
+    assert sorted(run.certified) == [0, 1]
+    assert all([r["k"] for r in c["certified"]] == [0, 1] for c in run.cycles)
+    config = json.loads((tmp_path / "config.json").read_text())
+    assert config["budgets"] == [0, 1]
