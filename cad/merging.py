@@ -39,16 +39,18 @@ a component that came assembled (or is assembled by flexing, which the file's ge
 cannot show). Planning it as one rigid part changes only files that had no plan (a file
 without such a pair is as before), and removes no way the rest can be assembled.
 
-Its id is the innermost group's when the part is that whole group, else its first
-member's; its mesh is the members' meshes together, its source ``file#a+b+c`` (how a spec
-names such a part: :mod:`cad.loading`), every node of the file it holds (a part joined of
-parts joined before lists their nodes, so a spec written from it reads the same mesh).
+Its id is the innermost group's when the part is that whole group and the file names
+the group, else its first member's; its mesh is the members' meshes together, its source
+``file#a+b+c`` (how a spec names such a part: :mod:`cad.loading`), every node of the file
+it holds (a part joined of parts joined before lists their nodes, so a spec written from
+it reads the same mesh).
 One warning names every part made so. Overlapping parts of no common innermost group stay
 parts (the relations then report them, with the spec lines that accept or join them).
 """
 
 from __future__ import annotations
 
+import re
 import warnings
 from dataclasses import replace
 
@@ -59,6 +61,9 @@ from cad.assembly import Assembly, Part
 from cad.faces import bounds_overlap
 from cad.freedom import eroded_meshes, overlaps
 from cad.tolerances import Tolerances, resolve_tolerances
+
+UNNAMED_GROUP = re.compile(r"group(_\d+)?")
+"""The id :mod:`cad.scene` gives a group node the file leaves unnamed."""
 
 
 def merge_overlapping(assembly: Assembly, file_name: str) -> Assembly:
@@ -228,9 +233,12 @@ def _joined(assembly: Assembly, joined: list[list[int]], file_name: str, why: st
 
 
 def _joined_id(ids: list[str], groups, taken: set[str]) -> str:
-    """The innermost group's id when ``ids`` are that whole group, else the first id."""
+    """The innermost group's id when ``ids`` are that whole group and the file names it,
+    else the first id (a node the file leaves unnamed is ``group_<n>``, :mod:`cad.scene`:
+    the engine's valve springs are ``spring_link_0_parts_1_1`` and ``_11``, the names of
+    their first links, not ``group_8`` and ``group_10``)."""
     wanted = set(ids)
     for gid, group in reversed(groups):  # innermost last in the file's order
-        if set(group) == wanted and gid not in taken:
+        if set(group) == wanted and gid not in taken and not UNNAMED_GROUP.fullmatch(gid):
             return gid
     return ids[0]

@@ -389,3 +389,16 @@ def test_overlapping_members_of_a_group_holding_groups_are_never_joined(tmp_path
             GeometryError, match=r"'block' and 'cover'.*overlap_ok: \[\[block, cover\]\]"
         ):
             compute_relations(assembly)
+
+
+def test_a_spring_under_a_node_the_file_leaves_unnamed_is_named_by_its_first_link(tmp_path):
+    """The two-cylinder engine's spring nodes have no names (read as ``group_<n>``): the
+    joined spring takes its first link's name, which says what it is."""
+    links = {name.replace("link", "coil"): mesh for name, mesh in coil(4).items()}
+    tree = {"group_4": links, "base": box([30, 30, 2], [0, 0, -2.5])}
+    path = write_tree_glb(tmp_path / "engine.glb", tree)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assembly = load_assembly(path)
+    assert assembly.ids == ("base", "coil_0")
+    assert assembly.parts[1].source.endswith("#coil_0+coil_1+coil_2+coil_3")
