@@ -65,10 +65,11 @@ spec's units.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import NamedTuple
 
 import numba
 import numpy as np
+from numba.core import types
+from numba.experimental import structref
 
 from asp.concurrent.build import Commit, Reply
 from asp.concurrent.model import WAIT, ConcurrentModel, concurrent_model
@@ -84,7 +85,46 @@ MAX_WORKERS = 8
 """Workers a position may hold (a cell of more is refused)."""
 
 
-class Tables(NamedTuple):
+TABLE_FIELDS = (
+    "indptr",
+    "dst",
+    "lab",
+    "change",
+    "keys",
+    "complete",
+    "label",
+    "chain_of",
+    "chains",
+    "chain_len",
+    "dur",
+    "ndur",
+    "conflict",
+    "side",
+    "human_op",
+    "human_left",
+    "fast",
+    "side_dur",
+    "n_side",
+    "pred_ptr",
+    "pred",
+    "topo",
+    "flex",
+    "kword",
+    "kshift",
+    "kbits",
+)
+"""The arrays of :class:`Tables`, in order."""
+
+
+@structref.register
+class TablesType(types.StructRef):
+    """The numba type of :class:`Tables`."""
+
+    def preprocess_fields(self, fields):
+        return tuple((name, types.unliteral(t)) for name, t in fields)
+
+
+class Tables(structref.StructRefProxy):
     """The arrays the compiled rules read (shapes: ``N`` states, ``E`` live transitions,
     ``n`` operations, ``W`` workers, ``D`` duration choices, ``C`` chains of length ``L``).
 
@@ -119,34 +159,32 @@ class Tables(NamedTuple):
         The operations both sides may do, by decreasing ratio of robot to human duration.
     kword, kshift, kbits (2 + 2W,) int64
         Where each field of a position row goes in its key (word, shift, width).
+
+    A numba structure reference, not a named tuple: a compiled function that takes a tuple
+    of arrays and may allocate counts a reference to each of them on every call (an atomic
+    increment and decrement each, 26 of them), which was a third of the concurrent search's
+    CPU; a structure is one reference. Built with the arrays by name; in Python each is an
+    attribute, as in a named tuple.
     """
 
-    indptr: np.ndarray
-    dst: np.ndarray
-    lab: np.ndarray
-    change: np.ndarray
-    keys: np.ndarray
-    complete: np.ndarray
-    label: np.ndarray
-    chain_of: np.ndarray
-    chains: np.ndarray
-    chain_len: np.ndarray
-    dur: np.ndarray
-    ndur: np.ndarray
-    conflict: np.ndarray
-    side: np.ndarray
-    human_op: np.ndarray
-    human_left: np.ndarray
-    fast: np.ndarray
-    side_dur: np.ndarray
-    n_side: np.ndarray
-    pred_ptr: np.ndarray
-    pred: np.ndarray
-    topo: np.ndarray
-    flex: np.ndarray
-    kword: np.ndarray
-    kshift: np.ndarray
-    kbits: np.ndarray
+    def __new__(cls, **arrays):
+        missing = [f for f in TABLE_FIELDS if f not in arrays]
+        if missing or len(arrays) != len(TABLE_FIELDS):
+            raise TypeError(f"Tables: expected the arrays {TABLE_FIELDS}, missing {missing}")
+        values = [arrays[f] for f in TABLE_FIELDS]
+        self = structref.StructRefProxy.__new__(cls, *values)
+        self.__dict__.update(zip(TABLE_FIELDS, values, strict=True))
+        return self
+
+    def __reduce__(self):
+        return _tables, (tuple(getattr(self, f) for f in TABLE_FIELDS),)
+
+
+def _tables(values: tuple) -> Tables:
+    return Tables(**dict(zip(TABLE_FIELDS, values, strict=True)))
+
+
+structref.define_proxy(Tables, TablesType, list(TABLE_FIELDS))
 
 
 BIG = 1 << 40
