@@ -27,9 +27,11 @@ rule, fixed so that a generated spec plans the same as the file it writes:
   times as long (rounded to whole seconds); the cost model is ``time``;
 - every gripper approach direction, every constraint on; the units are
   those the files declare (STEP, glTF, 3MF), ``units: mm`` for the others;
-- ``held: true`` on the placement of every part (the base aside) that no other part can
-  stop falling along gravity (:func:`unsupported_parts`: its row of the support relation
-  ``SP_g`` is empty, e.g. a dowel in a through hole or a shaft in a bore with clearance):
+- ``held: true`` on the placement of every part (the base aside) that no part there
+  before it can stop falling along gravity (:func:`unsupported_parts`: its row of the
+  support relation ``SP_g`` is empty, e.g. a dowel in a through hole or a shaft in a bore
+  with clearance, or holds only parts that block it, with the base, along every
+  direction, e.g. a standoff under the speaker it holds up, the product on its side):
   an agent holds it until a later operation fixes it. It needs the part relations, so
   :func:`hold_unsupported` applies it once they are computed (``asmplan.pipeline.load``),
   and :func:`spec_text` computes them to write it;
@@ -76,26 +78,45 @@ def placement_durations(diagonal_mm: float) -> tuple[float, float]:
     return human, float(round(ROBOT_FACTOR * human))
 
 
-HELD_REASON = "nothing below can stop it falling; an agent holds it until a later part fixes it"
+HELD_REASON = (
+    "nothing below can stop it falling (or only parts that must go in after it); an agent "
+    "holds it until a later part fixes it"
+)
 """Why a generated spec marks an operation ``held`` (the comment ``asmplan init`` writes)."""
 
 
 def unsupported_parts(relations, gravity: str, base: str | None = None) -> tuple[str, ...]:
-    """Parts that no other part can keep from falling along ``gravity``.
+    """Parts that nothing there before them can keep from falling along ``gravity``.
 
-    Part ``i`` is unsupported when ``sp[i, j, g]`` is false for every ``j`` (no drop onto
-    any part, threaded on none), so every insertion of it fails the stability test unless
-    an agent holds it. The base part (placed first, never tested) is left out; relations
-    without a support table (built by hand) give none.
+    Part ``i`` (the base part aside: placed first, never tested) is unsupported when every
+    part ``j`` with ``sp[i, j, g]`` (a drop onto ``j``, or threaded on it) *comes after it*:
+    ``j`` and the base part together block ``i`` along every direction (``not tt[i, j, d]
+    or not tt[i, base, d]`` for each ``d``). That covers an empty row (no drop onto any
+    part: a dowel in a through hole, a shaft in a bore with clearance) and a part resting
+    only on the part it holds up (a standoff between a back plate and the speaker on it,
+    the product on its side: only the speaker's pocket stops it falling, and the speaker,
+    with the plate, leaves it no way in).
+
+    **Why it must be held, and why the mark is sound.** The base part is in every state
+    an insertion is tested in, and blocking only grows with the parts there (DESIGN.md:
+    ``TT_d(p, S)`` is the AND over ``S``). So once such a ``j`` is in, ``i`` has no free
+    direction and can never go in: in every complete sequence ``i`` goes in before each
+    part that could support it, and its stability test fails there whatever the order.
+    ``held: true`` (an agent holds it until a later operation fixes it) is what every
+    plan needs; it skips the stability test of ``i`` only, so it adds sequences (the ones
+    with ``i`` held) and removes none, and the independent checker replays the plan with
+    the same mark. (Inside a subassembly's workspace the base is not there; the mark then
+    only lets ``i`` go in before ``j`` as well.)
 
     Parameters
     ----------
     relations : cad.relations.Relations
-        ``parts`` and ``sp`` ``(n, n, 6)`` bool (or None).
+        ``parts``, ``tt`` and ``sp`` ``(n, n, 6)`` bool (``sp`` None: built by hand, none).
     gravity : str
         The spec's gravity direction, e.g. ``"-z"``.
     base : str, optional
-        The base part id.
+        The base part id (None: no part is there first; a supporter must then block
+        ``i`` along every direction by itself).
 
     Returns
     -------
@@ -106,10 +127,16 @@ def unsupported_parts(relations, gravity: str, base: str | None = None) -> tuple
 
     if getattr(relations, "sp", None) is None:
         return ()
-    rows = np.asarray(relations.sp, dtype=bool)[:, :, DIRECTIONS.index(gravity)].any(axis=1)
-    return tuple(
-        str(p) for p, ok in zip(relations.parts, rows, strict=True) if not ok and p != base
-    )
+    ids = [str(p) for p in relations.parts]
+    rests = np.asarray(relations.sp, dtype=bool)[:, :, DIRECTIONS.index(gravity)].copy()
+    np.fill_diagonal(rests, False)
+    tt = np.asarray(relations.tt, dtype=bool)
+    open_ = tt[:, ids.index(base), :] if base in ids else np.ones((len(ids), 6), dtype=bool)
+    after = ~(tt & open_[:, None, :]).any(axis=2)  # after[i, j]: j comes after i
+    if base in ids:
+        after[:, ids.index(base)] = False  # the base is there first
+    loose = ~(rests & ~after).any(axis=1)
+    return tuple(p for p, out in zip(ids, loose, strict=True) if out and p != base)
 
 
 def hold_unsupported(spec: AssemblySpec, relations) -> tuple[AssemblySpec, tuple[str, ...]]:
