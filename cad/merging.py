@@ -16,14 +16,16 @@ the whole product (the node over every part is no group, :mod:`cad.scene`).
 
 Rule (:func:`merge_overlapping`), within each innermost group:
 
-1. *Chains*: a group whose pieces are all one shape (:func:`cad.identical.alike_labels`)
-   and touch each other in one chain (the pieces' surfaces within the pair's contact
-   tolerance, FCL distance, connect them all) is one part: a spring modelled as its coil
-   links (Khronos' ``2CylinderEngine``: each valve spring is ten links, touching end to
-   end, none locking its neighbour), a chain's links, a bead string. Identical copies of a
-   purchased part that are assembled one by one (screws, washers of one group) do not
-   touch each other in one chain; when they do (a stack of identical spacers), the spec's
-   parts name them one by one.
+1. *Chains*: a group of three or more pieces, all one shape
+   (:func:`cad.identical.alike_labels`), touching each other in one chain (the pieces'
+   surfaces within the pair's contact tolerance, FCL distance: they connect all of them,
+   and none touches more than two others, the one before and the one after it) is one
+   part: a spring modelled as its coil links (Khronos' ``2CylinderEngine``: each valve
+   spring is ten links, each touching the next end to end, none locking its neighbour), a
+   chain's links, a bead string. Identical copies of a purchased part that are assembled
+   one by one (screws, washers of one group) do not touch each other in a chain; two
+   identical gears meshing are two pieces, never a chain; when they do (a stack of three
+   identical spacers), the spec's parts name them one by one.
 2. *Overlaps and locks*: two parts of the group that either overlap deeper than their
    tolerance (:func:`cad.freedom.overlaps`, the check the relations make) or, clear of each
    other, *lock* each other (each blocked by the other along all six directions,
@@ -104,8 +106,8 @@ def innermost_groups(groups) -> frozenset[str]:
 
 
 def chain_groups(assembly: Assembly, inner: frozenset[str]) -> list[list[int]]:
-    """Part indices of each innermost group whose pieces are all one shape and touch each
-    other in one chain (module rule 1)."""
+    """Part indices of each innermost group of three or more pieces, all one shape,
+    touching each other in one chain (module rule 1)."""
     import fcl
     from scipy.sparse.csgraph import connected_components
 
@@ -117,7 +119,7 @@ def chain_groups(assembly: Assembly, inner: frozenset[str]) -> list[list[int]]:
     tols = None
     for gid, group in assembly.groups:
         members = [index[m] for m in group if m in index]
-        if gid not in inner or len(members) < 2:
+        if gid not in inner or len(members) < 3:
             continue
         if len(set(alike_labels([assembly.parts[k].mesh for k in members]))) != 1:
             continue
@@ -133,7 +135,9 @@ def chain_groups(assembly: Assembly, inner: frozenset[str]) -> list[list[int]]:
                     objects[i], objects[j], fcl.DistanceRequest(), fcl.DistanceResult()
                 )
                 touch[i, j] = dist <= gap
-        if connected_components(touch, directed=False)[0] == 1:
+        touch |= touch.T
+        in_a_chain = touch.sum(axis=1).max() <= 2  # each touches the one before and after
+        if in_a_chain and connected_components(touch, directed=False)[0] == 1:
             chains.append(members)
     return chains
 

@@ -402,3 +402,16 @@ def test_a_spring_under_a_node_the_file_leaves_unnamed_is_named_by_its_first_lin
         assembly = load_assembly(path)
     assert assembly.ids == ("base", "coil_0")
     assert assembly.parts[1].source.endswith("#coil_0+coil_1+coil_2+coil_3")
+
+
+def test_identical_pieces_touching_other_than_in_a_chain_stay_parts(tmp_path):
+    """Two identical gears meshing (two pieces) and four identical blocks in a square
+    (each touching three, corners included) are no chain: each piece stays a part."""
+    pair = {"gear_a": box([10, 10, 4], [0, 0, 2]), "gear_b": box([10, 10, 4], [10, 0, 2])}
+    square = {f"block_{k}": box([5, 5, 5], [5.0 * (k % 2), 5.0 * (k // 2), 2.5]) for k in range(4)}
+    tree = {"gears": pair, "blocks": square, "plate": box([40, 40, 2], [5, 5, -1])}
+    path = write_tree_glb(tmp_path / "train.glb", tree)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        ids = load_assembly(path).ids
+    assert set(ids) == {"plate", *pair, *square}
