@@ -66,7 +66,8 @@ Every rule that cuts the search, with its proof:
 
 8. *Moves memoised.* A position's commitments (:func:`asp.concurrent.rules.commit_rows`)
    depend on its state and on which operation each worker runs, not on the remaining times
-   nor on the budget (the kernel reads no other field), so each search call keeps them per
+   nor on the budget (the kernel reads no other field), so one :class:`Search` keeps them
+   (across its calls: every budget and the robust policy's game) per
    ``(state, running operations)`` (:func:`_commits_of`) and positions that differ only
    there share one list. Likewise the human side's joint choices after a commitment
    (:func:`asp.concurrent.rules.reply_choices`: every rule of a reply but the budget) per
@@ -609,13 +610,16 @@ def _choices_of(T, mv, cur, told):  # pragma: no cover - compiled
 
 
 ENTER, NEXT_COMMIT, NEXT_REPLY, AFTER_CHILD = 0, 1, 2, 3
-"""Phases of a frame of :func:`_search`'s explicit stack."""
+"""Phases of a frame of :func:`_search_memo`'s explicit stack."""
 
 
 @numba.njit(cache=True)
-def _search(T, H, root, alpha, beta, st, prefs, n_prefs):  # pragma: no cover - compiled
+def _search_memo(T, H, root, alpha, beta, st, prefs, n_prefs, moves, replies):  # pragma: no cover
     """The value of position ``root`` in the window ``(alpha, beta)`` (fail-soft, module
-    docstring); 0 when stopped (``st[ABORT]``; nothing is stored then).
+    docstring); 0 when stopped (``st[ABORT]``; nothing is stored then). ``moves`` and
+    ``replies`` are the memos of rule 8 (:func:`_commits_of`, :func:`_choices_of`), kept by
+    the caller from one call to the next (they depend on the rules alone): ``(value, moves,
+    replies)``, the memos as grown.
 
     Depth-first with an explicit stack of positions (numba cannot cache a recursive
     function): a frame is a position, its commitments in the order tried and, for the one
@@ -665,10 +669,8 @@ def _search(T, H, root, alpha, beta, st, prefs, n_prefs):  # pragma: no cover - 
         rdelta_l.append(np.empty((1, 2), np.int64)[:0, 1])
         rlbs_l.append(np.empty(0, np.int64))
         rby_l.append(np.empty(0, np.int64))
-    moves = _new_moves(nw, 64, 256)  # the commitments of each (state, running ops)
-    replies = _new_moves(nw + 1, 64, 256)  # the human side's choices (rule 8)
     if root[0] < 0:
-        return 0
+        return 0, moves, replies
     d = 0
     rows[0] = root
     win_a[0], win_b[0], phase[0], lbh[0] = alpha, beta, ENTER, -1
@@ -680,7 +682,7 @@ def _search(T, H, root, alpha, beta, st, prefs, n_prefs):  # pragma: no cover - 
             made = st[ENTRIES]
             s_ = _entry(T, H, row, st, lbh[d])
             if s_ < 0:
-                return 0
+                return 0, moves, replies
             lo, hi = H.lo[s_], H.hi[s_]
             if lo < win_b[d] and lo < hi and hi > win_a[d] and st[ENTRIES] == made:
                 # met again: the other budgets' entries may prove more by now (rules 9, 10)
@@ -697,9 +699,9 @@ def _search(T, H, root, alpha, beta, st, prefs, n_prefs):  # pragma: no cover - 
             st[NODES] += 1
             if st[NODES] >= st[NODE_LIMIT]:
                 st[ABORT] = STOP_NODES
-                return 0
+                return 0, moves, replies
             if (st[NODES] & TICK) == 0 and _tick(st):
-                return 0
+                return 0, moves, replies
             slot[d] = s_
             a_[d] = max(win_a[d], lo)
             b_[d] = min(win_b[d], hi)
@@ -826,7 +828,7 @@ def _search(T, H, root, alpha, beta, st, prefs, n_prefs):  # pragma: no cover - 
             v[d] = w
         jr[d] += 1
         phase[d] = NEXT_REPLY
-    return ret
+    return ret, moves, replies
 
 
 # --------------------------------------------------------------------------- policy games
@@ -837,30 +839,9 @@ def _choose(T, H, row, commits, kind, prefs, n_prefs, st):  # pragma: no cover -
     """The commitment (index) a policy of ``kind`` takes at ``row``; -1 when stopped."""
     m = commits.shape[0]
     if kind == ROBUST:
-        key = key_of(T, row)
-        i = _find(H, key)
-        if i >= 0:
-            _refresh(T, H, row, key, i)  # what the other budgets prove (rules 9, 10)
-            if H.lo[i] == H.hi[i] and H.move[i] >= 0:
-                return H.move[i]  # exact with its move: what the search below would return
-            # a higher budget's move proving at most the proven floor (rule 10)
-            f = _move_above(T, H, row, key, H.lo[i], m)
-            if f >= 0:
-                return f
-        v = _search(T, H, row, -1, INF, st, prefs, n_prefs)
-        if st[ABORT]:
-            return -1
-        i = _find(H, key)
-        if H.move[i] < 0:
-            f = _move_above(T, H, row, key, v, m)
-            if f >= 0:
-                return f
-            # exact by bounds alone (rule 3): search again for the move
-            H.hi[i] = INF
-            _search(T, H, row, v - 1, v + 1, st, prefs, n_prefs)
-            if st[ABORT]:
-                return -1
-        return H.move[i]
+        nw = T.side.shape[0]
+        moves, replies = _new_moves(nw, 64, 256), _new_moves(nw + 1, 64, 256)
+        return _robust_move(T, H, row, m, st, prefs, n_prefs, moves, replies)[0]
     if kind == HYBRID:  # the table's move of the same state at the highest budget it has
         other = row.copy()
         for b in range(budget_cap_of(T, row), -1, -1):
@@ -876,6 +857,40 @@ def _choose(T, H, row, commits, kind, prefs, n_prefs, st):  # pragma: no cover -
         if e < best:
             best, best_i = e, i
     return best_i
+
+
+@numba.njit(cache=True)
+def _robust_move(T, H, row, m, st, prefs, n_prefs, moves, replies):  # pragma: no cover
+    """The robust policy's commitment (index, of ``m``) at ``row``, -1 when stopped: the
+    table's move where it is exact, else a higher budget's that proves the floor (rule 10),
+    else the search's, run to the exact value (:func:`_search_memo`, with the caller's memos
+    of rule 8): ``(index, moves, replies)``."""
+    key = key_of(T, row)
+    i = _find(H, key)
+    if i >= 0:
+        _refresh(T, H, row, key, i)  # what the other budgets prove (rules 9, 10)
+        if H.lo[i] == H.hi[i] and H.move[i] >= 0:
+            return H.move[i], moves, replies  # exact with its move: what a search would return
+        # a higher budget's move proving at most the proven floor (rule 10)
+        f = _move_above(T, H, row, key, H.lo[i], m)
+        if f >= 0:
+            return f, moves, replies
+    v, moves, replies = _search_memo(T, H, row, -1, INF, st, prefs, n_prefs, moves, replies)
+    if st[ABORT]:
+        return -1, moves, replies
+    i = _find(H, key)
+    if H.move[i] < 0:
+        f = _move_above(T, H, row, key, v, m)
+        if f >= 0:
+            return f, moves, replies
+        # exact by bounds alone (rule 3): search again for the move
+        H.hi[i] = INF
+        _, moves, replies = _search_memo(
+            T, H, row, v - 1, v + 1, st, prefs, n_prefs, moves, replies
+        )
+        if st[ABORT]:
+            return -1, moves, replies
+    return H.move[i], moves, replies
 
 
 @numba.njit(cache=True)
@@ -954,12 +969,14 @@ def _node_row(row, kind, told, nw):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True)
-def _policy_game(T, H, P, starts, kind, prefs, n_prefs, st, max_nodes):  # pragma: no cover
+def _policy_game(T, H, P, starts, kind, prefs, n_prefs, st, max_nodes, memos):  # pragma: no cover
     """The policy game of ``kind`` from the rows ``starts`` (module docstring).
 
     Node 0 is the end; robot and human nodes alternate. Returns ``(ok, node rows, start
     nodes, edge src, dst, cost, side, ops, durations, deviations)``; ``ok`` False when
-    stopped (``st[ABORT]``) or over ``max_nodes``."""
+    stopped (``st[ABORT]``) or over ``max_nodes``. ``memos`` (a list of one ``(moves,
+    replies)``, rule 8's memos of the caller's search) is read and left grown."""
+    moves, replies = memos[0]
     nw = T.side.shape[0]
     width = 3 + 3 * nw
     nodes = np.zeros((1024, width), np.int64)
@@ -998,8 +1015,14 @@ def _policy_game(T, H, P, starts, kind, prefs, n_prefs, st, max_nodes):  # pragm
         top -= 1
         row = stack[top].copy()
         v = P.lo[_slot(P, key_of(T, row))]
-        commits = commit_rows(T, row)
-        i = _choose(T, H, row, commits, kind, prefs, n_prefs, st)
+        commits, moves = _commits_of(T, moves, row)
+        if kind == ROBUST:
+            i, moves, replies = _robust_move(
+                T, H, row, commits.shape[0], st, prefs, n_prefs, moves, replies
+            )
+        else:
+            i = _choose(T, H, row, commits, kind, prefs, n_prefs, st)
+        memos[0] = (moves, replies)
         if i < 0 or n + 1 >= max_nodes:
             return False, nodes[:n], start_ids, e_src[:m], e_dst[:m], e_cost[:m], e_side[:m], \
                 e_ops[:m], e_dur[:m], e_dev[:m]  # fmt: skip
@@ -1089,16 +1112,27 @@ def _compile_kernels(rules: Rules, prefs: np.ndarray, n_prefs: np.ndarray) -> No
     touched."""
     kw = rules.key_words
     row = rules.start(0).row()
-    for kernel in (_search, _policy_game):
+    for kernel in (_search_memo, _policy_game):
         stats = np.zeros(N_STATS, dtype=np.int64)
         stats[MAX_ENTRIES], stats[NODE_LIMIT] = MIN_ENTRIES // 2, 1
         table = new_table(MIN_ENTRIES, kw)
-        if kernel is _search:
-            _search(rules.tables, table, row, -1, INF, stats, prefs, n_prefs)
+        memos = new_memos(rules.n_workers)
+        if kernel is _search_memo:
+            _search_memo(rules.tables, table, row, -1, INF, stats, prefs, n_prefs, *memos[0])
         else:
             starts = np.array([row], dtype=np.int64)
             other = new_table(MIN_ENTRIES, kw)
-            _policy_game(rules.tables, table, other, starts, GREEDY, prefs, n_prefs, stats, 1)
+            _policy_game(
+                rules.tables, table, other, starts, GREEDY, prefs, n_prefs, stats, 1, memos
+            )
+
+
+def new_memos(n_workers: int) -> List:
+    """Free memos of rule 8 (the commitments, the human side's choices) as a list of one
+    ``(moves, replies)``, which :func:`_policy_game` reads and leaves grown."""
+    memos = List()
+    memos.append((_new_moves(n_workers, 64, 256), _new_moves(n_workers + 1, 64, 256)))
+    return memos
 
 
 @dataclass
@@ -1146,6 +1180,9 @@ class Search:
                 f"search (at least {need:,.0f} bytes)"
             )
         self.table = new_table(min(self.entries, FIRST_ENTRIES), kw)
+        # rule 8's memos, kept from one search call to the next (they depend on the rules
+        # alone; at most one entry per position or human node expanded)
+        self.memos = new_memos(rules.n_workers)
         self.stats = np.zeros(N_STATS, dtype=np.int64)
         self.stats[MAX_ENTRIES] = min(self.entries, int(self.table.keys.shape[0] * LOAD))
         limit = self.limits.time_limit
@@ -1224,11 +1261,16 @@ class Search:
         self.stats[NODE_LIMIT] = self._cap(nodes)
 
     def _run(self, row, alpha: int, beta: int) -> int:
-        """:func:`_search` of ``row``, again with a larger table while it grows (the entries
+        """:func:`_search_memo` of ``row``, again with a larger table while it grows (the entries
         kept, so the search goes on where it stopped)."""
         t = self.rules.tables
         while True:
-            v = _search(t, self.table, row, alpha, beta, self.stats, self.prefs, self.n_prefs)
+            moves, replies = self.memos[0]
+            v, moves, replies = _search_memo(
+                t, self.table, row, alpha, beta, self.stats, self.prefs, self.n_prefs, moves,
+                replies,
+            )  # fmt: skip
+            self.memos[0] = (moves, replies)
             if not self._grow():
                 self._noted()
                 return int(v)
@@ -1310,8 +1352,9 @@ class Search:
         while True:  # a table for ``room`` nodes, four times larger while it is over
             table = new_table(room, kw)
             out = _policy_game(
-                rules.tables, self.table, table, starts, kind, prefs, n_prefs, self.stats, room
-            )
+                rules.tables, self.table, table, starts, kind, prefs, n_prefs, self.stats, room,
+                self.memos,
+            )  # fmt: skip
             if out[0]:
                 break
             if self._grow():
