@@ -11,6 +11,17 @@ training cost (environment steps, seconds). Lower is better; every figure is exa
     nice -n 10 .venv/bin/python benchmarks/arl_concurrent.py
     nice -n 10 .venv/bin/python benchmarks/arl_concurrent.py --seeds 3 --config concurrent
     nice -n 10 .venv/bin/python benchmarks/arl_concurrent.py ASSEMBLY --time-limit 120
+    nice -n 5 .venv/bin/python benchmarks/arl_concurrent.py cycloidal.3DXML \
+        --budgets 0,1,2,3,inf --cycles 12 --seeds 2 --time-limit 120
+
+Past the exact size the fixed policies are certified by values only
+(:func:`asp.concurrent.certify.best_response_values`, ``--certify-time`` search seconds a
+budget) and the learned robot at the budgets whose policy game fits
+(:func:`arl.concurrent_trainer.certify_fitting`); ``-`` marks a budget not certified.
+On the 72-part cycloidal drive (2026-12-04): L(k) 192 at k = 0..3 and inf; U(k) 192 / 192 /
+192 / 216; greedy 316; CP-SAT schedule 195 / 204 / 212 / 216; ARL seed 0 195 / 203 / 203 / 203,
+seed 1 198 / 199 / 200 / 201 (24,576 steps, 162-178 s CPU each); nothing certified at k = inf
+(README, "Learning the robot policy").
 
 Measured (2026-12-02, the shared 2-core machine, config ``concurrent``: 9 cycles, 18,432
 environment steps; certified worst case at k = 0 / 1 / 2 / inf; seconds are the training's,
