@@ -172,7 +172,7 @@ class Tables(structref.StructRefProxy):
         if missing or len(arrays) != len(TABLE_FIELDS):
             raise TypeError(f"Tables: expected the arrays {TABLE_FIELDS}, missing {missing}")
         values = [arrays[f] for f in TABLE_FIELDS]
-        self = structref.StructRefProxy.__new__(cls, *values)
+        self = _new_tables(*values)  # (compiled and cached: numba's own constructor is not)
         self.__dict__.update(zip(TABLE_FIELDS, values, strict=True))
         return self
 
@@ -185,6 +185,20 @@ def _tables(values: tuple) -> Tables:
 
 
 structref.define_proxy(Tables, TablesType, list(TABLE_FIELDS))
+
+
+@numba.njit(cache=True)
+def _new_tables(
+    indptr, dst, lab, change, keys, complete, label, chain_of, chains, chain_len, dur, ndur,
+    conflict, side, human_op, human_left, fast, side_dur, n_side, pred_ptr, pred, topo, flex,
+    kword, kshift, kbits,
+):  # fmt: skip  # pragma: no cover - compiled
+    """A :class:`Tables` of these arrays (in the order of :data:`TABLE_FIELDS`)."""
+    return Tables(
+        indptr, dst, lab, change, keys, complete, label, chain_of, chains, chain_len, dur, ndur,
+        conflict, side, human_op, human_left, fast, side_dur, n_side, pred_ptr, pred, topo, flex,
+        kword, kshift, kbits,
+    )  # fmt: skip
 
 
 BIG = 1 << 40

@@ -1112,13 +1112,13 @@ def _compile_kernels(rules: Rules, prefs: np.ndarray, n_prefs: np.ndarray) -> No
     touched."""
     kw = rules.key_words
     row = rules.start(0).row()
-    for kernel in (_search_memo, _policy_game):
+    for kernel in (_search_in, _policy_game):
         stats = np.zeros(N_STATS, dtype=np.int64)
         stats[MAX_ENTRIES], stats[NODE_LIMIT] = MIN_ENTRIES // 2, 1
         table = new_table(MIN_ENTRIES, kw)
         memos = new_memos(rules.n_workers)
-        if kernel is _search_memo:
-            _search_memo(rules.tables, table, row, -1, INF, stats, prefs, n_prefs, *memos[0])
+        if kernel is _search_in:
+            _search_in(rules.tables, table, row, -1, INF, stats, prefs, n_prefs, memos)
         else:
             starts = np.array([row], dtype=np.int64)
             other = new_table(MIN_ENTRIES, kw)
@@ -1127,12 +1127,24 @@ def _compile_kernels(rules: Rules, prefs: np.ndarray, n_prefs: np.ndarray) -> No
             )
 
 
-def new_memos(n_workers: int) -> List:
+@numba.njit(cache=True)
+def new_memos(n_workers):  # pragma: no cover - compiled
     """Free memos of rule 8 (the commitments, the human side's choices) as a list of one
-    ``(moves, replies)``, which :func:`_policy_game` reads and leaves grown."""
+    ``(moves, replies)``, which :func:`_search_in` and :func:`_policy_game` read and leave
+    grown (made and read in compiled code only: a typed list's methods called from Python
+    compile on every run)."""
     memos = List()
     memos.append((_new_moves(n_workers, 64, 256), _new_moves(n_workers + 1, 64, 256)))
     return memos
+
+
+@numba.njit(cache=True)
+def _search_in(T, H, root, alpha, beta, st, prefs, n_prefs, memos):  # pragma: no cover
+    """:func:`_search_memo` with the memos of ``memos`` (:func:`new_memos`), left grown."""
+    moves, replies = memos[0]
+    v, moves, replies = _search_memo(T, H, root, alpha, beta, st, prefs, n_prefs, moves, replies)
+    memos[0] = (moves, replies)
+    return v
 
 
 @dataclass
@@ -1265,12 +1277,9 @@ class Search:
         kept, so the search goes on where it stopped)."""
         t = self.rules.tables
         while True:
-            moves, replies = self.memos[0]
-            v, moves, replies = _search_memo(
-                t, self.table, row, alpha, beta, self.stats, self.prefs, self.n_prefs, moves,
-                replies,
-            )  # fmt: skip
-            self.memos[0] = (moves, replies)
+            v = _search_in(
+                t, self.table, row, alpha, beta, self.stats, self.prefs, self.n_prefs, self.memos
+            )
             if not self._grow():
                 self._noted()
                 return int(v)

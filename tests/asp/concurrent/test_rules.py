@@ -160,6 +160,34 @@ def test_hand_checked_job_moves_and_positions():
     assert rules.key(after_p) != rules.key(start)
 
 
+def test_tables_are_one_structure_with_every_array_by_name_and_pickle():
+    # The rules' arrays are one numba structure (one reference per kernel call); in Python
+    # each is an attribute, a pickled copy plays the same moves, and a missing array is
+    # refused by name.
+    import pickle
+
+    from asp.concurrent.rules import TABLE_FIELDS, Rules, Tables
+
+    spec, graph = job(
+        [
+            {"id": "p", "agents": {"H": 1}},
+            {"id": "q", "agents": {"H": 5}},
+            {"id": "r", "agents": {"R": 5}, "after": ["p"]},
+        ]
+    )
+    rules = concurrent_rules(spec, graph)
+    t = rules.tables
+    assert all(isinstance(getattr(t, f), np.ndarray) for f in TABLE_FIELDS)
+    copy = Rules(model=rules.model, tables=pickle.loads(pickle.dumps(t)), fixed=rules.fixed)
+    for f in TABLE_FIELDS:
+        assert np.array_equal(getattr(copy.tables, f), getattr(t, f))
+    assert minimax(copy, copy.start(1)) == minimax(rules, rules.start(1)) == 11
+    assert copy.lower_bound(copy.start(1)) == rules.lower_bound(rules.start(1))
+    arrays = {f: getattr(t, f) for f in TABLE_FIELDS if f != "flex"}
+    with pytest.raises(TypeError, match="flex"):
+        Tables(**arrays)
+
+
 def test_end_position_and_budget_errors():
     spec, graph = job([{"id": "a", "agents": {"R": 2}}], agents={"R": {"side": "robot"}})
     rules = concurrent_rules(spec, graph)
