@@ -130,8 +130,8 @@ def test_lower_bound_is_admissible_everywhere_on_random_jobs():
                 seen.extend(nxt for _, nxt in rules.replies(pos, c))
 
 
-def test_hand_checked_job_moves_and_positions():
-    # The person should do p (1 s) so the robot can start r; q first costs 5 s of idle.
+def p_q_r_rules():
+    """The person's p (1 s) or q (5 s), then the robot's r after p."""
     spec, graph = job(
         [
             {"id": "p", "agents": {"H": 1}},
@@ -139,7 +139,12 @@ def test_hand_checked_job_moves_and_positions():
             {"id": "r", "agents": {"R": 5}, "after": ["p"]},
         ]
     )
-    rules = concurrent_rules(spec, graph)
+    return concurrent_rules(spec, graph)
+
+
+def test_hand_checked_job_moves_and_positions():
+    # The person should do p (1 s) so the robot can start r; q first costs 5 s of idle.
+    rules = p_q_r_rules()
     start = rules.start(1)
     assert start == Position(0, 1, ((WAIT, 0), (WAIT, 0)))
     assert rules.budget_cap(start) == 2 and rules.start(None).budget == 2
@@ -168,14 +173,7 @@ def test_tables_are_one_structure_with_every_array_by_name_and_pickle():
 
     from asp.concurrent.rules import TABLE_FIELDS, Rules, Tables
 
-    spec, graph = job(
-        [
-            {"id": "p", "agents": {"H": 1}},
-            {"id": "q", "agents": {"H": 5}},
-            {"id": "r", "agents": {"R": 5}, "after": ["p"]},
-        ]
-    )
-    rules = concurrent_rules(spec, graph)
+    rules = p_q_r_rules()
     t = rules.tables
     assert all(isinstance(getattr(t, f), np.ndarray) for f in TABLE_FIELDS)
     copy = Rules(model=rules.model, tables=pickle.loads(pickle.dumps(t)), fixed=rules.fixed)
