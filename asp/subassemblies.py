@@ -188,7 +188,15 @@ def build_with_units(
                     return groups, False
             else:
                 return units_of(graph, stuck_operations(graph)), False
-        graph = build_state_graph(with_units, relations, **unchecked)
+        try:
+            graph = build_state_graph(with_units, relations, **unchecked)
+        except StateLimit:
+            if proof is None:
+                raise
+            # too many states to find the stuck operations: the file's units the proof
+            # involves are given up (None: all of them, or the proof is the error)
+            drop.update(_proof_units(with_units, proof, optional))
+            return None, True
         return units_of(graph, stuck_operations(graph)), True
 
     first_error = None
@@ -372,45 +380,94 @@ def refuted_units(
     on_unit: Callable[[str], None] | None = None,
 ) -> set[str]:
     """The CAD file's sub-assemblies to give up before any state graph is built: those the
-    derived precedences prove leave no complete sequence (:func:`asp.graph.precedences.refutation`,
-    milliseconds), with ``exclude``.
+    derived precedences prove leave no complete sequence (:func:`refuted_reasons`), with
+    ``exclude``; each given up is said with its proof on ``on_unit``."""
+    say = on_unit or (lambda _line: None)
+    reasons = refuted_reasons(spec, relations, exclude)
+    for line in dict.fromkeys(reasons.values()):
+        say(line)
+    return set(exclude) | set(reasons)
+
+
+def refuted_reasons(spec: AssemblySpec, relations, exclude: Iterable[str] = ()) -> dict[str, str]:
+    """The CAD file's sub-assemblies the derived precedences prove leave no complete
+    sequence (:func:`asp.graph.precedences.refutation`, milliseconds), each with the one line
+    that says so (the units given up together share it); ``exclude``: given up already.
 
     While the file's units (:func:`with_cad_units`, without the ones given up) admit such a
     proof, the units it involves are given up (the unit it names, or whose members its
     failing test looks at: what a part could rest on, touch or is blocked by; all of them
-    when it names none) and each is said with the proof on ``on_unit``; the file's inner
-    groups may then become units. When the same operation fails in the spec without units
-    (a holder blocked by its bearings, whatever the file groups), the units are not the
-    cause and are left to the state graph (:func:`build_with_units`: automatic units).
-    Sound: a proof holds for every order, so the state graph would give these units up as
-    well, after building it.
+    when it names none); the file's inner groups may then become units. When the same
+    operation fails in the spec without units (a holder blocked by its bearings, whatever
+    the file groups), the units are not the cause and are left to the state graph
+    (:func:`build_with_units`: automatic units); a unit the proof names itself (its
+    insertion: blocked along every direction by parts that must be there before it, as a
+    piston with its pin, grouped without the rod the pin passes through) is always the
+    cause, since without it that operation does not exist.
+
+    Sound, it removes no plan that was possible: a proof holds for every order, so with
+    the units of that round no sequence is complete, and a plan keeps every unit it is
+    given (each is built in its workspace and inserted as one body), so no plan has those
+    units; the state graph would give them up as well, after building it. The file's
+    groups only ever restrict the sequences of the loose parts (a unit's sequences are the
+    loose sequences whose members go in together), so planning without them loses none.
     """
     from asp.graph.precedences import refutation
 
-    say = on_unit or (lambda _line: None)
     given_up = set(exclude)
+    out: dict[str, str] = {}
     while True:
         with_units, choices = with_cad_units(spec, relations, given_up)
         used = {u.id: set(u.members) for u in choices if u.used}
         if not used:
-            return given_up
+            return out
         proof = refutation(hold_unsupported_units(with_units, relations), relations)
         if proof is None:
-            return given_up
-        alone = refutation(spec, relations)
-        if alone is not None and alone.operation == proof.operation:
-            return given_up  # the same part fails without units: they are not the cause
+            return out
         op = with_units.operation(proof.operation)
-        named = set(proof.parts) | set(op.parts)
-        drop = {u for u, members in used.items() if u == op.unit or members & named}
-        drop = drop or set(used)
+        if op.unit not in used:
+            alone = refutation(spec, relations)
+            if alone is not None and alone.operation == proof.operation:
+                return out  # the same part fails without units: they are not the cause
+        drop = _proof_units(with_units, proof, used) or set(used)
         given_up |= drop
         one = len(drop) == 1
-        say(
+        line = (
             f"the file's sub-assembl{'y' if one else 'ies'} {', '.join(sorted(drop))}: no "
             f"complete sequence with {'it as one unit' if one else 'them as units'} "
             f"({proof.why}); planned without {'it' if one else 'them'}"
         )
+        out.update(dict.fromkeys(drop, line))
+
+
+def _proof_units(spec: AssemblySpec, proof, units: dict[str, set[str]]) -> set[str]:
+    """The units of ``units`` (id -> members) a proof involves: the one whose insertion it
+    names, and those whose members its operation places or its failing test looks at."""
+    op = spec.operation(proof.operation)
+    named = set(proof.parts) | set(op.parts)
+    return {u for u, members in units.items() if u == op.unit or members & named}
+
+
+def file_units(
+    spec: AssemblySpec, relations, on_unit: Callable[[str], None] | None = None
+) -> tuple[HierarchyUnit, ...]:
+    """The decisions on the CAD file's sub-assemblies that a plan of the file starts from
+    (``asmplan init`` writes them): :func:`cad_units` without the ones the derived
+    precedences prove leave no complete sequence (:func:`refuted_reasons`: their reason is
+    the proof, said on ``on_unit`` too), so a written spec never fixes a unit the plan of
+    the file gives up (the two-cylinder engine's piston with its pin, grouped without the
+    rod the pin passes through)."""
+    reasons = refuted_reasons(spec, relations)
+    say = on_unit or (lambda _line: None)
+    for line in dict.fromkeys(reasons.values()):
+        say(line)
+    out = []
+    for u in cad_units(spec, relations, reasons):
+        if u.id in reasons and u.reason == GIVEN_UP:
+            why = reasons[u.id].split(": ", 1)[1].removesuffix("; planned without it")
+            u = replace(u, reason=why.removesuffix("; planned without them"))
+        out.append(u)
+    return tuple(out)
 
 
 def prepared_units(spec: AssemblySpec, relations, on_unit=None) -> AssemblySpec:
@@ -905,8 +962,10 @@ __all__ = [
     "HierarchyUnit",
     "build_with_units",
     "cad_units",
+    "file_units",
     "hierarchy_line",
     "host_groups",
+    "refuted_reasons",
     "refuted_units",
     "unit_members",
     "unit_parts_of_line",

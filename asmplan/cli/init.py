@@ -30,7 +30,7 @@ def init_command(
     from asp.atomic import write_text
     from asp.fromcad.generate import spec_text
     from asp.spec import spec_from_dict
-    from asp.subassemblies import cad_units
+    from asp.subassemblies import file_units
     from cad.yamlfile import DecimalsAsText
 
     if not source.exists():
@@ -38,13 +38,17 @@ def init_command(
     check_output(output, folder=False)
     if output.exists() and not force:
         raise ValueError(f"{output} exists (use --force to overwrite it)")
+
+    def say(line: str) -> None:
+        typer.echo(line, err=True)
+
     text = spec_text(
         source,
         spec_folder=output.parent,
         contact_tol=contact_tol,
         penetration_tol=penetration_tol,
-        on_note=lambda line: typer.echo(line, err=True),
-        decide_units=cad_units,
+        on_note=say,
+        decide_units=lambda spec, rel: file_units(spec, rel, on_unit=say),
         units=units,
         gravity=gravity,
     )

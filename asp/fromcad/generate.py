@@ -36,7 +36,7 @@ rule, fixed so that a generated spec plans the same as the file it writes:
   :func:`hold_unsupported` applies it once they are computed (``asmplan.pipeline.load``),
   and :func:`spec_text` computes them to write it;
 - subassemblies: the file's sub-assemblies that can be built on their own and inserted
-  as one unit (:func:`asp.subassemblies.cad_units`: not holding the base part, buildable in their
+  as one unit (:func:`asp.subassemblies.file_units`: not holding the base part, buildable in their
   own workspace, free from the base part along some direction) are units; the others are
   written commented with the reason. The state graph of a generated spec gives up a unit
   that leaves no complete sequence (:func:`asp.subassemblies.build_with_units`).
@@ -672,7 +672,7 @@ def spec_text(
     the ``held`` marks; else both keys are written commented out. ``on_note`` (optional) is
     called with a line for each decision of :func:`decide_generated` (build frame,
     gravity, base part, ``held``). ``decide_units(spec,
-    relations)`` (:func:`asp.subassemblies.cad_units`, given by the caller: it sits above this
+    relations)`` (:func:`asp.subassemblies.file_units`, given by the caller: it sits above this
     module) decides which of the file's sub-assemblies are written as ``subassemblies:``;
     without it they are all written commented. ``units`` (of mesh files that declare
     none) and ``gravity`` (kept, not chosen): ``--units`` and ``--gravity``.

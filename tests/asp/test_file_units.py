@@ -1,0 +1,93 @@
+"""The CAD file's groups that the derived precedences prove can never be one unit are not
+written or kept as units (asp/subassemblies.py: file_units, refuted_reasons)."""
+
+from __future__ import annotations
+
+import numpy as np
+import trimesh
+
+from tests.cad.real_shapes import box, cylinder, difference
+from tests.cad.test_subassemblies import write_glb
+
+
+def pin_along_x(radius: float, x0: float, x1: float, z: float) -> trimesh.Trimesh:
+    """A pin along x from ``x0`` to ``x1`` at height ``z`` (mm)."""
+    turn = trimesh.transformations.rotation_matrix(np.pi / 2, (0, 1, 0))  # z -> x
+    pin = cylinder(radius, -x1, -x0, 24).apply_transform(turn)
+    return pin.apply_translation((0, 0, z))
+
+
+def piston_on_rod() -> dict:
+    """A crankcase, a connecting rod standing on it, a piston whose slot takes the rod's
+    top (it rests on the rod) and a pin through the piston's cheeks and the rod's eye."""
+
+    def eye():
+        return pin_along_x(2.0, -20, 20, 34)
+
+    return {
+        "crankcase": box((-30, -30, 0), (30, 30, 5)),
+        "rod": difference(box((-4, -4, 5), (4, 4, 40)), eye()),
+        "piston": difference(
+            box((-10, -10, 28), (10, 10, 50)), box((-4, -4, 27), (4, 4, 40)), eye()
+        ),
+        "pin": pin_along_x(2.0, -10, 10, 34),
+    }
+
+
+PISTON_TREE = {"Product": ["crankcase", "rod", "Piston group"], "Piston group": ["piston", "pin"]}
+
+
+def test_the_scene_is_a_pin_through_the_rod():
+    parts = piston_on_rod()
+    assert all(m.is_watertight for m in parts.values())
+    assert parts["pin"].bounds.tolist() == [[-10, -2, 32], [10, 2, 36]]
+
+
+def test_init_writes_no_unit_that_can_never_go_in(tmp_path):
+    """The file groups the piston with its pin but not the rod the pin passes through: the
+    group can be built (pin into piston) and touches the rod, so it passes the unit checks,
+    but inserted as one body it is blocked along every direction by the rod, on which alone
+    it rests (so the rod is there first). ``init`` writes it commented with the proof and
+    says so on stderr; the spec it writes plans, the pin going in after piston and rod."""
+    from typer.testing import CliRunner
+
+    from asmplan import pipeline
+    from asmplan.cli import app
+    from asp.graph.checker import check_line, plan_operations
+
+    write_glb(tmp_path / "engine.glb", piston_on_rod(), PISTON_TREE)
+    out = tmp_path / "work" / "assembly.yaml"
+    result = CliRunner().invoke(app, ["init", str(tmp_path / "engine.glb"), "-o", str(out)])
+    assert result.exit_code == 0, result.output
+    text = out.read_text()
+    assert "\nsubassemblies:" not in text
+    proof = "unit piston_group is blocked along every direction by parts that must be there"
+    assert (
+        "\n#   piston_group: [pin, piston]   # not used: no complete sequence with it as one "
+        f"unit ({proof}" in text
+    )
+    said = [line for line in result.output.splitlines() if "piston_group" in line]
+    assert len(said) == 1 and said[0].startswith("the file's sub-assembly piston_group: no")
+    assert said[0].endswith("; planned without it")
+
+    planned = pipeline.plan(out, time_limit=5)
+    doc = planned.to_dict()
+    assert doc["subassemblies"] == {}
+    line = plan_operations(doc)
+    check_line(planned.assembly.spec, planned.assembly.relations, line)
+    parts = [planned.assembly.spec.operation(o).parts[0] for o in line]
+    assert parts.index("pin") > max(parts.index("piston"), parts.index("rod"))
+
+
+def test_the_plan_of_the_file_gives_the_group_up_with_the_same_proof(tmp_path):
+    from asmplan import pipeline
+    from asp.subassemblies import cad_units, file_units, refuted_reasons
+
+    write_glb(tmp_path / "engine.glb", piston_on_rod(), PISTON_TREE)
+    assembly = pipeline.load(tmp_path / "engine.glb")
+    spec, relations = assembly.spec, assembly.relations
+    assert [u.used for u in cad_units(spec, relations)] == [True]  # the checks pass it
+    reasons = refuted_reasons(spec, relations)
+    assert list(reasons) == ["piston_group"]
+    (decided,) = file_units(spec, relations)
+    assert not decided.used and "piston_group is blocked along every direction" in decided.reason
