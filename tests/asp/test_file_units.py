@@ -91,3 +91,38 @@ def test_the_plan_of_the_file_gives_the_group_up_with_the_same_proof(tmp_path):
     assert list(reasons) == ["piston_group"]
     (decided,) = file_units(spec, relations)
     assert not decided.used and "piston_group is blocked along every direction" in decided.reason
+
+
+def test_a_proved_round_too_large_to_build_gives_the_files_units_up(monkeypatch):
+    """The tower's first holder can never go in alone, whatever the file groups (the file's
+    second level is a unit): the derived precedences prove it. When the round's automatic
+    units come to nothing and its whole graph exceeds the state limit, the file's units
+    are given up and the error is the proof, not the state limit."""
+    from dataclasses import replace
+
+    import pytest
+
+    import asp.graph.state_graph
+    import asp.subassemblies
+    from asp.errors import InfeasibleAssembly, StateLimit
+    from cad import Assembly, compute_relations
+    from tests.cad.test_subassemblies import rod_tower, tower_spec
+
+    relations = compute_relations(Assembly.from_meshes(rod_tower()))
+    level_2 = ("holder_2", "bearing_2a", "bearing_2b")
+    spec = replace(tower_spec(relations), generated=True, hierarchy=(("level_2", level_2),))
+    real = asp.graph.state_graph.build_state_graph
+
+    def over_the_limit(spec, *args, **kwargs):
+        if kwargs.get("check", True) is False:
+            raise StateLimit(f"{spec.source}: the state graph exceeds the limit")
+        return real(spec, *args, **kwargs)
+
+    monkeypatch.setattr(asp.graph.state_graph, "build_state_graph", over_the_limit)
+    monkeypatch.setattr(asp.subassemblies, "_new_units", lambda *args, **kwargs: None)
+    lines = []
+    with pytest.raises(InfeasibleAssembly, match="holder_1"):
+        asp.subassemblies.build_with_units(
+            spec, relations, hierarchy=True, reduce=True, on_unit=lines.append
+        )
+    assert any(line.startswith("the file's sub-assembly level_2: ") for line in lines)
