@@ -395,22 +395,22 @@ def refuted_reasons(spec: AssemblySpec, relations, exclude: Iterable[str] = ()) 
     that says so (the units given up together share it); ``exclude``: given up already.
 
     While the file's units (:func:`with_cad_units`, without the ones given up) admit such a
-    proof, the units it involves are given up (the unit it names, or whose members its
-    failing test looks at: what a part could rest on, touch or is blocked by; all of them
-    when it names none); the file's inner groups may then become units. When the same
-    operation fails in the spec without units (a holder blocked by its bearings, whatever
-    the file groups), the units are not the cause and are left to the state graph
-    (:func:`build_with_units`: automatic units); a unit the proof names itself (its
-    insertion: blocked along every direction by parts that must be there before it, as a
-    piston with its pin, grouped without the rod the pin passes through) is always the
-    cause, since without it that operation does not exist.
+    proof, the units it involves are given up (:func:`_proof_units`: the unit whose
+    insertion it names, alone; else those whose members its failing test looks at: what a
+    part could rest on, touch or is blocked by; all of them when it names none); the
+    file's inner groups may then become units. When the same operation fails in the spec
+    without units (a holder blocked by its bearings, whatever the file groups), the units
+    are not the cause and are left to the state graph (:func:`build_with_units`: automatic
+    units); a unit whose insertion the proof names (blocked along every direction by parts
+    that must be there before it: a piston with its pin, grouped without the rod the pin
+    passes through) is always the cause, that operation not existing without it.
 
-    Sound, it removes no plan that was possible: a proof holds for every order, so with
-    the units of that round no sequence is complete, and a plan keeps every unit it is
-    given (each is built in its workspace and inserted as one body), so no plan has those
-    units; the state graph would give them up as well, after building it. The file's
-    groups only ever restrict the sequences of the loose parts (a unit's sequences are the
-    loose sequences whose members go in together), so planning without them loses none.
+    Giving a unit up removes no plan that was possible. The proof holds for every order of
+    the spec with the units of that round, so that spec has no complete sequence: a unit
+    whose insertion can never be done is in no complete sequence, and every plan is a
+    complete sequence. With the unit there is no plan to lose; without it (its members
+    placed one by one) any plan the state graph finds is checked as every plan is. The
+    state graph would give the unit up as well, after building it.
     """
     from asp.graph.precedences import refutation
 
@@ -442,8 +442,12 @@ def refuted_reasons(spec: AssemblySpec, relations, exclude: Iterable[str] = ()) 
 
 def _proof_units(spec: AssemblySpec, proof, units: dict[str, set[str]]) -> set[str]:
     """The units of ``units`` (id -> members) a proof involves: the one whose insertion it
-    names, and those whose members its operation places or its failing test looks at."""
+    names (that unit alone: it can never go in, whatever the other units are; the others
+    are judged again without it), else those whose members its operation places or its
+    failing test looks at."""
     op = spec.operation(proof.operation)
+    if op.unit in units:
+        return {op.unit}
     named = set(proof.parts) | set(op.parts)
     return {u for u, members in units.items() if u == op.unit or members & named}
 
