@@ -389,10 +389,14 @@ def refuted_units(
     return set(exclude) | set(reasons)
 
 
-def refuted_reasons(spec: AssemblySpec, relations, exclude: Iterable[str] = ()) -> dict[str, str]:
+def refuted_reasons(
+    spec: AssemblySpec, relations, exclude: Iterable[str] = (), *, inserted_only: bool = False
+) -> dict[str, str]:
     """The CAD file's sub-assemblies the derived precedences prove leave no complete
     sequence (:func:`asp.graph.precedences.refutation`, milliseconds), each with the one line
     that says so (the units given up together share it); ``exclude``: given up already.
+    With ``inserted_only``, only units whose insertion a proof names, stopping at the first
+    proof that names none (what ``asmplan init`` writes: :func:`file_units`).
 
     While the file's units (:func:`with_cad_units`, without the ones given up) admit such a
     proof, the units it involves are given up (:func:`_proof_units`: the unit whose
@@ -425,6 +429,8 @@ def refuted_reasons(spec: AssemblySpec, relations, exclude: Iterable[str] = ()) 
         if proof is None:
             return out
         op = with_units.operation(proof.operation)
+        if op.unit not in used and inserted_only:
+            return out
         if op.unit not in used:
             alone = refutation(spec, relations)
             if alone is not None and alone.operation == proof.operation:
@@ -457,11 +463,13 @@ def file_units(
 ) -> tuple[HierarchyUnit, ...]:
     """The decisions on the CAD file's sub-assemblies that a plan of the file starts from
     (``asmplan init`` writes them): :func:`cad_units` without the ones the derived
-    precedences prove leave no complete sequence (:func:`refuted_reasons`: their reason is
-    the proof, said on ``on_unit`` too), so a written spec never fixes a unit the plan of
-    the file gives up (the two-cylinder engine's piston with its pin, grouped without the
-    rod the pin passes through)."""
-    reasons = refuted_reasons(spec, relations)
+    precedences prove can never be inserted (:func:`refuted_reasons` with
+    ``inserted_only``: their reason is the proof, said on ``on_unit`` too), so a written
+    spec never fixes a unit that is in no complete sequence (the two-cylinder engine's
+    piston with its pin, grouped without the rod the pin passes through; the satellite's
+    ultrasonic sensors, which can only go in built into the front). A proof that names no
+    unit's insertion is left to the plan (its automatic units), the units kept."""
+    reasons = refuted_reasons(spec, relations, inserted_only=True)
     say = on_unit or (lambda _line: None)
     for line in dict.fromkeys(reasons.values()):
         say(line)
