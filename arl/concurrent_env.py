@@ -255,7 +255,8 @@ class ConcurrentEnv(gym.Env):
     opponent : Opponent
         The other side (:meth:`set_opponent` changes it).
     budgets : list of int or None
-        Each episode starts at one of these budgets, drawn uniformly (None: ``k = inf``).
+        Each episode starts at one of these budgets, drawn uniformly (None: ``k = inf``);
+        a game in which the learner has no decision is played out and another drawn.
     opponent_deterministic : bool
         An SB3 opponent plays its greedy action (else it samples its policy).
     """
@@ -348,8 +349,10 @@ class ConcurrentEnv(gym.Env):
         super().reset(seed=seed)
         if seed is not None:
             self.np_random_opp = np.random.default_rng(seed + 1)
-        budget = self.budgets[int(self.np_random.integers(len(self.budgets)))]
         for _ in range(MAX_RESTARTS):
+            # drawn per game: at some budget the learner may never decide (a person with
+            # no deviation left and fixed durations only follows the instructions)
+            budget = self.budgets[int(self.np_random.integers(len(self.budgets)))]
             self.row = self.rules.start(budget).row()
             self.phase, self.turn, self.told, self.elapsed = ROBOT_SIDE, None, None, 0
             self._play()

@@ -159,3 +159,24 @@ def test_a_models_greedy_action_is_its_predict():
             sampled = act(model, obs, mask, rng, False)
             assert mask[sampled]
             obs, _, done, _, _ = env.step(sampled)
+
+
+FIXED_TIMES = [
+    {"id": "a", "agents": {"H1": 2, "R1": 3}, "after": []},
+    {"id": "b", "agents": {"H1": 2, "R1": 1}, "after": []},
+    {"id": "c", "agents": {"H1": 1, "R1": 2}, "after": ["a", "b"]},
+]
+
+
+def test_a_budget_where_the_learner_never_decides_is_drawn_again():
+    """Fixed durations, no deviation left: the person only follows the instructions, so at
+    k = 0 the human side never decides. Training at budgets 0 and 1 still finds games
+    (each restart draws its budget); at 0 alone the error says why, in one line."""
+    spec, graph = job(FIXED_TIMES, agents={"H1": {"side": "human"}, "R1": {"side": "robot"}})
+    rules = concurrent_rules(spec, graph)
+    with pytest.raises(ValueError, match="the human side has no decision in 100 games"):
+        ConcurrentHumanEnv(rules, budgets=[0]).reset(seed=0)
+    env = ConcurrentHumanEnv(rules, budgets=[0, 1])
+    for seed in range(5):  # some of these draw budget 0 first (fails on the old code)
+        obs, _ = env.reset(seed=seed)
+        assert env.action_masks().any() and obs.shape == env.observation_space.shape
