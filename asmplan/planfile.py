@@ -126,12 +126,7 @@ def _state_columns(table: PolicyTable, describe, op_index: dict, agent_index: di
             mask = 0
             for op in state["done"]:
                 mask |= 1 << op_index[op]
-            values = []
-            for name, value in state["tools"].items():
-                known = tools.setdefault(name, [])
-                if value not in known:
-                    known.append(value)
-                values.append(known.index(value))
+            values = [_value_index(tools, name, value) for name, value in state["tools"].items()]
             running = [[r["agent"], r["operation"], r["remaining"]] for r in state["running"]]
             cache[v] = (format(mask, "x"), values, running)
         mask_hex, values, running = cache[v]
@@ -176,45 +171,71 @@ def concurrent_policy_object(names: PolicyNames, table: PolicyTable) -> dict:
     op_index = {op: k for k, op in enumerate(op_names)}
     agent_names = list(names.agents)
     agent_index = {a: k for k, a in enumerate(agent_names)}
-    describe = names.states.__getitem__
-
-    states = _state_columns(table, describe, op_index, agent_index)
-    edges = table.edge.tolist()
-    starts_col, deviations = [], []
-    for starts, dev in names.starts:
-        starts_col.append([[op_index[o], agent_index[a], _number(d)] for o, a, d in starts])
-        deviations.append(dev)
 
     def told(instruct: dict) -> list | None:
         if not instruct:
             return None
         return [[-1 if o == "wait" else op_index[o], agent_index[h]] for h, o in instruct.items()]
 
-    robots, instruction, budget = [], [], []
-    for i, (v, t) in enumerate(zip(table.node.tolist(), table.turn.tolist(), strict=True)):
-        lo, hi = int(table.ptr[i]), int(table.ptr[i + 1])
-        state = describe(v)
-        budget.append(state.get("budget"))
-        if t == ROBOT and hi > lo and edges[lo] >= 0:
-            robots.append([s[:2] for s in starts_col[lo]])
-            instruction.append(told(names.commits[edges[lo]]))
+    # Each distinct value converted once, then written for every state or move that has it.
+    tools: dict[str, list[str]] = {}
+    done_tools = []
+    for done, values in names.done_tools:
+        mask = 0
+        for op in done:
+            mask |= 1 << op_index[op]
+        done_tools.append(
+            (format(mask, "x"), [_value_index(tools, n, x) for n, x in values.items()])
+        )
+    running = [[[r["agent"], r["operation"], r["remaining"]] for r in rs] for rs in names.running]
+    budgets = [budget for budget, _ in names.budget_told]
+    instructions = [told(instruct) for _, instruct in names.budget_told]
+    starts = [[[op_index[o], agent_index[a], _number(d)] for o, a, d in s] for s, _ in names.starts]
+    commits = {k: told(instruct) for k, instruct in names.commits.items()}
+
+    state_of, running_of, told_of = (
+        x.tolist() for x in (names.state_of, names.running_of, names.told_of)
+    )
+    move_of, edges, ptr = names.move_of.tolist(), table.edge.tolist(), table.ptr.tolist()
+    robots, instruction = [], []
+    for i, t in enumerate(table.turn.tolist()):
+        lo = ptr[i]
+        if t == ROBOT and ptr[i + 1] > lo and edges[lo] >= 0:
+            robots.append([s[:2] for s in starts[move_of[lo]]])
+            instruction.append(commits[move_of[lo]])
         else:
             robots.append([])
-            instruction.append(told(state.get("instructions", {})))
-    states.update(robots=robots, instruction=instruction, budget=budget)
+            instruction.append(instructions[told_of[i]])
+    states = {
+        "turn": np.array(TURN_NAMES, dtype=object)[table.turn].tolist(),
+        "done": [done_tools[k][0] for k in state_of],
+        "tools": [done_tools[k][1] for k in state_of],
+        "running": [running[k] for k in running_of],
+        "bound": _numbers(table.bound),
+        "robots": robots,
+        "instruction": instruction,
+        "budget": [budgets[k] for k in told_of],
+    }
     return {
-        **_policy_head(
-            CONCURRENT.name, names.cost_model, table, op_names, agent_names, states.pop("_tools")
-        ),
+        **_policy_head(CONCURRENT.name, names.cost_model, table, op_names, agent_names, tools),
         "states": {"node": table.node.tolist(), **states},
         "moves": {
-            "ptr": table.ptr.tolist(),
-            "starts": starts_col,
-            "deviations": deviations,
+            "ptr": ptr,
+            "starts": [starts[k] for k in move_of],
+            "deviations": [names.starts[k][1] for k in move_of],
             "cost": _numbers(names.cost),
             "next": table.next.tolist(),
         },
     }
+
+
+def _value_index(tools: dict[str, list[str]], name: str, value: str) -> int:
+    """The index of tool ``name``'s ``value`` in ``tools[name]``, appended when new (the
+    values of a tool in the order the policy first reaches them)."""
+    known = tools.setdefault(name, [])
+    if value not in known:
+        known.append(value)
+    return known.index(value)
 
 
 def _number(x: float):
