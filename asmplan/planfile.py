@@ -192,6 +192,7 @@ def concurrent_policy_object(names: PolicyNames, table: PolicyTable) -> dict:
     instructions = [told(instruct) for _, instruct in names.budget_told]
     starts = [[[op_index[o], agent_index[a], _number(d)] for o, a, d in s] for s, _ in names.starts]
     commits = {k: told(instruct) for k, instruct in names.commits.items()}
+    robot_starts = [[s[:2] for s in x] for x in starts]  # a robot move: no durations
 
     state_of, running_of, told_of = (
         x.tolist() for x in (names.state_of, names.running_of, names.told_of)
@@ -201,7 +202,7 @@ def concurrent_policy_object(names: PolicyNames, table: PolicyTable) -> dict:
     for i, t in enumerate(table.turn.tolist()):
         lo = ptr[i]
         if t == ROBOT and ptr[i + 1] > lo and edges[lo] >= 0:
-            robots.append([s[:2] for s in starts[move_of[lo]]])
+            robots.append(robot_starts[move_of[lo]])
             instruction.append(commits[move_of[lo]])
         else:
             robots.append([])

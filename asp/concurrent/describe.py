@@ -249,10 +249,18 @@ def _first_distinct(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     inverse : (n_rows,) int64
         Each row's index among the distinct rows.
     """
-    code = np.zeros(keys.shape[0], dtype=np.int64)
-    for column in keys.T:  # the rows as one integer each, column by column (sorts 1-D only)
-        values, inverse = np.unique(column, return_inverse=True)
-        _, code = np.unique(code * values.size + inverse.ravel(), return_inverse=True)
+    code, size = np.zeros(keys.shape[0], dtype=np.int64), 1
+    for column in keys.T:  # each row as one integer, a digit per column (radix: its range)
+        low = int(column.min(initial=0))
+        radix = int(column.max(initial=0)) - low + 1
+        if radix > keys.shape[0]:  # sparse values: their ranks instead
+            column, low = np.unique(column, return_inverse=True)[1].ravel(), 0
+            radix = int(column.max(initial=0)) + 1
+        if size * radix >= 1 << 62:  # number the codes so far 0.. so that they stay int64
+            _, code = np.unique(code, return_inverse=True)
+            code, size = code.ravel().astype(np.int64), int(code.max(initial=0)) + 1
+        code = code * radix + (column.astype(np.int64) - low)
+        size *= radix
     _, first, inverse = np.unique(code.ravel(), return_index=True, return_inverse=True)
     order = np.argsort(first, kind="stable")
     rank = np.empty_like(order)
