@@ -310,12 +310,18 @@ def estimate_cycle(
     The sample: throwaway models of the same configuration but rollouts of at most
     :data:`arl.pace.SAMPLE_STEPS` steps; the robot's phase is run twice (the first warms
     up) and the second timed, and the robot's greedy policy is certified once at
-    ``budgets`` (:func:`asp.concurrent.certify.certify`; ``max_memory``: the bytes its
-    policy game may use, default the one rule), timed. A cycle is then both sides'
+    ``budgets``, those whose policy game fits (:func:`certify_fitting`; ``max_memory``: the
+    bytes its policy game may use, default the one rule), timed. A cycle is then both sides'
     ``phase_steps`` (rounded up to whole rollouts) at the measured seconds a step, and one
     certification. Nothing of a run folder is read or written. The untrained
     robot's policy game may be larger or smaller than a trained one's.
     """
+    return _estimate(rules, config, seed, budgets, cycles_left, max_memory, None)[0]
+
+
+def _estimate(rules, config, seed, budgets, cycles_left, max_memory, say):
+    """:func:`estimate_cycle` and the budgets its certificate kept (``say``: told each
+    budget dropped), so that a run does not try a dropped budget again."""
     cfg = get_config(config)
     budgets = list(budgets) if budgets is not None else list(DEFAULT_BUDGETS)
     k = max(1, min(cfg.n_steps, SAMPLE_STEPS))
@@ -325,9 +331,11 @@ def estimate_cycle(
     robot.learn(k, reset_num_timesteps=False)
     step_s = (time.perf_counter() - t0) / k
     t0 = time.perf_counter()
-    certify_fitting(rules, learned_policy(rules, robot), budgets, max_memory=max_memory)
+    _, kept = certify_fitting(
+        rules, learned_policy(rules, robot), budgets, max_memory=max_memory, say=say
+    )
     check_s = time.perf_counter() - t0
-    return CycleEstimate(
+    estimate = CycleEstimate(
         seconds=2 * phase_seconds(cfg.phase_steps, cfg.n_steps, step_s) + check_s,
         step_s=step_s,
         sample_steps=k,
@@ -336,6 +344,7 @@ def estimate_cycle(
         check_s=check_s,
         check=CERTIFICATION,
     )
+    return estimate, kept
 
 
 def train_concurrent(
@@ -394,7 +403,7 @@ def train_concurrent(
     with Heartbeat(heartbeat, lambda: time.perf_counter() - t0) as beat:
         if max_cycle_seconds is not None or on_estimate is not None:
             beat.doing = "estimating a cycle's time (a sample of steps, one certification)"
-            estimate = estimate_cycle(rules, cfg, seed=seed, budgets=budgets, max_memory=room)
+            estimate, budgets = _estimate(rules, cfg, seed, budgets, None, room, _stderr)
             estimate.refuse_over(max_cycle_seconds)
             if on_estimate is not None:
                 on_estimate(estimate)
@@ -475,7 +484,7 @@ class _Makespans(BaseCallback):
 
 
 def _k_text(row: dict) -> str:
-    return f"k={'inf' if row['k'] is None else row['k']}: {row['bound']:g}"
+    return f"k={_k_name(row['k'])}: {row['bound']:g}"
 
 
 def _model_bytes(model) -> bytes:

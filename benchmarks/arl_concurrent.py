@@ -64,7 +64,7 @@ def row(name: str, values: dict, budgets: list) -> str:
 
 
 def main() -> None:
-    from arl.concurrent_trainer import train_concurrent
+    from arl.concurrent_trainer import get_config, train_concurrent
     from asmplan import pipeline
     from asp.concurrent.certify import best_response_values
     from asp.concurrent.curve import solve_curve
@@ -135,12 +135,10 @@ def main() -> None:
     print(row(f"U(k) ({curve.policy})", upper, budgets))
     for name, values in fixed.items():
         print(row(name, values, budgets))
+    cfg = get_config(args.config)
+    if args.cycles is not None:
+        cfg = cfg.replace(cycles=args.cycles)
     for seed in range(args.first_seed, args.first_seed + args.seeds):
-        cfg = args.config
-        if args.cycles is not None:
-            from arl.concurrent_trainer import get_config
-
-            cfg = get_config(cfg).replace(cycles=args.cycles)
         t0 = time.process_time()
         run = train_concurrent(rules, cfg, seed=seed, budgets=budgets, progress=True)
         cpu = time.process_time() - t0

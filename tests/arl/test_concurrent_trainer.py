@@ -194,3 +194,9 @@ def test_a_policy_game_too_large_drops_the_largest_budgets_first(monkeypatch, tm
     assert all([r["k"] for r in c["certified"]] == [0, 1] for c in run.cycles)
     config = json.loads((tmp_path / "config.json").read_text())
     assert config["budgets"] == [0, 1]
+    # With the estimate first, its certificate drops k = inf and the cycles never retry it.
+    asked.clear()
+    train_concurrent(
+        rules, get_config("concurrent-tiny"), budgets=[0, 1, None], seed=1, max_cycle_seconds=1e6
+    )
+    assert asked == [[0, 1, None], [0, 1], [0, 1], [0, 1]]
