@@ -14,6 +14,7 @@ $(BIN)/python:
 $(STAMP): pyproject.toml | $(BIN)/python
 	$(BIN)/pip install --quiet torch==2.13.0
 	$(BIN)/pip install --quiet -e '.[test,cluster,step]'
+	$(BIN)/python -m asmplan.warmup  # compile the numba kernels once (about a minute)
 	touch $(STAMP)
 
 venv: $(STAMP)
