@@ -123,12 +123,9 @@ def _state_columns(table: PolicyTable, describe, op_index: dict, agent_index: di
     for v in table.node.tolist():
         if v not in cache:
             state = describe(v)
-            mask = 0
-            for op in state["done"]:
-                mask |= 1 << op_index[op]
             values = [_value_index(tools, name, value) for name, value in state["tools"].items()]
             running = [[r["agent"], r["operation"], r["remaining"]] for r in state["running"]]
-            cache[v] = (format(mask, "x"), values, running)
+            cache[v] = (_done_mask(state["done"], op_index), values, running)
         mask_hex, values, running = cache[v]
         done_col.append(mask_hex)
         tools_col.append(values)
@@ -143,9 +140,18 @@ def _state_columns(table: PolicyTable, describe, op_index: dict, agent_index: di
     }
 
 
+def _done_mask(done, op_index: dict) -> str:
+    """The hexadecimal done mask of the operations ``done`` (bit ``op_index[op]``: ``op``
+    done), as ``policy.states.done`` writes it (module docstring)."""
+    mask = 0
+    for op in done:
+        mask |= 1 << op_index[op]
+    return format(mask, "x")
+
+
 def _done_masks(describe: AlternateStates, nodes: np.ndarray, op_index: dict) -> list[str]:
     """The hexadecimal done mask of each node of ``nodes`` (bit ``op_index[op]``: ``op``
-    done), as :func:`_state_columns` writes it, computed for many nodes at once."""
+    done), as :func:`_done_mask` writes it, computed for many nodes at once."""
     uniq, inverse = np.unique(nodes, return_inverse=True)
     done = describe.done_matrix(uniq)
     bit_of = np.array([op_index[op] for op in describe.op_ids], dtype=np.int64)
@@ -181,11 +187,8 @@ def concurrent_policy_object(names: PolicyNames, table: PolicyTable) -> dict:
     tools: dict[str, list[str]] = {}
     done_tools = []
     for done, values in names.done_tools:
-        mask = 0
-        for op in done:
-            mask |= 1 << op_index[op]
         done_tools.append(
-            (format(mask, "x"), [_value_index(tools, n, x) for n, x in values.items()])
+            (_done_mask(done, op_index), [_value_index(tools, n, x) for n, x in values.items()])
         )
     running = [[[r["agent"], r["operation"], r["remaining"]] for r in rs] for rs in names.running]
     budgets = [budget for budget, _ in names.budget_told]
