@@ -172,14 +172,17 @@ def policy_names(game: ConcurrentGame, table) -> PolicyNames:
     nodes, edges = table.node, table.edge
     state_key, running_key, told_key = _node_keys(game, nodes)
 
-    first, state_of = _first_distinct(state_key)
-    described = [state_description(game, v) for v in nodes[first].tolist()]
-    done_tools = [(d["done"], d["tools"]) for d in described]
-    first, running_of = _first_distinct(running_key)
-    running = [state_description(game, v)["running"] for v in nodes[first].tolist()]
-    first, told_of = _first_distinct(told_key)
-    described = [state_description(game, v) for v in nodes[first].tolist()]
-    budget_told = [(d["budget"], d.get("instructions", {})) for d in described]
+    (first_state, state_of), (first_running, running_of), (first_told, told_of) = (
+        _first_distinct(key) for key in (state_key, running_key, told_key)
+    )
+    # One pass: each table state that first has one of the three parts described once.
+    wanted = np.unique(np.concatenate([first_state, first_running, first_told]))
+    described = {i: state_description(game, int(nodes[i])) for i in wanted.tolist()}
+    done_tools = [(described[i]["done"], described[i]["tools"]) for i in first_state.tolist()]
+    running = [described[i]["running"] for i in first_running.tolist()]
+    budget_told = [
+        (described[i]["budget"], described[i].get("instructions", {})) for i in first_told.tolist()
+    ]
 
     first, move_of = _first_distinct(_move_keys(game, edges))
     starts = [([], 0) if e < 0 else move_starts(game, e) for e in edges[first].tolist()]
