@@ -115,6 +115,21 @@ def _plotly_js() -> Path:
     return Path(str(resources.files("plotly").joinpath("package_data", "plotly.min.js")))
 
 
+def _replaying(message: dict, receive):
+    """An ASGI ``receive`` that hands on ``message`` (the request a middleware has already
+    read) first, then what ``receive`` gives."""
+    sent = False
+
+    async def replay():
+        nonlocal sent
+        if not sent:
+            sent = True
+            return message
+        return await receive()
+
+    return replay
+
+
 class BodyLimit:
     """ASGI middleware: refuse request bodies over ``limit`` bytes with 413.
 
@@ -146,16 +161,7 @@ class BodyLimit:
             if not message.get("more_body", False):
                 break
         whole = {"type": "http.request", "body": b"".join(chunks), "more_body": False}
-        sent = False
-
-        async def replay():
-            nonlocal sent
-            if not sent:
-                sent = True
-                return whole
-            return await receive()
-
-        return await self.app(scope, replay, send)
+        return await self.app(scope, _replaying(whole, receive), send)
 
 
 async def _too_large(send, limit: int) -> None:
@@ -490,16 +496,7 @@ class EventFastPath:
         except ValueError:
             event = None
         if event is None:
-            sent = False
-
-            async def again():
-                nonlocal sent
-                if not sent:
-                    sent = True
-                    return message
-                return await receive()
-
-            return await self.app(scope, again, send)
+            return await self.app(scope, _replaying(message, receive), send)
         status, data, headers = 200, None, {}
         sid = match.group(1)
         try:
