@@ -22,6 +22,8 @@ GAMES_MAX = 1_000_000
 TIME_LIMIT_MAX = 86_400.0
 """CP-SAT time limit: at most a day."""
 WORKERS_MAX = 1_024
+MEMORY_MAX_GB = 1e6
+"""``--max-memory``: at most a million GB (a petabyte; the bound only keeps it a number)."""
 
 CostModel = choices("CostModel", COST_MODELS, "Cost of a move.")
 TurnModel = choices("TurnModel", TURN_MODELS, "Turn model of the game.")
@@ -36,6 +38,12 @@ def time_limit_option(
     """``--time-limit``: one definition for every command that runs CP-SAT (``help`` says
     what the default does when it is not a number)."""
     return typer.Option(default, "--time-limit", min=0.001, max=TIME_LIMIT_MAX, help=help)
+
+
+def max_memory_option(help: str):
+    """``--max-memory``, GB (0.001 to :data:`MEMORY_MAX_GB`): one definition for every
+    command that bounds its memory; ``help`` says what it bounds and the default."""
+    return typer.Option(None, "--max-memory", min=0.001, max=MEMORY_MAX_GB, help=help)
 
 
 def seed_option(help: str, default: int | None = 0):

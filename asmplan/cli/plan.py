@@ -23,6 +23,7 @@ from asmplan.cli.options import (
     check_output,
     finite_or_none,
     gravity_option,
+    max_memory_option,
     seed_option,
     time_limit_option,
     tolerance_option,
@@ -188,11 +189,8 @@ def plan_command(
         min=1,
         help="Concurrent: positions the search may expand (default 50,000,000).",
     ),
-    max_memory: float | None = typer.Option(
-        None,
-        "--max-memory",
-        min=0.001,
-        help="Concurrent: GB for the search's table and its policy games (default 1).",
+    max_memory: float | None = max_memory_option(
+        "Concurrent: GB for the search's table and its policy games (default 1)."
     ),
 ) -> None:
     """Plan an assembly end to end: relations, state graph, game, robust plan, CP-SAT

@@ -13,6 +13,7 @@ from asmplan.cli.options import (
     GAMES_MAX,
     TurnModel,
     check_output,
+    max_memory_option,
     seed_option,
     turn_model_option,
 )
@@ -199,14 +200,10 @@ def train_command(
         None, "--max-cycles", min=1, max=MAX_CYCLES, help="Stop after N cycles."
     ),
     progress: bool = typer.Option(True, "--progress/--no-progress", help="Show a progress bar."),
-    max_memory: float | None = typer.Option(
-        None,
-        "--max-memory",
-        min=0.001,
-        max=1e6,
-        help="Refuse a game whose training needs more GB than this, before any work "
+    max_memory: float | None = max_memory_option(
+        "Refuse a game whose training needs more GB than this, before any work "
         "(default: 3/4 of the memory available; arl/memory.py); --config concurrent: the "
-        "state graph, the learners and each certificate's policy game within it.",
+        "state graph, the learners and each certificate's policy game within it."
     ),
     max_cycle_seconds: float | None = typer.Option(
         None,
