@@ -10,7 +10,7 @@ from pathlib import Path
 import typer
 
 from asmplan.cli.app import OutputFormat, app
-from asmplan.cli.options import CostModel, check_output
+from asmplan.cli.options import CostModel, check_output, max_states_option
 
 LIST_MAX = 1_000_000
 
@@ -36,9 +36,7 @@ def graph_command(
         max=LIST_MAX,
         help="Also list up to N feasible complete sequences (the AST).",
     ),
-    max_states: int | None = typer.Option(
-        None, "--max-states", min=1, help="State graph limit (default: spec's, else 20,000,000)."
-    ),
+    max_states: int | None = max_states_option(),
 ) -> None:
     """Build the assembly state graph and the game DAG; print the sizes, write the DAG."""
     from asmplan import pipeline

@@ -46,6 +46,18 @@ def max_memory_option(help: str):
     return typer.Option(None, "--max-memory", min=0.001, max=MEMORY_MAX_GB, help=help)
 
 
+MAX_STATES_HELP = "State graph limit (default: spec's, else 20,000,000)."
+"""Help of ``--max-states``: its default is :data:`asp.graph.state_graph.DEFAULT_MAX_STATES`
+(not imported: the commands import the library only when they run; a test holds the two
+equal)."""
+
+
+def max_states_option():
+    """``--max-states``: the state graph's limit (at least 1; default None: the spec's), one
+    definition for every command that builds a state graph."""
+    return typer.Option(None, "--max-states", min=1, help=MAX_STATES_HELP)
+
+
 def seed_option(help: str, default: int | None = 0):
     """``--seed``: one definition (a 32-bit seed, :data:`SEED_MAX`) for every command; ``help``
     says what it seeds."""

@@ -24,6 +24,7 @@ from asmplan.cli.options import (
     finite_or_none,
     gravity_option,
     max_memory_option,
+    max_states_option,
     seed_option,
     time_limit_option,
     tolerance_option,
@@ -160,9 +161,7 @@ def plan_command(
         help="Concurrent: grid of a person's duration range (0: its two end points).",
         callback=finite_or_none,
     ),
-    max_states: int | None = typer.Option(
-        None, "--max-states", min=1, help="State graph limit (default: spec's, else 20,000,000)."
-    ),
+    max_states: int | None = max_states_option(),
     contact_tol: float | None = tolerance_option("contact_tol"),
     penetration_tol: float | None = tolerance_option("penetration_tol"),
     force: bool = typer.Option(

@@ -7,8 +7,10 @@ import pytest
 import asmplan.errors
 import asp.errors
 from asmplan.cli import main
+from asmplan.cli.options import MAX_STATES_HELP
 from asmplan.errors import AsmplanError
 from asp.game.io import save_dag
+from asp.graph.state_graph import DEFAULT_MAX_STATES
 from tests.asp.figures import figure4
 
 
@@ -31,6 +33,10 @@ def one_line_error(code: int, err: str) -> str:
     lines = err.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("asmplan: error: "), err
     return lines[0]
+
+
+def test_the_max_states_help_names_the_default():
+    assert f"{DEFAULT_MAX_STATES:,}" in MAX_STATES_HELP
 
 
 def test_the_whole_family_is_re_exported():
