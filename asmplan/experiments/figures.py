@@ -14,7 +14,6 @@ are safe to draw from any thread or process.
 
 from __future__ import annotations
 
-import io
 from collections.abc import Sequence
 
 import numpy as np
@@ -23,6 +22,7 @@ from matplotlib.figure import Figure
 from arl.plots import MOVING_AVERAGE, rewards_png
 from asmplan.experiments.paper_values import paper_table3_row, paper_table4_row
 from asmplan.experiments.tasks import ResultRow
+from asmplan.report.png import png_bytes
 
 
 def primary_rows(rows: Sequence[ResultRow]) -> list[ResultRow]:
@@ -50,9 +50,7 @@ def paper_row(row: ResultRow):
 
 
 def _png(fig: Figure) -> bytes:
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=130, bbox_inches="tight")
-    return buffer.getvalue()
+    return png_bytes(fig, dpi=130, bbox_inches="tight")
 
 
 def figure11_training(

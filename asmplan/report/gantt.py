@@ -6,12 +6,11 @@ PNGs are written atomically.
 
 from __future__ import annotations
 
-import io
 import os
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
-from asp.atomic import write_bytes
+from asmplan.report.png import write_png
 
 AGENT_COLOURS = {"H": "#9e9e9e", "R1": "#2e9d4a", "R2": "#f28c28"}
 """The paper's Figure 9 colours: operator grey, R1 green, R2 orange."""
@@ -24,12 +23,6 @@ def _figure(figsize: tuple[float, float], dpi: int):
 
     fig = Figure(figsize=figsize, dpi=dpi)
     return fig, fig.subplots()
-
-
-def _save(fig, path) -> Path:
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png")
-    return write_bytes(path, buffer.getvalue())
 
 
 def plot_robustness(
@@ -72,7 +65,7 @@ def plot_robustness(
     ax.legend(fontsize=8, frameon=False, loc="best")
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    return _save(fig, path)
+    return write_png(fig, path)
 
 
 SHOWN_WIDTH = 11.5
@@ -120,7 +113,7 @@ def plot_gantt(
     draw_gantt(ax, bars, makespan=makespan, unit=unit)
     ax.set_title(title, fontsize=LABEL_PT + 1)
     fig.tight_layout()
-    return _save(fig, path)
+    return write_png(fig, path)
 
 
 def draw_gantt(ax, bars: Sequence, *, makespan: float | None = None, unit: str = "s") -> dict:

@@ -16,10 +16,10 @@ redraws it.
 
 from __future__ import annotations
 
-import base64
 import html
 from pathlib import Path
 
+from asmplan.report.png import data_uri
 from asmplan.report.steps import assembly_steps
 from asp.game.turns import turn_of
 
@@ -102,10 +102,6 @@ def plan_report(doc: dict, dag_png: bytes | None = None) -> str:
     return report_html(doc, figures)
 
 
-def _data_uri(png: bytes) -> str:
-    return "data:image/png;base64," + base64.b64encode(png).decode("ascii")
-
-
 # --------------------------------------------------------------------------- the page
 
 
@@ -163,15 +159,15 @@ def report_html(plan: dict, figures: dict[str, bytes] | None = None) -> str:
     if "robustness" in figures:
         if note := _graph_note(plan):
             body.append(note)
-        body.append(_img(_data_uri(figures["robustness"]), "price of robustness"))
+        body.append(_img(data_uri(figures["robustness"]), "price of robustness"))
         for name in ("gantt_cooperative", "gantt_worst"):
-            body.append(_img(_data_uri(figures[name]), name.replace("_", " ")))
+            body.append(_img(data_uri(figures[name]), name.replace("_", " ")))
     else:
         reason = figures.get("why", b"not computed").decode()
         body.append(f"<p class='note'>The concurrent game was not solved: {esc(reason)}.</p>")
     if "gantt_schedule" in figures:
         body.append("<h2>CP-SAT schedule</h2>")
-        body.append(_img(_data_uri(figures["gantt_schedule"]), "CP-SAT Gantt chart"))
+        body.append(_img(data_uri(figures["gantt_schedule"]), "CP-SAT Gantt chart"))
     if sched.get("status_note"):
         body.append(f"<p class='note'>CP-SAT: {esc(sched['status_note'])}</p>")
 
@@ -210,7 +206,7 @@ def report_html(plan: dict, figures: dict[str, bytes] | None = None) -> str:
         body.append("</table>")
     if "dag" in figures and not _concurrent(plan):
         body.append("<h2>The game DAG</h2>")
-        body.append(_img(_data_uri(figures["dag"]), "game DAG", width=1100))
+        body.append(_img(data_uri(figures["dag"]), "game DAG", width=1100))
     if plan.get("credit"):
         body.append(f"<p class='note'>{esc(plan['credit'])}</p>")
     return PAGE.format(title=esc(str(plan.get("assembly", "plan"))), body="\n".join(body))

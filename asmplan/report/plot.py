@@ -10,7 +10,6 @@ is left open); the PNG is written atomically.
 
 from __future__ import annotations
 
-import io
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -18,7 +17,7 @@ from pathlib import Path
 import numba
 import numpy as np
 
-from asp.atomic import write_bytes
+from asmplan.report.png import write_png
 from asp.game.dag import GameDAG, ids_topological
 from asp.game.solve import node_order
 
@@ -222,6 +221,4 @@ def _draw_layers(figure: DagFigure, path: str | os.PathLike[str], title: str) ->
 def _save(fig, path: str | os.PathLike[str]) -> Path:
     """Write the matplotlib Figure ``fig`` as a PNG atomically."""
     fig.tight_layout()
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png")
-    return write_bytes(path, buffer.getvalue())
+    return write_png(fig, path)

@@ -14,8 +14,6 @@ drawing is matplotlib's ``mplot3d`` without pyplot, one figure reused for every 
 
 from __future__ import annotations
 
-import base64
-import io
 import math
 import textwrap
 from dataclasses import dataclass
@@ -23,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from asmplan.report.meshes import base_parts, part_meshes
+from asmplan.report.png import data_uri, png_bytes
 
 NEW, PLACED, GHOST = "#f28c28", "#4f81bd", "#cccccc"
 ARROW = "#d62728"
@@ -204,6 +203,4 @@ def assembly_steps(
 
 def _png(fig) -> str:
     """A matplotlib Figure as a ``data:image/png;base64,...`` URI."""
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png", dpi=90)
-    return "data:image/png;base64," + base64.b64encode(buffer.getvalue()).decode("ascii")
+    return data_uri(png_bytes(fig, dpi=90))
