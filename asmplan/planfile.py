@@ -374,7 +374,8 @@ def line_steps(policy: dict, follow: str, operations: dict[str, dict]) -> list[d
 
 
 def _where(info: dict) -> dict:
-    """What a line step says of one operation it starts: parts, workspace, unit, held."""
+    """What a line step or an insertion says of one operation it starts: parts, workspace,
+    unit, held."""
     return {
         "parts": list(info.get("parts", [])),
         "workspace": info.get("workspace", MAIN),
@@ -562,10 +563,8 @@ def add_insertions(steps: list[dict], spec, checked: dict, operations: dict) -> 
                 step["insertions"].append(
                     {
                         "operation": op,
-                        "parts": body,
-                        "workspace": info.get("workspace", MAIN),
-                        "unit": info.get("unit"),
-                        "held": info.get("held", False),
+                        **_where(info),
+                        "parts": body,  # in _where's place: the keys keep their order
                         "free_along": free,
                         "insert_along": _opposite(free) if free else None,
                         "insert_vector_file": file_vector(spec, _opposite(free)) if free else None,
