@@ -36,10 +36,10 @@ def warm(sources: list[str]) -> None:
         If a source does not exist (named in the message).
     """
     from asmplan import pipeline
-    from asp.concurrent.search import new_table, table_rehash
+    from asp.concurrent import search
 
     # the search table's growth (a large product's search outgrows its first table)
-    table_rehash(new_table(16, 1), new_table(64, 1))
+    search.table_rehash(search.new_table(16, 1), search.new_table(64, 1))
     for source in sources:
         if not Path(source).exists():
             raise FileNotFoundError(f"warmup: {source}: no such file or folder")
