@@ -87,8 +87,9 @@ def _full_name(raw: str) -> str:
 
 
 def display_name(raw: str) -> str:
-    """A CAD name without its instance path or number (``Washer#1:8:6`` -> ``Washer``)."""
-    name = re.split(r"[#<]", str(raw), maxsplit=1)[0]
+    """A CAD name without its instance path or number (``Washer#1:8:6`` -> ``Washer``,
+    ``Bolt<2>`` -> ``Bolt``); any other ``<`` is the name's own (``Tom <b>`` stays)."""
+    name = re.split(r"#|<\d+>", str(raw), maxsplit=1)[0]
     return re.sub(r"(:\d+|\(\d+\))$", "", name).strip() or str(raw)
 
 

@@ -15,6 +15,7 @@ from cad.identical import shape_classes
 from cad.scene import (
     STEP_CHORD_MM,
     clean_name,
+    display_name,
     is_generic,
     load_scene_file,
     read_scene,
@@ -46,6 +47,22 @@ DATA = Path(__file__).parent / "data"
 )
 def test_clean_name(raw, clean):
     assert clean_name(raw) == clean
+
+
+@pytest.mark.parametrize(
+    ("raw", "shown"),
+    [
+        ("Hex Nut M6<2>", "Hex Nut M6"),
+        ("Washer#1:8:6", "Washer"),
+        ("Bolt:1", "Bolt"),
+        ("Tom <b>", "Tom <b>"),
+        ('"><img src=x>', '"><img src=x>'),
+        ("Gear <small> (3)", "Gear <small>"),
+        ("<2>", "<2>"),
+    ],
+)
+def test_display_name_drops_only_the_instance_suffix(raw, shown):
+    assert display_name(raw) == shown
 
 
 @pytest.mark.parametrize(
