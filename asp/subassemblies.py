@@ -360,7 +360,7 @@ def _fasteners_in_order(
         f"too many states ({projected or 'the full graph exceeds the limit'}): "
         f"{len(found)} joining parts (each touches only the two parts it "
         "joins and goes in whatever else is there: screws, pins) placed in one order, each "
-        f"after the two parts it joins ({listed([j.part for j in found])}; "
+        f"after the parts it joins ({listed([j.part for j in found])}; "
         "asp/graph/fasteners.py)"
         + (f"; held while its joining parts go in: {listed(held)}" if held else "")
     )

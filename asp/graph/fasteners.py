@@ -2,22 +2,26 @@
 
 A product held together by screws (the APLAN toy truck: 61 parts, 39 of them screws) has
 states for every subset of screws driven so far, and the state graph exceeds any limit
-(71.5 M projected), although a screw matters to nothing but the two parts it joins.
+(71.5 M projected), although a screw matters to nothing but the two parts it joins. Scene
+files of purchased or visual assets have the same class with one host or several: a cover
+touching only the block it sits on, a sensor module on a back plate, a bolt through three
+plates (the two-cylinder engine: 4 such parts on its head and block, 16 times fewer states).
 
 **Joining part.** Part ``f``, placed alone by an operation of the main assembly (no unit,
 no tools, no explicit predecessors, no operation waiting for it, not the base part), is a
-*joining part* of ``a`` and ``b`` when, in the insertion tests (:mod:`asp.graph.feasibility`,
-DESIGN.md "Support" and "precedence"):
+*joining part* of the parts it touches (its *joined parts*, one or more) when, in the
+insertion tests (:mod:`asp.graph.feasibility`, DESIGN.md "Support" and "precedence"):
 
-1. ``f`` touches (or rests on) exactly two parts, ``a`` and ``b``, each the base part or
-   placed alone in the main assembly, and neither a joining part itself (so no other part
-   touches or rests on ``f``);
+1. every part ``f`` touches (or rests on) is the base part or placed alone in the main
+   assembly, and none of them is a joining part itself (so no part but its joined parts
+   touches or rests on ``f``, and a joined part needs no joining part to touch: links
+   of a chain, each touching the next, are none);
 2. ``f`` goes in whatever else is there: some direction the gripper may approach from is
-   free of every other part, and ``f`` rests on ``a`` or ``b`` (or is ``held``).
+   free of every other part, and ``f`` rests on a joined part (or is ``held``).
 
 **The reduction** (:func:`fastener_order`): each joining part waits for the parts it joins
 and for the joining part before it (one chain, ordered by when their joined parts can be
-there: the later of the two in the spec's order); a joined part resting on nothing but its
+there: the latest of them in the spec's order); a joined part resting on nothing but its
 own joining parts, which now come after it, is ``held`` while they go in (DESIGN.md: held
 until a later operation fixes it). These are only precedences and ``held`` marks on the
 spec, so the state graph still tests every move with the same insertion oracle: every
@@ -25,19 +29,23 @@ sequence it holds is feasible by the DESIGN's rules with those marks, and every 
 sound (the independent checker replays it with the plan's held flags).
 
 **What it keeps.** With the marks, the reduced graph has a complete sequence iff the full
-graph has one in which every joining part follows both parts it joins. Proof: take such a
+graph has one in which every joining part follows every part it joins. Proof: take such a
 sequence, keep its other parts in their order and put the joining parts last, in chain
 order. A part ``q`` that is no joining part now sees a subset of what it saw: its free
-directions stay free; what it touched or rested on was no joining part (a joining part
-touches only its joined parts, and came after them); its predecessors are the same. A
-joining part at the end goes in along its free direction (2), touching and resting on its
-joined parts, which are there (and its predecessors, the chain's, are done). Conversely
+directions stay free (a part that blocks no move when there blocks none when not);
+what it touched or rested on was no joining part (a joining part touches only its joined
+parts, and came after them); its predecessors are the same. A joining part at the end
+goes in along its free direction (2), touching and resting on its
+joined parts, which are there (and its predecessors, the chain's, are done). How many
+parts it joins plays no part in this. Conversely
 every sequence of the reduced graph is one of the full graph (with the marks). When the
 reduced graph has no complete sequence, the full graph's answer stands
 (:func:`asp.subassemblies.build_with_units` keeps the state-limit error).
 
-**Where it applies.** Only where the full graph exceeds its state limit: screws and pins
-that touch nothing but their two parts and go in along a way nothing else closes. A screw
+**Where it applies.** Only where the full graph exceeds its state limit (or, in a round of
+automatic units guessed for a proved failure, first: :func:`asp.subassemblies.build_with_units`):
+screws, pins, covers and modules that touch nothing but their joined parts and go in along a
+way nothing else closes. A screw
 whose head a later cover would stop (blocked by it along its only way) is not one: it stays
 free. The joining parts are found before the full graph is built. When they alone multiply
 its states past the limit (:func:`joining_states`, a lower bound where no joined part is
@@ -49,7 +57,7 @@ first, with a projection margin of 1 (:func:`asp.graph.state_graph.build_state_g
 graph sure to go over is given up as soon as its cautious projection passes the limit.
 
 **What it changes.** The game is played over the sequences with the joining parts in that
-order, each after its two parts: TCT and W* are those of that game (TCT no lower than the
+order, each after the parts it joins: TCT and W* are those of that game (TCT no lower than the
 full graph's; the order is a rule of the cell, "fasten in this order once the parts are
 there", said on stderr and kept in the plan's spec as precedences).
 """
@@ -71,13 +79,14 @@ class Joining:
     Attributes
     ----------
     part : str
-    joins : tuple of (str, str)
+    joins : tuple of str
+        The parts it touches (one or more), in the relations' order.
     operation : str
         The operation placing it.
     """
 
     part: str
-    joins: tuple[str, str]
+    joins: tuple[str, ...]
     operation: str
 
 
@@ -126,22 +135,21 @@ def joining_parts(spec: AssemblySpec, relations) -> list[Joining]:
     single = _single_placements(spec)
     base = spec.base_part
     waited_for = {a for op in spec.operations for a in op.after}
-    candidates: dict[str, tuple[str, str]] = {}
+    candidates: dict[str, tuple[str, ...]] = {}
     for p, i in single.items():
         op = spec.operations[i]
         if p == spec.base_part or p not in where or op.after or op.id in waited_for:
             continue
         f = where[p]
         near = np.flatnonzero(touch[f])
-        if len(near) != 2 or not all(ids[j] in single or ids[j] == base for j in near):
+        if not len(near) or not all(ids[j] in single or ids[j] == base for j in near):
             continue
-        a, b = (int(j) for j in near)
         rest = np.ones(len(ids), dtype=bool)
         rest[f] = False
         free = tt[f, rest].all(axis=0) & allowed  # (2): free of every other part
-        rests = op.held or not spec.constraints.stability or sp[f, [a, b], g].any()
+        rests = op.held or not spec.constraints.stability or sp[f, near, g].any()
         if free.any() and rests:
-            candidates[p] = (ids[a], ids[b])
+            candidates[p] = tuple(ids[j] for j in near)
     return [
         Joining(p, joins, spec.operations[single[p]].id)
         for p, joins in candidates.items()

@@ -70,7 +70,7 @@ def test_the_order_keeps_only_sound_sequences_and_a_complete_one():
     "change",
     [
         "screw blocked by a cover along its only way",  # (2): does not go in whatever is there
-        "screw touches a third part",  # (1)
+        "screw touches another screw",  # (1): not both
         "screw has a predecessor",
     ],
 )
@@ -83,8 +83,9 @@ def test_a_part_that_is_no_joining_part_is_left_alone(change):
         other = rel.parts.index("bracket1")
         tt[s, other, 4] = tt[other, s, 5] = False
     elif change.startswith("screw touches"):
-        other = rel.parts.index("bracket1")
+        other = rel.parts.index("bracket1_screw0")
         tc[s, other, 0] = tc[other, s, 1] = True
+        screw = "bracket1_screw0"  # the later of the two in spec order touches the first
     else:
         ops = [
             op.__class__(**{**op.__dict__, "after": ("bracket1",)}) if op.id == screw else op
@@ -237,11 +238,52 @@ def stacked_links(n_links):
     return parts_spec(parts, "links.yaml"), rel
 
 
-@pytest.mark.parametrize("n_links, joining", [(1, ["link0"]), (2, []), (3, []), (6, [])])
-def test_links_in_a_chain_are_no_joining_parts(n_links, joining):
-    """One link between the base and the cap touches those two only: a pin joining them.
-    Links in a chain touch each other: each would join a link that is itself a joining
-    part (condition 1), so none is one and none is put in an order."""
+@pytest.mark.parametrize("n_links", [1, 2, 3, 6])
+def test_links_in_a_chain_are_no_joining_parts(n_links):
+    """Links in a chain touch each other, and the cap touches the top link only: each
+    would join a part that qualifies itself (condition 1), so none is one and none is put
+    in an order (with one link the cap and the link join each other)."""
     spec, rel = stacked_links(n_links)
-    assert [j.part for j in joining_parts(spec, rel)] == joining
-    assert fastener_order(spec, rel) == (spec, [])  # fewer than two: nothing ordered
+    assert joining_parts(spec, rel) == []
+    assert fastener_order(spec, rel) == (spec, [])
+
+
+def test_a_part_on_one_host_or_three_is_a_joining_part():
+    """A cover touching only the block it sits on, and a bolt through three plates, are
+    joining parts of one and of three parts (the rule once took exactly two: the engine's
+    and the satellite's free modules were none); ordered, the graph keeps a complete
+    sequence and each of its sequences is sound by the original spec's rules."""
+    parts = ("base", "plate1", "plate2", "cover", "bolt", "module")
+    contacts = [
+        ("plate1", "base", "-z"),
+        ("plate2", "plate1", "-z"),
+        ("cover", "plate2", "-z"),
+        ("bolt", "base", "-z"),
+        ("bolt", "plate1", "+x"),
+        ("bolt", "plate2", "+x"),
+        ("module", "base", "-z"),
+    ]
+    blocks = [
+        *(("plate1", "base", d) for d in ("-z", *LATERAL)),
+        *(("plate2", "plate1", d) for d in ("-z", *LATERAL)),
+        ("cover", "plate2", "-z"),
+        ("bolt", "base", "-z"),
+        ("module", "base", "-z"),
+    ]
+    rel = relations(parts, contacts, blocks)
+    spec = parts_spec(parts, "hosts.yaml")
+    found = {j.part: set(j.joins) for j in joining_parts(spec, rel)}
+    assert found == {
+        "cover": {"plate2"},
+        "bolt": {"base", "plate1", "plate2"},
+        "module": {"base"},
+    }
+    ordered, chain = fastener_order(spec, rel)
+    assert [j.part for j in chain] == ["module", "cover", "bolt"]
+    full, reduced = build_state_graph(spec, rel), build_state_graph(ordered, rel)
+    assert reduced.n_states < full.n_states
+    assert done_sets(reduced) <= done_sets(full)
+    sequences = reduced.sequences(limit=50)
+    assert sequences
+    for seq in sequences:
+        check_line(spec, rel, seq)
