@@ -358,7 +358,7 @@ def _fasteners_in_order(
     ]
     say(
         f"too many states ({projected or 'the full graph exceeds the limit'}): "
-        f"{len(found)} joining parts (each touches only the two parts it "
+        f"{len(found)} joining parts (each touches only the parts it "
         "joins and goes in whatever else is there: screws, pins) placed in one order, each "
         f"after the parts it joins ({listed([j.part for j in found])}; "
         "asp/graph/fasteners.py)"
