@@ -382,44 +382,99 @@ def refuted_units(
     """The CAD file's sub-assemblies to give up before any state graph is built: those the
     derived precedences prove leave no complete sequence (:func:`refuted_reasons`), with
     ``exclude``; each given up is said with its proof on ``on_unit``."""
-    say = on_unit or (lambda _line: None)
-    reasons = refuted_reasons(spec, relations, exclude)
-    for line in dict.fromkeys(reasons.values()):
-        say(line)
-    return set(exclude) | set(reasons)
+    return set(exclude) | set(_said_refuted(spec, relations, on_unit, exclude))
+
+
+@dataclass(frozen=True)
+class Refuted:
+    """File units given up together, and the proof that they leave no complete sequence.
+
+    Attributes
+    ----------
+    units : tuple of str
+        The units, sorted.
+    why : str
+        The proof (:attr:`asp.graph.precedences.Refutation.why`, with what it means for
+        the units when a part's hosts reach into them).
+    """
+
+    units: tuple[str, ...]
+    why: str
+
+    @property
+    def reason(self) -> str:
+        """Why each unit is not used (a spec comment, ``plan.json``'s ``units``)."""
+        with_them = "it as one unit" if len(self.units) == 1 else "them as units"
+        return f"no complete sequence with {with_them} ({self.why})"
+
+    @property
+    def line(self) -> str:
+        """The line a person reads on stderr."""
+        one = len(self.units) == 1
+        return (
+            f"the file's sub-assembl{'y' if one else 'ies'} {', '.join(self.units)}: "
+            f"{self.reason}; planned without {'it' if one else 'them'}"
+        )
+
+
+def _said_refuted(
+    spec: AssemblySpec,
+    relations,
+    on_unit: Callable[[str], None] | None,
+    exclude: Iterable[str] = (),
+    *,
+    inserted_only: bool = False,
+) -> dict[str, Refuted]:
+    """:func:`refuted_reasons`, each distinct decision's line said on ``on_unit``."""
+    reasons = refuted_reasons(spec, relations, exclude, inserted_only=inserted_only)
+    if on_unit is not None:
+        for refuted in dict.fromkeys(reasons.values()):
+            on_unit(refuted.line)
+    return reasons
 
 
 def refuted_reasons(
     spec: AssemblySpec, relations, exclude: Iterable[str] = (), *, inserted_only: bool = False
-) -> dict[str, str]:
+) -> dict[str, Refuted]:
     """The CAD file's sub-assemblies the derived precedences prove leave no complete
-    sequence (:func:`asp.graph.precedences.refutation`, milliseconds), each with the one line
-    that says so (the units given up together share it); ``exclude``: given up already.
-    With ``inserted_only``, only units whose insertion a proof names, stopping at the first
-    proof that names none (what ``asmplan init`` writes: :func:`file_units`).
+    sequence (:func:`asp.graph.precedences.refutation`, milliseconds), each with the proof
+    (the units given up together share one :class:`Refuted`); ``exclude``: given up already.
+    With ``inserted_only``, only the units a proof names (their insertion, or the hosts of
+    a part, below), stopping at the first proof that names none (what ``asmplan init``
+    writes: :func:`file_units`).
 
     While the file's units (:func:`with_cad_units`, without the ones given up) admit such a
-    proof, the units it involves are given up (:func:`_proof_units`: the unit whose
-    insertion it names, alone; else those whose members its failing test looks at: what a
-    part could rest on, touch or is blocked by; all of them when it names none); the
-    file's inner groups may then become units. When the same operation fails in the spec
-    without units (a holder blocked by its bearings, whatever the file groups), the units
-    are not the cause and are left to the state graph (:func:`build_with_units`: automatic
-    units); a unit whose insertion the proof names (blocked along every direction by parts
-    that must be there before it: a piston with its pin, grouped without the rod the pin
-    passes through) is always the cause, that operation not existing without it.
+    proof, the units it involves are given up:
 
-    Giving a unit up removes no plan that was possible. The proof holds for every order of
-    the spec with the units of that round, so that spec has no complete sequence: a unit
-    whose insertion can never be done is in no complete sequence, and every plan is a
-    complete sequence. With the unit there is no plan to lose; without it (its members
-    placed one by one) any plan the state graph finds is checked as every plan is. The
-    state graph would give the unit up as well, after building it.
+    - the unit whose insertion it names, alone (blocked along every direction by parts
+      that must be there before it: a piston with its pin, grouped without the rod the pin
+      passes through): that operation does not exist without it;
+    - when it names a part whose every host group (:func:`host_groups`, the parts it could
+      go in with as an automatic unit) takes parts of the file's units, the units of its
+      smallest group (:func:`_units_in_the_way`, the rule the plan's rounds of automatic
+      units apply: the satellite's USB board, resting only on the connectors of two boards
+      the file groups with their standoffs, can go in only with both boards), whether or
+      not the part fails without the units too: with them fixed, no automatic unit can
+      hold it;
+    - else (not ``inserted_only``), those whose members its failing test looks at (what a
+      part could rest on, touch or is blocked by; all of them when it names none), unless
+      the same operation fails in the spec without units (a holder blocked by its
+      bearings, whatever the file groups): the units are then not the cause and are left
+      to the state graph (:func:`build_with_units`: automatic units).
+
+    The file's inner groups may then become units. Giving a unit up removes no plan that
+    was possible. The proof holds for every order of the spec with the units of that
+    round, so that spec has no complete sequence (every plan is a complete sequence):
+    with the unit there is no plan to lose; without it (its members placed one by one, or
+    in an automatic unit) any plan the state graph finds is checked as every plan is.
     """
+    from asp.graph.feasibility import insertion_oracle
     from asp.graph.precedences import refutation
 
     given_up = set(exclude)
-    out: dict[str, str] = {}
+    fixed = {m for _, ms in spec.subassemblies for m in ms}
+    placed_by = {p for op in spec.operations for p in op.parts}
+    out: dict[str, Refuted] = {}
     while True:
         with_units, choices = with_cad_units(spec, relations, given_up)
         used = {u.id: set(u.members) for u in choices if u.used}
@@ -429,21 +484,31 @@ def refuted_reasons(
         if proof is None:
             return out
         op = with_units.operation(proof.operation)
-        if op.unit not in used and inserted_only:
-            return out
-        if op.unit not in used:
+        why = proof.why
+        drop: set[str] = set()
+        if op.unit in used:
+            drop = {op.unit}
+        else:
+            oracle = insertion_oracle(with_units, relations)
+            owner = {m: u for u, ms in used.items() for m in ms}
+            for name in (op.unit,) if op.unit else op.parts:
+                candidates = _host_candidates(
+                    with_units, oracle, oracle.index(name), fixed, placed_by
+                )
+                drop |= _units_in_the_way(candidates, owner)
+                if drop:
+                    hosts = sorted(min(candidates, key=len) - {name})
+                    why += f"; it can go in only with {', '.join(hosts)} holding it"
+                    break
+        if not drop:
+            if inserted_only:
+                return out
             alone = refutation(spec, relations)
             if alone is not None and alone.operation == proof.operation:
                 return out  # the same part fails without units: they are not the cause
-        drop = _proof_units(with_units, proof, used) or set(used)
+            drop = _proof_units(with_units, proof, used) or set(used)
         given_up |= drop
-        one = len(drop) == 1
-        line = (
-            f"the file's sub-assembl{'y' if one else 'ies'} {', '.join(sorted(drop))}: no "
-            f"complete sequence with {'it as one unit' if one else 'them as units'} "
-            f"({proof.why}); planned without {'it' if one else 'them'}"
-        )
-        out.update(dict.fromkeys(drop, line))
+        out.update(dict.fromkeys(drop, Refuted(tuple(sorted(drop)), why)))
 
 
 def _proof_units(spec: AssemblySpec, proof, units: dict[str, set[str]]) -> set[str]:
@@ -463,21 +528,18 @@ def file_units(
 ) -> tuple[HierarchyUnit, ...]:
     """The decisions on the CAD file's sub-assemblies that a plan of the file starts from
     (``asmplan init`` writes them): :func:`cad_units` without the ones the derived
-    precedences prove can never be inserted (:func:`refuted_reasons` with
+    precedences prove leave no complete sequence as units (:func:`refuted_reasons` with
     ``inserted_only``: their reason is the proof, said on ``on_unit`` too), so a written
     spec never fixes a unit that is in no complete sequence (the two-cylinder engine's
     piston with its pin, grouped without the rod the pin passes through; the satellite's
-    ultrasonic sensors, which can only go in built into the front). A proof that names no
-    unit's insertion is left to the plan (its automatic units), the units kept."""
-    reasons = refuted_reasons(spec, relations, inserted_only=True)
-    say = on_unit or (lambda _line: None)
-    for line in dict.fromkeys(reasons.values()):
-        say(line)
+    ultrasonic sensors, which can only go in built into the front) nor one that keeps a
+    part from its only hosts (the satellite's USB board and its two boards). A proof that
+    names no unit is left to the plan (its automatic units), the units kept."""
+    reasons = _said_refuted(spec, relations, on_unit, inserted_only=True)
     out = []
     for u in cad_units(spec, relations, reasons):
         if u.id in reasons and u.reason == GIVEN_UP:
-            why = reasons[u.id].split(": ", 1)[1].removesuffix("; planned without it")
-            u = replace(u, reason=why.removesuffix("; planned without them"))
+            u = replace(u, reason=reasons[u.id].reason)
         out.append(u)
     return tuple(out)
 
@@ -686,24 +748,11 @@ def _new_units(
     before = sorted(map(sorted, groups))
     for i in ops:
         for p in model.part_lists[i]:
-            if p >= len(graph.spec.part_ids) and graph.spec.part_ids:
-                # a unit's insertion: the unit with what holds one of its members
-                name = oracle.parts[p]
-                members = dict(graph.spec.subassemblies)[name]
-                candidates = [
-                    {oracle.parts[j] for j in g} | set(members) - {name}
-                    for m in members
-                    for g in host_groups(oracle, oracle.index(m), oracle.base)
-                ]
-            else:
-                candidates = [
-                    {oracle.parts[j] for j in g} for g in host_groups(oracle, p, oracle.base)
-                ]
             grouped = set().union(*groups) if groups else set()
-            candidates = [c for c in candidates if not c & fixed and c <= placed_by]
-            if candidates and all(c & set(owner) for c in candidates) and drop is not None:
-                smallest = min(candidates, key=len)
-                drop |= {owner[m] for m in smallest if m in owner}
+            candidates = _host_candidates(graph.spec, oracle, p, fixed, placed_by)
+            in_the_way = _units_in_the_way(candidates, owner)
+            if in_the_way and drop is not None:
+                drop |= in_the_way
                 continue
             # a group inside one unit adds nothing; one spanning several units merges them
             # (a stripper plate hanging on the bolts of one and the punch of the other)
@@ -720,6 +769,37 @@ def _new_units(
     order = {p: k for k, p in enumerate(oracle.parts)}
     out = [tuple(sorted(g, key=order.__getitem__)) for g in groups]
     return None if sorted(map(sorted, out)) == before else out
+
+
+def _host_candidates(
+    spec: AssemblySpec, oracle, p: int, fixed: set[str], placed_by: set[str]
+) -> list[set[str]]:
+    """The groups that could carry row ``p`` of ``oracle`` (a part, or a unit of ``spec``)
+    in: its host groups (:func:`host_groups`; a unit's: each member's, with the other
+    members), without those taking parts of the ``fixed`` units' members or parts no
+    operation places (``placed_by``: the parts the operations place)."""
+    if p >= len(spec.part_ids) and spec.part_ids:
+        # a unit's insertion: the unit with what holds one of its members
+        name = oracle.parts[p]
+        members = dict(spec.subassemblies)[name]
+        candidates = [
+            {oracle.parts[j] for j in g} | set(members) - {name}
+            for m in members
+            for g in host_groups(oracle, oracle.index(m), oracle.base)
+        ]
+    else:
+        candidates = [{oracle.parts[j] for j in g} for g in host_groups(oracle, p, oracle.base)]
+    return [c for c in candidates if not c & fixed and c <= placed_by]
+
+
+def _units_in_the_way(candidates: list[set[str]], owner: dict[str, str]) -> set[str]:
+    """The CAD file's units (``owner``: member -> unit) that a part's host groups
+    ``candidates`` (:func:`_host_candidates`) run into: when every group takes parts of
+    them, the units of the smallest group (given up, its parts may join the part's
+    automatic unit); else nothing."""
+    if candidates and all(c & set(owner) for c in candidates):
+        return {owner[m] for m in min(candidates, key=len) if m in owner}
+    return set()
 
 
 def _named(spec: AssemblySpec, groups: list[tuple[str, ...]]) -> list[tuple[str, tuple[str, ...]]]:
@@ -972,6 +1052,7 @@ def unit_parts_of_line(spec: AssemblySpec, operations: Iterable[str]) -> list[li
 
 __all__ = [
     "HierarchyUnit",
+    "Refuted",
     "build_with_units",
     "cad_units",
     "file_units",

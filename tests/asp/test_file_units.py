@@ -126,3 +126,61 @@ def test_a_proved_round_too_large_to_build_gives_the_files_units_up(monkeypatch)
             spec, relations, hierarchy=True, reduce=True, on_unit=lines.append
         )
     assert any(line.startswith("the file's sub-assembly level_2: ") for line in lines)
+
+
+def collared_tower():
+    """The rod tower (each holder touches only its two flanged bearings, so it can only go
+    in with them) with a collar on each lower bearing's flange; the file groups each lower
+    bearing with its collar (buildable, insertable: the unit checks pass both)."""
+    from tests.cad.real_shapes import annulus
+    from tests.cad.test_subassemblies import LEVELS, RODS, rod_tower
+
+    parts = rod_tower()
+    z = LEVELS["1"]
+    for side, x in zip("ab", RODS, strict=True):
+        parts[f"collar_1{side}"] = annulus(4, 7, z + 8, z + 10, 40, 48, (x, 0))
+    return parts
+
+
+COLLAR_UNITS = (
+    ("bearing_a", ("bearing_1a", "collar_1a")),
+    ("bearing_b", ("bearing_1b", "collar_1b")),
+)
+
+
+def test_init_gives_up_the_file_units_a_loose_part_can_only_go_in_with():
+    """The lower holder's one host group is its two bearings, each in a unit of the file:
+    with those units fixed no automatic unit can take the holder in, so the spec ``init``
+    writes would have no plan. ``file_units`` gives both up with the proof and the hosts
+    (the rule the plan's rounds apply, ``_units_in_the_way``); the spec without them
+    plans, the holders going in with their bearings."""
+    from dataclasses import replace
+
+    import pytest
+
+    from asp.errors import InfeasibleAssembly
+    from asp.subassemblies import build_with_units, cad_units, file_units
+    from cad import Assembly, compute_relations
+    from tests.cad.test_subassemblies import tower_spec
+
+    relations = compute_relations(Assembly.from_meshes(collared_tower()))
+    spec = replace(tower_spec(relations), generated=True, hierarchy=COLLAR_UNITS)
+    assert [u.used for u in cad_units(spec, relations)] == [True, True]  # the checks pass them
+    with pytest.raises(InfeasibleAssembly, match="part holder_1"):  # the spec with them fixed
+        build_with_units(tower_spec(relations, {u: list(ms) for u, ms in COLLAR_UNITS}), relations)
+
+    said: list[str] = []
+    decided = file_units(spec, relations, on_unit=said.append)
+    assert [u.used for u in decided] == [False, False]
+    proof = "part holder_1 (operation holder_1) is blocked along every direction"
+    hosts = "it can go in only with bearing_1a, bearing_1b holding it"
+    assert said == [
+        f"the file's sub-assemblies bearing_a, bearing_b: no complete sequence with them as "
+        f"units ({proof} by parts that must be there before it; {hosts}); planned without them"
+    ]
+    assert all(u.reason.startswith("no complete sequence with them as units (") for u in decided)
+    graph = build_with_units(tower_spec(relations), relations)
+    assert sorted(map(sorted, dict(graph.spec.subassemblies).values())) == [
+        ["bearing_1a", "bearing_1b", "holder_1"],
+        ["bearing_2a", "bearing_2b", "holder_2"],
+    ]
